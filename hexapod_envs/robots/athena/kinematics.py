@@ -1,0 +1,198 @@
+"""ATHENA leg kinematics (seed 002, Section 3.2), pure numpy.
+
+Forward kinematics follows the Denavit-Hartenberg table 3 literally (T = Rz(theta) Tz(d) Tx(a)
+Rx(alpha) per row) with the mounting angle theta_1 of eq. (13); `foot_position_closed_form` is
+eq. (12) and must agree with the DH product. Inverse kinematics is the analytic solution of
+eqs. (14)-(18): the TC angle from the foot's azimuth about the hip, then a planar two-link problem
+for CTr and FTi on the "knee up" branch (theta_4 in (-pi, 0), the branch of the standing posture;
+eq. (18)'s pi + acos(...) is the same angle modulo 2 pi).
+
+All positions are in the body frame (x forward, y left, z up, origin at the torso centre), in m;
+angles are the DH joint angles theta_2 (TC), theta_3 (CTr), theta_4 (FTi) in rad. Per-robot
+arrays have shape (6, 3): rows in `LEG_NAMES` order, columns (TC, CTr, FTi) or (x, y, z).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .params import ATHENA, JOINT_NAMES, LEG_NAMES, AthenaParams
+
+
+def dh_transform(alpha: float, a: float, theta: float, d: float = 0.0) -> np.ndarray:
+    """Homogeneous 4x4 transform of one DH row: Rz(theta) Tz(d) Tx(a) Rx(alpha)."""
+    ct, st = math.cos(theta), math.sin(theta)
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    return np.array(
+        [
+            [ct, -st * ca, st * sa, a * ct],
+            [st, ct * ca, -ct * sa, a * st],
+            [0.0, sa, ca, d],
+            [0.0, 0.0, 0.0, 1.0],
+        ]
+    )
+
+
+def dh_table(leg: str, q: np.ndarray, params: AthenaParams = ATHENA) -> list[tuple]:
+    """Table 3 for `leg` at joint angles q = (theta_2, theta_3, theta_4): rows (alpha, a, theta)."""
+    q = _leg_angles(q)
+    return [
+        (0.0, params.hip_distance(leg), params.mounting_angle(leg)),
+        (math.pi / 2, params.l2, q[0]),
+        (0.0, params.l3, q[1]),
+        (0.0, params.l4, q[2]),
+    ]
+
+
+def leg_frames(leg: str, q: np.ndarray, params: AthenaParams = ATHENA) -> np.ndarray:
+    """(5, 4, 4) transforms T_k^0 of the DH frames {0} (body) ... {4} (foot centre)."""
+    frames = [np.eye(4)]
+    for alpha, a, theta in dh_table(leg, q, params):
+        frames.append(frames[-1] @ dh_transform(alpha, a, theta))
+    return np.array(frames)
+
+
+def forward_kinematics(leg: str, q: np.ndarray, params: AthenaParams = ATHENA) -> np.ndarray:
+    """Foot-sphere centre of `leg` in the body frame (eq. 11, via the DH chain), m."""
+    return leg_frames(leg, q, params)[-1][:3, 3].copy()
+
+
+def foot_position_closed_form(leg: str, q: np.ndarray, params: AthenaParams = ATHENA) -> np.ndarray:
+    """Eq. (12) written out: the same point as `forward_kinematics`, m."""
+    t2, t3, t4 = _leg_angles(q)
+    t1, l1 = params.mounting_angle(leg), params.hip_distance(leg)
+    reach = params.l4 * math.cos(t3 + t4) + params.l3 * math.cos(t3) + params.l2
+    return np.array(
+        [
+            math.cos(t1 + t2) * reach + l1 * math.cos(t1),
+            math.sin(t1 + t2) * reach + l1 * math.sin(t1),
+            params.l4 * math.sin(t3 + t4) + params.l3 * math.sin(t3),
+        ]
+    )
+
+
+def forward_kinematics_all(q: np.ndarray, params: AthenaParams = ATHENA) -> np.ndarray:
+    """(6, 3) foot positions in the body frame for (6, 3) joint angles (rows `LEG_NAMES`)."""
+    q = _robot_array(q, "joint angles")
+    return np.array([forward_kinematics(leg, q[i], params) for i, leg in enumerate(LEG_NAMES)])
+
+
+def is_reachable(leg: str, p: np.ndarray, params: AthenaParams = ATHENA) -> bool:
+    """True if the foot point `p` (body frame, m) has an IK solution inside the joint ranges."""
+    try:
+        inverse_kinematics(leg, p, params)
+    except ValueError:
+        return False
+    return True
+
+
+def inverse_kinematics(
+    leg: str, p: np.ndarray, params: AthenaParams = ATHENA, *, clamp: bool = False
+) -> np.ndarray:
+    """Joint angles (theta_2, theta_3, theta_4) that put the foot centre of `leg` at `p`.
+
+    `p` is in the body frame (m). Unreachable points (too far/near for the femur-tibia pair, or
+    angles outside the joint ranges) raise ValueError, unless `clamp` is True: then the distance
+    is clamped to the reachable annulus and the angles to the joint ranges, which gives the
+    nearest pose the servos can take (what a controller wants to command).
+    """
+    p = np.asarray(p, dtype=float)
+    if p.shape != (3,) or not np.all(np.isfinite(p)):
+        raise ValueError(f"foot position must be 3 finite numbers, got {p!r}")
+    t1 = params.mounting_angle(leg)
+    d = p - params.hip_position(leg)
+    l3, l4 = params.l3, params.l4
+
+    # Eq. (14): TC angle = azimuth of the foot about the hip, relative to the mounting angle.
+    t2 = _wrap(math.atan2(d[1], d[0]) - t1)
+    horizontal = math.hypot(d[0], d[1])
+    tc_lo, tc_hi = params.joint_range("TC")
+    if not tc_lo <= t2 <= tc_hi and tc_lo <= _wrap(t2 + math.pi) <= tc_hi:
+        # Foot horizontally behind the hip (femur down, tibia folded back under the body):
+        # the coxa points away from the foot and the foot's reach along it is negative.
+        t2, horizontal = _wrap(t2 + math.pi), -horizontal
+    # Planar problem in the leg's vertical plane, origin at the CTr joint (frame U, eq. 16).
+    rho = horizontal - params.l2
+    z = d[2]
+    s = math.hypot(rho, z)
+    s_min, s_max = abs(l3 - l4), l3 + l4
+    if not s_min + 1e-12 <= s <= s_max - 1e-12:
+        if not clamp:
+            raise ValueError(
+                f"foot position {p.tolist()} is out of reach of leg {leg}: distance "
+                f"{s:.4f} m from the CTr joint, reachable [{s_min:.4f}, {s_max:.4f}] m"
+            )
+        s_new = min(max(s, s_min + 1e-9), s_max - 1e-9)
+        if s > 0:
+            rho, z = rho * s_new / s, z * s_new / s
+        else:
+            rho, z = s_new, 0.0
+        s = s_new
+    # Eqs. (17)-(18), knee-up branch (theta_4 < 0).
+    c4 = (s * s - l3 * l3 - l4 * l4) / (2 * l3 * l4)
+    t4 = -math.acos(min(1.0, max(-1.0, c4)))
+    t3 = math.atan2(z, rho) - math.atan2(l4 * math.sin(t4), l3 + l4 * math.cos(t4))
+    q = np.array([t2, _wrap(t3), t4])
+
+    lo, hi = params.joint_ranges[:, 0], params.joint_ranges[:, 1]
+    outside = (q < lo - 1e-9) | (q > hi + 1e-9)
+    if np.any(outside):
+        if not clamp:
+            bad = [
+                f"{JOINT_NAMES[k]}={q[k]:.4f} not in [{lo[k]:.4f}, {hi[k]:.4f}]"
+                for k in np.flatnonzero(outside)
+            ]
+            raise ValueError(
+                f"foot position {p.tolist()} of leg {leg} needs joint angles outside the "
+                f"ranges: {', '.join(bad)}"
+            )
+        q = np.clip(q, lo, hi)
+    return q
+
+
+def inverse_kinematics_all(
+    p: np.ndarray, params: AthenaParams = ATHENA, *, clamp: bool = False
+) -> np.ndarray:
+    """(6, 3) joint angles for (6, 3) foot positions (rows in `LEG_NAMES` order)."""
+    p = _robot_array(p, "foot positions")
+    return np.array(
+        [inverse_kinematics(leg, p[i], params, clamp=clamp) for i, leg in enumerate(LEG_NAMES)]
+    )
+
+
+def standing_joint_angles(params: AthenaParams = ATHENA) -> np.ndarray:
+    """(6, 3) joint angles of the standing posture (Section 5.1), rad."""
+    return np.tile(np.asarray(params.standing_posture, dtype=float), (6, 1))
+
+
+def standing_foot_positions(params: AthenaParams = ATHENA) -> np.ndarray:
+    """(6, 3) foot-centre positions of the standing posture in the body frame, m."""
+    return forward_kinematics_all(standing_joint_angles(params), params)
+
+
+def within_limits(q: np.ndarray, params: AthenaParams = ATHENA) -> np.ndarray:
+    """Boolean mask (same shape as q, last axis = joints) of angles inside the joint ranges."""
+    q = np.asarray(q, dtype=float)
+    lo, hi = params.joint_ranges[:, 0], params.joint_ranges[:, 1]
+    return (q >= lo) & (q <= hi)
+
+
+def _leg_angles(q: np.ndarray) -> np.ndarray:
+    q = np.asarray(q, dtype=float)
+    if q.shape != (3,):
+        raise ValueError(f"leg joint angles must have shape (3,) = {JOINT_NAMES}, got {q.shape}")
+    return q
+
+
+def _robot_array(a: np.ndarray, what: str) -> np.ndarray:
+    a = np.asarray(a, dtype=float)
+    if a.shape != (6, 3):
+        raise ValueError(f"{what} must have shape (6, 3) (rows {LEG_NAMES}), got {a.shape}")
+    return a
+
+
+def _wrap(angle: float) -> float:
+    """Angle wrapped to (-pi, pi]."""
+    return math.atan2(math.sin(angle), math.cos(angle))

@@ -1,0 +1,152 @@
+"""ATHENA parameters and DH kinematics (seed 002, Section 3.2): closed-form checks, no MuJoCo."""
+
+import math
+
+import numpy as np
+import pytest
+
+from hexapod_envs.robots.athena import kinematics as kin
+from hexapod_envs.robots.athena.params import (
+    ATHENA,
+    JOINT_NAMES,
+    LEG_FROM_PAPER_NUMBER,
+    LEG_NAMES,
+    PAPER_LEG_NUMBER,
+    TRIPODS,
+)
+
+
+def _random_angles(rng, n):
+    lo, hi = ATHENA.joint_ranges[:, 0], ATHENA.joint_ranges[:, 1]
+    return rng.uniform(lo, hi, size=(n, 3))
+
+
+def test_table2_inertias_are_those_of_the_listed_boxes():
+    # The reading of the table's inertia unit (1e-3 kg m^2) rests on this check.
+    for link in (ATHENA.body, ATHENA.coxa, ATHENA.femur, ATHENA.tibia):
+        lx, ly, lz = link.size
+        box = link.mass / 12 * np.array([ly**2 + lz**2, lx**2 + lz**2, lx**2 + ly**2])
+        np.testing.assert_allclose(link.inertia, box, rtol=0.04)
+    sphere = 0.4 * ATHENA.foot.mass * ATHENA.foot.radius**2
+    np.testing.assert_allclose(ATHENA.foot.inertia, sphere, rtol=0.01)
+
+
+def test_total_mass_and_standing_height():
+    assert ATHENA.total_mass == pytest.approx(0.7 + 6 * (0.081 + 0.136 + 0.0134 + 0.0089))
+    assert ATHENA.standing_torso_height == pytest.approx(0.084 + 0.020)
+
+
+def test_joint_ranges_keep_the_papers_ranges_about_the_standing_posture():
+    np.testing.assert_allclose(ATHENA.joint_range("TC"), (-0.612, 0.612))
+    np.testing.assert_allclose(ATHENA.joint_range("CTr"), (-1.484, 1.484))
+    np.testing.assert_allclose(
+        ATHENA.joint_range("FTi"), (-math.pi / 2 - 1.484, -math.pi / 2 + 1.484)
+    )
+    assert np.all(kin.within_limits(kin.standing_joint_angles()))
+
+
+def test_mounting_angles_are_eq13_rotated_into_our_frame():
+    a = math.atan(ATHENA.hip_offset_x / ATHENA.hip_offset_y)  # eq. (13)'s atan(l0/w)
+    paper = {1: 0.0, 2: a, 3: math.pi - a, 4: math.pi, 5: math.pi + a, 6: -a}
+    for n, theta_paper in paper.items():
+        ours = ATHENA.mounting_angle(LEG_FROM_PAPER_NUMBER[n])
+        assert math.isclose(math.cos(ours), math.cos(theta_paper - math.pi / 2), abs_tol=1e-12)
+        assert math.isclose(math.sin(ours), math.sin(theta_paper - math.pi / 2), abs_tol=1e-12)
+
+
+def test_paper_numbering_runs_counter_clockwise_from_the_right_middle_leg():
+    assert LEG_FROM_PAPER_NUMBER[1] == "RM"
+    azimuths = [ATHENA.mounting_angle(LEG_FROM_PAPER_NUMBER[n]) for n in range(1, 7)]
+    steps = np.mod(np.diff(azimuths + azimuths[:1]), 2 * math.pi)
+    assert np.all(steps > 0) and math.isclose(steps.sum(), 2 * math.pi)  # one CCW turn
+    # Paper tripods {1, 3, 5} and {2, 4, 6} are the project's tripods.
+    assert {PAPER_LEG_NUMBER[leg] for leg in TRIPODS[0]} == {1, 3, 5}
+    assert {PAPER_LEG_NUMBER[leg] for leg in TRIPODS[1]} == {2, 4, 6}
+
+
+def test_dh_chain_equals_eq12_closed_form():
+    rng = np.random.default_rng(0)
+    for q in _random_angles(rng, 50):
+        for leg in LEG_NAMES:
+            np.testing.assert_allclose(
+                kin.forward_kinematics(leg, q), kin.foot_position_closed_form(leg, q), atol=1e-12
+            )
+
+
+def test_dh_foot_frame_matches_eq11_rotation():
+    q = np.array([0.3, -0.4, -1.2])
+    leg = "RF"
+    t = kin.leg_frames(leg, q)[-1]
+    t12 = ATHENA.mounting_angle(leg) + q[0]
+    t34 = q[1] + q[2]
+    expected = np.array(
+        [
+            [math.cos(t12) * math.cos(t34), -math.cos(t12) * math.sin(t34), math.sin(t12)],
+            [math.sin(t12) * math.cos(t34), -math.sin(t12) * math.sin(t34), -math.cos(t12)],
+            [math.sin(t34), math.cos(t34), 0.0],
+        ]
+    )
+    np.testing.assert_allclose(t[:3, :3], expected, atol=1e-12)
+
+
+def test_standing_feet_are_below_and_outward_of_the_hips():
+    feet = kin.standing_foot_positions()
+    for i, leg in enumerate(LEG_NAMES):
+        hip = ATHENA.hip_position(leg)
+        t1 = ATHENA.mounting_angle(leg)
+        reach = ATHENA.l2 + ATHENA.l3
+        expected = hip + np.array([reach * math.cos(t1), reach * math.sin(t1), -ATHENA.l4])
+        np.testing.assert_allclose(feet[i], expected, atol=1e-12)
+    # Left feet at y > 0, right at y < 0, front at x > 0 (our frame: x fwd, y left).
+    assert np.all(feet[:3, 1] > 0) and np.all(feet[3:, 1] < 0)
+    assert feet[0, 0] > 0 and feet[2, 0] < 0
+
+
+def test_ik_inverts_fk_over_the_joint_ranges():
+    rng = np.random.default_rng(1)
+    for q in _random_angles(rng, 300):
+        for leg in LEG_NAMES:
+            p = kin.forward_kinematics(leg, q)
+            q_ik = kin.inverse_kinematics(leg, p)
+            np.testing.assert_allclose(q_ik, q, atol=1e-9)
+            np.testing.assert_allclose(kin.forward_kinematics(leg, q_ik), p, atol=1e-12)
+
+
+def test_whole_robot_ik_round_trip():
+    rng = np.random.default_rng(2)
+    q = _random_angles(rng, 6)
+    np.testing.assert_allclose(
+        kin.inverse_kinematics_all(kin.forward_kinematics_all(q)), q, atol=1e-9
+    )
+
+
+def test_ik_rejects_unreachable_points_and_clamps_on_request():
+    hip = ATHENA.hip_position("LM")
+    far = hip + np.array([0.0, 0.5, -0.1])
+    with pytest.raises(ValueError, match="out of reach"):
+        kin.inverse_kinematics("LM", far)
+    assert not kin.is_reachable("LM", far)
+    q = kin.inverse_kinematics("LM", far, clamp=True)
+    assert np.all(kin.within_limits(q))
+    # Clamped pose points the fully stretched leg at the target.
+    p = kin.forward_kinematics("LM", q)
+    assert np.linalg.norm(p - far) == pytest.approx(
+        np.linalg.norm(far - hip) - ATHENA.l2 - ATHENA.l3 - ATHENA.l4, abs=0.02
+    )
+    # A foot swung beyond the TC range is rejected, and clamped to the range limit.
+    behind = hip + 0.15 * np.array([-math.sin(1.0), math.cos(1.0), 0.0]) - [0, 0, 0.08]
+    with pytest.raises(ValueError, match="TC"):
+        kin.inverse_kinematics("LM", behind)
+    assert kin.inverse_kinematics("LM", behind, clamp=True)[0] == pytest.approx(0.612)
+
+
+def test_bad_inputs_raise_clear_errors():
+    with pytest.raises(ValueError, match="valid: LF, LM, LR, RF, RM, RR"):
+        kin.forward_kinematics("XX", np.zeros(3))
+    with pytest.raises(ValueError, match="shape"):
+        kin.forward_kinematics("LF", np.zeros(2))
+    with pytest.raises(ValueError, match=r"\(6, 3\)"):
+        kin.forward_kinematics_all(np.zeros((5, 3)))
+    with pytest.raises(ValueError, match="joint"):
+        ATHENA.joint_range("knee")
+    assert JOINT_NAMES == ("TC", "CTr", "FTi")
