@@ -1,0 +1,59 @@
+"""The one interface every controller implements, learned or analytical.
+
+A policy is an object with ``reset()`` (start of an episode) and ``__call__(observation) ->
+action`` returning an action in the env's own action space. `evaluate.py` runs all of them the
+same way. Analytical policies read the observation by name through the env's
+`observation_structure`; none of them reaches into the simulator.
+"""
+
+from __future__ import annotations
+
+from typing import Protocol, runtime_checkable
+
+import gymnasium as gym
+import numpy as np
+
+
+@runtime_checkable
+class Policy(Protocol):
+    def reset(self) -> None: ...
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray: ...
+
+
+class ZeroPolicy:
+    """Always the zero action (in residual mode: the env's reference motion)."""
+
+    def __init__(self, action_space: gym.spaces.Box):
+        self._action = np.zeros(action_space.shape, dtype=action_space.dtype)
+
+    def reset(self) -> None:
+        pass
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        return self._action.copy()
+
+
+class RandomPolicy:
+    """Uniform random actions from a seeded generator (reproducible with `seed`)."""
+
+    def __init__(self, action_space: gym.spaces.Box, seed: int | None = None):
+        self.space, self.seed = action_space, seed
+        self.reset()
+
+    def reset(self) -> None:
+        self._rng = np.random.default_rng(self.seed)
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        low, high = self.space.low, self.space.high
+        return self._rng.uniform(low, high).astype(self.space.dtype)
+
+
+class ObservationReader:
+    """Named access to a flat observation: ``reader(obs)["fasm_margin_deg"]``."""
+
+    def __init__(self, structure: dict[str, slice]):
+        self.structure = dict(structure)
+
+    def __call__(self, observation: np.ndarray) -> dict[str, np.ndarray]:
+        return {name: observation[..., sl] for name, sl in self.structure.items()}

@@ -1,0 +1,17 @@
+"""Gymnasium environments on MuJoCo for hexapod robots (see DESIGN.md).
+
+Importing the package registers the env ids with Gymnasium:
+
+>>> import gymnasium as gym, hexapod_envs
+>>> env = gym.make("HexapodCliffWalk-v0")
+"""
+
+from gymnasium.envs.registration import register
+
+__version__ = "0.1.0"
+
+register(
+    id="HexapodCliffWalk-v0",
+    entry_point="hexapod_envs.envs.cliff_walk:CliffWalkEnv",
+    max_episode_steps=3000,
+)

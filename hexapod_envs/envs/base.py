@@ -1,0 +1,188 @@
+"""Shared machinery of every hexapod env: model building, fixed control timing, stepping with
+instability detection, observations from named pieces, reward from named terms, rendering.
+
+Subclasses provide the model (`_build_spec`), the action mapping (`_ctrl_from_action`), the
+observation pieces (`_observation_pieces`), the reward terms and the termination rule.
+"""
+
+from __future__ import annotations
+
+import inspect
+from collections.abc import Mapping
+from typing import Any, ClassVar
+
+import gymnasium as gym
+import mujoco
+import numpy as np
+from gymnasium import spaces
+
+DEFAULT_CAMERA = {"distance": 14.0, "elevation": -20.0, "azimuth": 135.0, "trackbodyid": 1}
+
+
+def check_kwargs(cls: type, kwargs: Mapping[str, Any]) -> None:
+    """Raise a TypeError naming unknown keyword arguments and listing the valid ones."""
+    valid: set[str] = set()
+    for klass in cls.__mro__:
+        init = klass.__dict__.get("__init__")
+        if init is None:
+            continue
+        params = inspect.signature(init).parameters.values()
+        valid |= {p.name for p in params if p.kind is p.KEYWORD_ONLY}
+        if not any(p.kind is p.VAR_KEYWORD for p in params):
+            break
+    unknown = sorted(set(kwargs) - set(valid))
+    if unknown:
+        raise TypeError(
+            f"{cls.__name__} got unknown keyword argument(s) {unknown}; valid: {sorted(valid)}"
+        )
+
+
+def substeps_for(control_dt: float, physics_dt: float) -> int:
+    """Physics steps per control step; the ratio must be a whole number."""
+    if control_dt <= 0 or physics_dt <= 0:
+        raise ValueError(f"control_dt and physics_dt must be > 0, got {control_dt}, {physics_dt}")
+    n = round(control_dt / physics_dt)
+    if n < 1 or abs(n * physics_dt - control_dt) > 1e-9 * max(1.0, control_dt):
+        raise ValueError(
+            f"control_dt={control_dt} s is not a whole multiple of physics_dt={physics_dt} s"
+        )
+    return n
+
+
+class ObservationLayout:
+    """An ordered list of named pieces laid out in one flat vector (name -> slice)."""
+
+    def __init__(self, sizes: Mapping[str, int]):
+        self.slices: dict[str, slice] = {}
+        start = 0
+        for name, size in sizes.items():
+            self.slices[name] = slice(start, start + size)
+            start += size
+        self.size = start
+
+    def pack(self, pieces: Mapping[str, np.ndarray], out: np.ndarray) -> np.ndarray:
+        for name, sl in self.slices.items():
+            out[sl] = pieces[name]
+        return out
+
+    def unpack(self, observation: np.ndarray) -> dict[str, np.ndarray]:
+        return {name: observation[..., sl] for name, sl in self.slices.items()}
+
+
+class HexapodEnv(gym.Env):
+    """Base class; see the module docstring. Keyword arguments are checked by name."""
+
+    metadata: ClassVar[dict[str, Any]] = {
+        "render_modes": ["human", "rgb_array", "depth_array"],
+        "render_fps": 50,
+    }
+
+    def __new__(cls, *args: Any, **kwargs: Any):
+        check_kwargs(cls, kwargs)
+        return super().__new__(cls)
+
+    def __init__(
+        self,
+        *,
+        control_dt: float,
+        physics_dt: float,
+        render_mode: str | None = None,
+        width: int = 640,
+        height: int = 480,
+        camera_name: str | None = None,
+    ):
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(
+                f"render_mode must be one of {self.metadata['render_modes']}, got {render_mode!r}"
+            )
+        self.control_dt = control_dt
+        self.physics_dt = physics_dt
+        self.n_substeps = substeps_for(control_dt, physics_dt)
+        self.render_mode = render_mode
+        self.metadata = {**self.metadata, "render_fps": int(round(1.0 / control_dt))}
+        self._render_size = (width, height)
+        self._camera_name = camera_name
+        self._renderer = None
+        self.model: mujoco.MjModel | None = None
+        self.data: mujoco.MjData | None = None
+
+    # --- model ---------------------------------------------------------------------------
+    def _compile(self, spec: mujoco.MjSpec) -> None:
+        """Compile `spec` with the env's physics timestep and (re)create data."""
+        spec.option.timestep = self.physics_dt
+        spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+        spec.visual.global_.offwidth = max(self._render_size[0], 640)
+        spec.visual.global_.offheight = max(self._render_size[1], 480)
+        self.model = spec.compile()
+        self.data = mujoco.MjData(self.model)
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    def _set_observation_layout(self, sizes: Mapping[str, int]) -> None:
+        self.observation_layout = ObservationLayout(sizes)
+        self.observation_space = spaces.Box(
+            -np.inf, np.inf, shape=(self.observation_layout.size,), dtype=np.float64
+        )
+        self._obs_buffer = np.zeros(self.observation_layout.size)
+
+    @property
+    def observation_structure(self) -> dict[str, slice]:
+        """Name -> slice of every piece of the flat observation vector."""
+        return dict(self.observation_layout.slices)
+
+    def _observation(self) -> np.ndarray:
+        self.observation_layout.pack(self._observation_pieces(), self._obs_buffer)
+        return self._obs_buffer.copy()
+
+    # --- stepping ------------------------------------------------------------------------
+    @staticmethod
+    def _validate_action(action: Any, space: spaces.Box) -> np.ndarray:
+        a = np.asarray(action, dtype=np.float64)
+        if a.shape != space.shape:
+            raise ValueError(f"action has shape {a.shape}; this env expects {space.shape}")
+        if not np.all(np.isfinite(a)):
+            bad = np.flatnonzero(~np.isfinite(a)).tolist()
+            raise ValueError(f"action contains NaN or inf at indices {bad}")
+        return np.clip(a, space.low, space.high)
+
+    def _simulate(self, ctrl: np.ndarray) -> bool:
+        """Run the physics for one control period; False if the simulation went unstable."""
+        self.data.ctrl[:] = ctrl
+        mujoco.mj_step(self.model, self.data, nstep=self.n_substeps)
+        w = self.data.warning
+        unstable = (
+            w[mujoco.mjtWarning.mjWARN_BADQACC].number
+            + w[mujoco.mjtWarning.mjWARN_BADQVEL].number
+            + w[mujoco.mjtWarning.mjWARN_BADQPOS].number
+        ) > 0
+        return not (unstable or not np.isfinite(self.data.qpos).all())
+
+    def _observation_pieces(self) -> dict[str, np.ndarray]:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    # --- rendering -----------------------------------------------------------------------
+    def render(self):
+        if self.render_mode is None:
+            gym.logger.warn("render() called without a render_mode; pass render_mode= to make()")
+            return None
+        if self._renderer is None:
+            from gymnasium.envs.mujoco.mujoco_rendering import MujocoRenderer
+
+            cam_id = None
+            if self._camera_name is not None:
+                cam_id = self.model.camera(self._camera_name).id
+            self._renderer = MujocoRenderer(
+                self.model,
+                self.data,
+                default_cam_config=None if cam_id is not None else DEFAULT_CAMERA,
+                width=self._render_size[0],
+                height=self._render_size[1],
+                camera_id=cam_id,
+            )
+        return self._renderer.render(self.render_mode)
+
+    def close(self):
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None

@@ -1,0 +1,74 @@
+"""HexapodCliffWalk-v0: the heavy-duty hexapod walks a tripod gait toward a unilateral cliff.
+
+Seed 000 §5.1: after 3 s of standing the robot walks on flat ground that, ahead of it, drops away
+on one side; a leg on that side steps into the void, the FASM falls below ξ_f = 20° and, without a
+recovery controller, the robot tips over.
+
+| Observation piece | size | unit |
+|---|---|---|
+| joint_pos | 18 | J_x, J_z [m], J_theta [rad] per leg (LF LM LR RF RM RR) |
+| joint_vel | 18 | m/s, rad/s |
+| foot_force | 18 | ground reaction on each foot, world frame [N] |
+| foot_contact | 6 | 1 when the foot carries > contact_threshold of the weight |
+| fasm_margin_deg | 1 | FASM from the measured foot forces [deg] (0 without a support polygon) |
+| imu_gyro | 3 | body angular velocity [rad/s] |
+| imu_accel | 3 | accelerometer [m/s²] |
+| imu_quat | 4 | body orientation (w, x, y, z) |
+| gait_phase | 3 | sin, cos of the gait clock, 1 once walking |
+
+| Reward term (info key) | meaning |
+|---|---|
+| reward_forward | forward_weight x CoG speed along x [m/s] |
+| reward_stability | stability_weight x clip(FASM, -20, 45) / 45 |
+| reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
+| reward_effort | -effort_weight x sum of |joint power| / (weight x gait speed) |
+
+Action: see `HeavyDutyEnv` (``action_mode="joint"`` or ``"residual"``, 18 values in [-1, 1]).
+"""
+
+from __future__ import annotations
+
+import mujoco
+
+from ..terrain.cliff import CLIFF_SIDES, add_cliff
+from ..terrain.flat import add_flat
+from .heavy_duty import HeavyDutyEnv
+
+TERRAINS = ("cliff", "flat")
+
+
+class CliffWalkEnv(HeavyDutyEnv):
+    """Tripod walking toward a unilateral cliff (set ``terrain="flat"`` for plain ground)."""
+
+    def __init__(
+        self,
+        *,
+        terrain: str = "cliff",
+        cliff_x: float = 2.8,
+        cliff_side: str = "right",
+        cliff_drop: float = 3.0,
+        cliff_edge_y: float = -1.0,
+        friction: float = 1.0,
+        **kwargs,
+    ):
+        if terrain not in TERRAINS:
+            raise ValueError(f"terrain must be one of {TERRAINS}, got {terrain!r}")
+        if cliff_side not in CLIFF_SIDES:
+            raise ValueError(f"cliff_side must be one of {CLIFF_SIDES}, got {cliff_side!r}")
+        front_feet_x = 2.4 + 0.25  # hip_x + half the stroke: the farthest a foot starts
+        if terrain == "cliff" and cliff_x <= front_feet_x:
+            raise ValueError(
+                f"cliff_x={cliff_x} m places the cliff at or behind the robot's front feet "
+                f"(x <= {front_feet_x} m); the robot walks along +x, put the cliff ahead of it"
+            )
+        self.terrain = terrain
+        self.cliff = {"start_x": cliff_x, "side": cliff_side, "drop": cliff_drop,
+                      "edge_y": cliff_edge_y}
+        self.friction = friction
+        super().__init__(**kwargs)
+
+    def _add_terrain(self, spec: mujoco.MjSpec) -> None:
+        if self.terrain == "flat":
+            add_flat(spec, friction=self.friction)
+        else:
+            add_cliff(spec, friction=self.friction, **self.cliff)

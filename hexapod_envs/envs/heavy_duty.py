@@ -1,0 +1,311 @@
+"""Common part of the envs that use the 5 t heavy-duty hexapod of seed 000.
+
+Action modes:
+- ``"joint"``: 18 joint position targets, each normalised to [-1, 1] over its range
+  (J_x, J_z, J_theta per leg, legs in LEG_NAMES order).
+- ``"residual"``: 18 offsets in [-1, 1] added to the reference tripod gait's targets, scaled by
+  ``residual_scale`` times each joint's half range; a zero action walks the paper's gait.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+from gymnasium import spaces
+
+from ..robots.heavy_duty import LEG_NAMES, HeavyDutyParams
+from ..robots.heavy_duty.gait import TripodGait, TripodGaitParams
+from ..robots.heavy_duty.model import add_heavy_duty
+from ..stability import fasm
+from .base import HexapodEnv
+from .sensors import RobotSensors
+
+XI_F_DEG = 20.0
+"""Tipping threshold ξ_f of seed 000 §3 [deg]."""
+
+ACTION_MODES = ("joint", "residual")
+
+
+class JointActionMap:
+    """Maps normalised actions in [-1, 1] to joint targets in the robot's units and back."""
+
+    def __init__(self, ranges: np.ndarray):
+        ranges = np.asarray(ranges, dtype=float)
+        self.low, self.high = ranges[:, 0], ranges[:, 1]
+        self.center = (self.low + self.high) / 2
+        self.half = (self.high - self.low) / 2
+
+    def to_joints(self, action: np.ndarray) -> np.ndarray:
+        return self.center + self.half * np.asarray(action)
+
+    def to_action(self, joints: np.ndarray) -> np.ndarray:
+        return np.clip((np.asarray(joints).reshape(-1) - self.center) / self.half, -1.0, 1.0)
+
+
+def fasm_from_feet(
+    feet: np.ndarray, forces: np.ndarray, cog: np.ndarray, loaded: np.ndarray
+) -> tuple[float, tuple[int, int] | None]:
+    """FASM [deg] from measured foot forces: f_r, n_r = minus the support wrench about the CoG.
+
+    Returns (0, None) when fewer than three feet carry load: no support polygon exists.
+    """
+    if np.count_nonzero(loaded) < 3:
+        return 0.0, None
+    p, f = feet[loaded], forces[loaded]
+    force = -f.sum(axis=0)
+    moment = -np.cross(p - cog, f).sum(axis=0)
+    try:
+        result = fasm(p, cog, force, moment)
+    except ValueError:  # collinear feet: the robot is on an edge
+        return 0.0, None
+    idx = np.flatnonzero(loaded)
+    return float(result.margin_deg), (int(idx[result.edge[0]]), int(idx[result.edge[1]]))
+
+
+class HeavyDutyEnv(HexapodEnv):
+    """Base for the heavy-duty hexapod scenarios: robot, sensors, FASM, action modes, rewards."""
+
+    def __init__(
+        self,
+        *,
+        action_mode: str = "residual",
+        residual_scale: float = 0.25,
+        control_dt: float = 0.02,
+        physics_dt: float = 0.002,
+        gait: TripodGaitParams | None = None,
+        forward_weight: float = 5.0,
+        stability_weight: float = 0.5,
+        tip_over_penalty: float = 100.0,
+        effort_weight: float = 0.05,
+        contact_threshold: float = 0.02,
+        tip_over_angle_deg: float = 30.0,
+        reset_noise_scale: float = 0.01,
+        render_mode: str | None = None,
+        width: int = 640,
+        height: int = 480,
+        camera_name: str | None = None,
+    ):
+        super().__init__(
+            control_dt=control_dt,
+            physics_dt=physics_dt,
+            render_mode=render_mode,
+            width=width,
+            height=height,
+            camera_name=camera_name,
+        )
+        if action_mode not in ACTION_MODES:
+            raise ValueError(f"action_mode must be one of {ACTION_MODES}, got {action_mode!r}")
+        self.action_mode = action_mode
+        self.residual_scale = residual_scale
+        self.robot = HeavyDutyParams()
+        self.gait = TripodGait(self.robot, gait)
+        self.weights = {
+            "forward": forward_weight,
+            "stability": stability_weight,
+            "tip_over": tip_over_penalty,
+            "effort": effort_weight,
+        }
+        self.contact_threshold = contact_threshold
+        self.tip_over_cos = float(np.cos(np.radians(tip_over_angle_deg)))
+        self.reset_noise_scale = reset_noise_scale
+        self.settle_time = 0.5
+        """Physics run in reset() so that the episode starts with the robot resting on its feet [s]."""
+        self.weight_n = self.robot.total_mass * 9.81
+        self.action_map = JointActionMap(np.tile(self.robot.joint_ranges, (6, 1)))
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(18,), dtype=np.float32)
+        steps_per_cycle = self.gait.gait.period / control_dt
+        if abs(steps_per_cycle - round(steps_per_cycle)) > 1e-9:
+            raise ValueError("gait period must be a whole number of control periods")
+        self._steps_per_cycle = int(round(steps_per_cycle))
+        self._reference_table = np.array(
+            [self.gait.joints_at_phase(k / self._steps_per_cycle).reshape(-1)
+             for k in range(self._steps_per_cycle)]
+        )
+        self._stand_steps = int(round(self.gait.gait.stand_time / control_dt))
+        self._build()
+        self._set_observation_layout(
+            {
+                "joint_pos": 18,
+                "joint_vel": 18,
+                "foot_force": 18,
+                "foot_contact": 6,
+                "fasm_margin_deg": 1,
+                "imu_gyro": 3,
+                "imu_accel": 3,
+                "imu_quat": 4,
+                "gait_phase": 3,
+                **self._extra_observation_sizes(),
+            }
+        )
+
+    # --- model ---------------------------------------------------------------------------
+    def _add_terrain(self, spec: mujoco.MjSpec) -> None:  # pragma: no cover - abstract
+        raise NotImplementedError
+
+    def _robot_start_height(self) -> float:
+        return self.robot.stand_height + 0.005
+
+    def _build(self) -> None:
+        spec = mujoco.MjSpec()
+        spec.modelname = type(self).__name__
+        self._add_terrain(spec)
+        self.handles = add_heavy_duty(spec, self.robot, pos=(0.0, 0.0, self._robot_start_height()))
+        self._compile(spec)
+        actuators = tuple(j for leg in LEG_NAMES for j in self.handles.joints[leg])
+        self.sensors = RobotSensors(self.model, self.data, LEG_NAMES, actuators)
+        self._act_ids = np.array([self.model.actuator(a).id for a in actuators])
+        # qpos of each joint in actuator order, to start the robot in the commanded pose.
+        self._joint_qpos = np.array(
+            [self.model.jnt_qposadr[self.model.actuator_trnid[i, 0]] for i in self._act_ids]
+        )
+        self._gears = self.model.actuator_gear[self._act_ids, 0].copy()
+
+    def _extra_observation_sizes(self) -> dict[str, int]:
+        return {}
+
+    # --- time and reference gait ------------------------------------------------------------
+    @property
+    def time(self) -> float:
+        return self._step_count * self.control_dt
+
+    def _gait_step(self) -> int:
+        """Index into the reference table (the gait clock is frozen while standing)."""
+        return max(0, self._step_count - self._stand_steps) % self._steps_per_cycle
+
+    def reference_joints(self) -> np.ndarray:
+        """(18,) reference tripod-gait joint targets at the current time."""
+        return self._reference_table[self._gait_step()]
+
+    def _ctrl_from_action(self, action: np.ndarray) -> np.ndarray:
+        if self.action_mode == "joint":
+            target = self.action_map.to_joints(action)
+        else:
+            target = self.reference_joints() + self.residual_scale * self.action_map.half * action
+        return np.clip(target, self.action_map.low, self.action_map.high)
+
+    # --- reset / step --------------------------------------------------------------------
+    def _initial_joints(self) -> np.ndarray:
+        return self._reference_table[0]
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        mujoco.mj_resetData(self.model, self.data)
+        self._step_count = 0
+        joints = self._initial_joints().copy()
+        noise = self.reset_noise_scale * self.action_map.half
+        joints += self.np_random.uniform(-noise, noise)
+        joints = np.clip(joints, self.action_map.low, self.action_map.high)
+        self.data.qpos[self._joint_qpos] = joints / self._gears
+        self.data.ctrl[self._act_ids] = joints
+        self._on_reset()
+        mujoco.mj_forward(self.model, self.data)
+        # Let the robot settle onto its feet before the episode starts (not part of the episode).
+        for _ in range(int(round(self.settle_time / self.control_dt))):
+            self._simulate(self.data.ctrl.copy())
+        self._tipped = False
+        self._prev_cog = self.sensors.cog().copy()
+        self._start_cog = self._prev_cog.copy()
+        self._update_stability()
+        self._last_obs = self._observation()
+        return self._last_obs, self._info({}, unstable=False)
+
+    def _on_reset(self) -> None:
+        """Hook for scenario state (terrain randomisation, platform pose)."""
+
+    def step(self, action):
+        action = self._validate_action(action, self.action_space)
+        ctrl = self._ctrl_from_action(action)
+        self._before_physics()
+        stable = self._simulate(self._full_ctrl(ctrl))
+        self._step_count += 1
+        if not stable:
+            # Keep training runs alive: end the episode with a flag, return the last good obs.
+            return self._last_obs, 0.0, False, True, self._info({}, unstable=True)
+        self._update_stability()
+        tipped = self._is_tipped_over()
+        self._tipped = self._tipped or tipped
+        terms = self._reward_terms(tipped)
+        self._prev_cog = self.sensors.cog().copy()
+        self._last_obs = self._observation()
+        reward = float(sum(terms.values()))
+        return self._last_obs, reward, tipped, False, self._info(terms, unstable=False)
+
+    def _before_physics(self) -> None:
+        """Hook run before each control period's physics (e.g. driving a platform)."""
+
+    def _full_ctrl(self, robot_ctrl: np.ndarray) -> np.ndarray:
+        ctrl = self.data.ctrl.copy()
+        ctrl[self._act_ids] = robot_ctrl
+        return ctrl
+
+    # --- stability -----------------------------------------------------------------------
+    def _update_stability(self) -> None:
+        forces = self.sensors.foot_forces()
+        self._forces = forces
+        self._loaded = np.linalg.norm(forces, axis=1) > self.contact_threshold * self.weight_n
+        self._fasm_deg, self._fasm_edge = fasm_from_feet(
+            self.sensors.foot_positions(), forces, self.sensors.cog(), self._loaded
+        )
+
+    def _is_tipped_over(self) -> bool:
+        """Tipped over when the body's up axis leans more than `tip_over_angle_deg` from vertical."""
+        return bool(self.sensors.torso_rotation()[2, 2] < self.tip_over_cos)
+
+    # --- observation, reward, info ----------------------------------------------------------
+    def _observation_pieces(self) -> dict[str, np.ndarray]:
+        phase = self._gait_step() / self._steps_per_cycle
+        walking = float(self._step_count >= self._stand_steps)
+        return {
+            "joint_pos": self.sensors.joint_positions(),
+            "joint_vel": self.sensors.joint_velocities(),
+            "foot_force": self._forces.reshape(-1),
+            "foot_contact": self._loaded,
+            "fasm_margin_deg": self._fasm_deg,
+            "imu_gyro": self.sensors.gyro(),
+            "imu_accel": self.sensors.accelerometer(),
+            "imu_quat": self.sensors.orientation(),
+            "gait_phase": (np.sin(2 * np.pi * phase), np.cos(2 * np.pi * phase), walking),
+            **self._extra_observation_pieces(),
+        }
+
+    def _extra_observation_pieces(self) -> dict[str, np.ndarray]:
+        return {}
+
+    def _reward_terms(self, tipped: bool) -> dict[str, float]:
+        w = self.weights
+        cog = self.sensors.cog()
+        speed = (cog[0] - self._prev_cog[0]) / self.control_dt
+        margin = min(max(self._fasm_deg, -XI_F_DEG), 45.0)
+        power = np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
+        reference_power = self.weight_n * self.gait.gait.body_speed
+        return {
+            "forward": w["forward"] * speed,
+            "stability": w["stability"] * margin / 45.0,
+            "tip_over": -w["tip_over"] if tipped else 0.0,
+            "effort": -w["effort"] * power / reference_power,
+        }
+
+    def _info(self, terms: dict[str, float], unstable: bool) -> dict:
+        stance = tuple(leg for leg, on in zip(LEG_NAMES, self._loaded, strict=True) if on)
+        edge = None
+        if self._fasm_edge is not None:
+            edge = (LEG_NAMES[self._fasm_edge[0]], LEG_NAMES[self._fasm_edge[1]])
+        cog = self.sensors.cog()
+        info = {f"reward_{name}": value for name, value in terms.items()}
+        info.update(
+            fasm_margin_deg=self._fasm_deg,
+            fasm_edge=edge,
+            stance_legs=stance,
+            is_tipping=self._fasm_deg < XI_F_DEG,
+            is_tipped_over=self._tipped,
+            is_success=not self._tipped and not unstable,
+            sim_unstable=unstable,
+            time=self.time,
+            cog=cog.copy(),
+            distance=float(cog[0] - self._start_cog[0]),
+        )
+        info.update(self._extra_info())
+        return info
+
+    def _extra_info(self) -> dict:
+        return {}

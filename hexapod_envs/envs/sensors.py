@@ -1,0 +1,89 @@
+"""Named accessors for what a real hexapod measures: joint encoders, 3-D foot force sensors, IMU.
+
+Every robot follows the same naming contract (see robots/*/model.py): per leg `L` a force sensor
+`L_foot_force` on site `L_foot`, actuators named after their joints, and IMU sensors `imu_gyro`,
+`imu_accel`, `imu_quat`. Addresses are resolved once; reading is a few array copies.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+
+def _sensor_slice(model: mujoco.MjModel, name: str) -> slice:
+    sid = model.sensor(name).id
+    adr, dim = model.sensor_adr[sid], model.sensor_dim[sid]
+    return slice(adr, adr + dim)
+
+
+class RobotSensors:
+    """Reads one robot's sensors from `data` (foot forces in the world frame, SI units)."""
+
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        data: mujoco.MjData,
+        legs: tuple[str, ...],
+        actuators: tuple[str, ...],
+        torso: str = "torso",
+    ):
+        self.model, self.data, self.legs = model, data, legs
+        self.n_legs = len(legs)
+        force_adr = [model.sensor_adr[model.sensor(f"{leg}_foot_force").id] for leg in legs]
+        self._force_idx = np.array([[a, a + 1, a + 2] for a in force_adr])
+        self._foot_site = np.array([model.site(f"{leg}_foot").id for leg in legs])
+        self._act = np.array([model.actuator(name).id for name in actuators])
+        self._gyro = _sensor_slice(model, "imu_gyro")
+        self._accel = _sensor_slice(model, "imu_accel")
+        self._quat = _sensor_slice(model, "imu_quat")
+        self.torso_id = model.body(torso).id
+
+    # --- encoders -------------------------------------------------------------------------
+    def joint_positions(self) -> np.ndarray:
+        """Actuator-side joint positions (the robot's joint units), actuator order."""
+        return self.data.actuator_length[self._act]
+
+    def joint_velocities(self) -> np.ndarray:
+        return self.data.actuator_velocity[self._act]
+
+    def actuator_forces(self) -> np.ndarray:
+        return self.data.actuator_force[self._act]
+
+    # --- feet -----------------------------------------------------------------------------
+    def foot_forces(self) -> np.ndarray:
+        """(n_legs, 3) ground reaction force on each foot, world frame [N].
+
+        MuJoCo's force sensor reports, in the site frame, the force the parent exerts on the foot
+        body; with a light foot that is minus the ground reaction.
+        """
+        local = self.data.sensordata[self._force_idx]
+        rot = self.data.site_xmat[self._foot_site].reshape(-1, 3, 3)
+        return -np.einsum("kij,kj->ki", rot, local)
+
+    def foot_positions(self) -> np.ndarray:
+        """(n_legs, 3) foot (sole) points in the world frame [m] (FK of the encoders + IMU)."""
+        return self.data.site_xpos[self._foot_site]
+
+    # --- body -----------------------------------------------------------------------------
+    def gyro(self) -> np.ndarray:
+        return self.data.sensordata[self._gyro]
+
+    def accelerometer(self) -> np.ndarray:
+        return self.data.sensordata[self._accel]
+
+    def orientation(self) -> np.ndarray:
+        """Torso orientation quaternion (w, x, y, z), world frame."""
+        return self.data.sensordata[self._quat]
+
+    def torso_rotation(self) -> np.ndarray:
+        """3x3 rotation matrix body -> world."""
+        return self.data.xmat[self.torso_id].reshape(3, 3)
+
+    def cog(self) -> np.ndarray:
+        """Whole-robot centre of gravity, world frame [m]: what the kinematic model computes from
+        the known link masses and the encoders."""
+        return self.data.subtree_com[self.torso_id]
+
+    def torso_position(self) -> np.ndarray:
+        return self.data.xpos[self.torso_id]

@@ -1,0 +1,184 @@
+"""MuJoCo model of the heavy-duty hexapod, generated from `HeavyDutyParams` with `mujoco.MjSpec`.
+
+Each leg is modelled in foot space: a hinge about x (the swing joint J_theta), a slide along x that
+moves the foot by P_x = K_x J_x (the horizontal joint through its pantograph), and a slide along the
+leg that sets the length d = K_z J_z + L2 (the vertical joint). The position servos act in the
+paper's joint units: their gear is 1/K, so `ctrl` is J and the actuator length sensor reads J.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from .params import JOINT_NAMES, LEG_NAMES, HeavyDutyParams
+
+_COLLIDE_GROUND = 1  # contype/conaffinity bit shared with terrain geoms
+_MASS_SPLIT = {"hip": 0.40, "carriage": 0.30, "shank": 0.28, "foot": 0.02}
+
+
+@dataclass(frozen=True)
+class HeavyDutyHandles:
+    """Names created by `add_heavy_duty`, for the env's named accessors."""
+
+    legs: tuple[str, ...]
+    joints: dict[str, tuple[str, ...]]
+    """Per leg: MuJoCo joint names in the paper's order (horizontal, vertical, swing)."""
+    gears: tuple[float, float, float]
+    """Actuator gear per joint: J = gear * qpos."""
+    torso: str = "torso"
+    root_joint: str = "root"
+
+
+def _box_inertia(mass: float, size: tuple[float, float, float]) -> list[float]:
+    lx, ly, lz = size
+    return [mass * (ly**2 + lz**2) / 12, mass * (lx**2 + lz**2) / 12, mass * (lx**2 + ly**2) / 12]
+
+
+def add_heavy_duty(
+    spec: mujoco.MjSpec,
+    params: HeavyDutyParams | None = None,
+    pos: tuple[float, float, float] = (0.0, 0.0, 1.87),
+    joints: dict[str, np.ndarray] | None = None,
+) -> HeavyDutyHandles:
+    """Add the robot to `spec` with its torso at `pos` (world, m).
+
+    `joints` optionally gives the initial [J_x, J_z, J_theta] per leg (default: standing pose).
+    """
+    p = params or HeavyDutyParams()
+    gears = (1.0 / p.k_x, 1.0 / p.k_z, 1.0)
+    torso = spec.worldbody.add_body(name="torso", pos=list(pos))
+    torso.add_freejoint(name="root")
+    torso.add_geom(
+        name="torso",
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        size=[s / 2 for s in p.body_size],
+        mass=p.body_mass,
+        rgba=[0.75, 0.55, 0.2, 1],
+        contype=_COLLIDE_GROUND,
+        conaffinity=0,
+    )
+    torso.add_site(name="imu", pos=[0, 0, 0])
+    torso.add_site(name="cog", pos=[0, 0, 0], size=[0.05, 0, 0])
+    # Camera that follows the body from behind-left, looking forward-down.
+    torso.add_camera(
+        name="track",
+        mode=mujoco.mjtCamLight.mjCAMLIGHT_TRACKCOM,
+        pos=[-9.0, 7.0, 4.5],
+        xyaxes=[-0.6, -0.8, 0, 0.33, -0.25, 0.91],
+    )
+
+    leg_joints: dict[str, tuple[str, ...]] = {}
+    for leg in LEG_NAMES:
+        l1 = p.signed_l1(leg)
+        names = tuple(f"{leg}_{j}" for j in JOINT_NAMES)
+        leg_joints[leg] = names
+        m = p.leg_mass
+        hip = torso.add_body(name=f"{leg}_hip", pos=p.hip_offsets[leg].tolist())
+        hip.add_joint(
+            name=names[2],
+            type=mujoco.mjtJoint.mjJNT_HINGE,
+            axis=[1, 0, 0],
+            range=list(p.j_theta_range),
+            damping=p.foot_damping[2],
+            armature=50.0,
+        )
+        hip.add_geom(
+            type=mujoco.mjtGeom.mjGEOM_BOX,
+            size=[0.25, abs(l1) / 2, 0.2],
+            pos=[0, l1 / 2, 0],
+            mass=m * _MASS_SPLIT["hip"],
+            contype=0,
+            conaffinity=0,
+            rgba=[0.3, 0.3, 0.35, 1],
+        )
+        carriage = hip.add_body(name=f"{leg}_carriage", pos=[0, l1, 0])
+        carriage.add_joint(
+            name=names[0],
+            type=mujoco.mjtJoint.mjJNT_SLIDE,
+            axis=[1, 0, 0],
+            range=[p.k_x * p.j_x_range[0], p.k_x * p.j_x_range[1]],
+            damping=p.foot_damping[0],
+            armature=20.0,
+        )
+        carriage.add_geom(
+            type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+            fromto=[0, 0, 0.15, 0, 0, -p.l2],
+            size=[0.1, 0, 0],
+            mass=m * _MASS_SPLIT["carriage"],
+            contype=0,
+            conaffinity=0,
+            rgba=[0.3, 0.3, 0.35, 1],
+        )
+        shank = carriage.add_body(name=f"{leg}_shank", pos=[0, 0, -p.l2])
+        shank.add_joint(
+            name=names[1],
+            type=mujoco.mjtJoint.mjJNT_SLIDE,
+            axis=[0, 0, -1],
+            range=[p.k_z * p.j_z_range[0], p.k_z * p.j_z_range[1]],
+            damping=p.foot_damping[1],
+            armature=20.0,
+        )
+        shank.add_geom(
+            type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+            fromto=[0, 0, 0.7, 0, 0, p.foot_radius],
+            size=[0.08, 0, 0],
+            mass=m * _MASS_SPLIT["shank"],
+            contype=0,
+            conaffinity=0,
+            rgba=[0.45, 0.45, 0.5, 1],
+        )
+        foot = shank.add_body(name=f"{leg}_foot", pos=[0, 0, 0])
+        foot.add_geom(
+            name=f"{leg}_foot",
+            type=mujoco.mjtGeom.mjGEOM_SPHERE,
+            size=[p.foot_radius, 0, 0],
+            pos=[0, 0, p.foot_radius],
+            mass=m * _MASS_SPLIT["foot"],
+            contype=_COLLIDE_GROUND,
+            conaffinity=0,
+            friction=[p.friction, 0.005, 0.0001],
+            condim=3,
+            rgba=[0.15, 0.15, 0.15, 1],
+        )
+        # The shank's origin is the sole: the kinematic foot point and the paper's foothold.
+        foot.add_site(name=f"{leg}_foot", pos=[0, 0, 0], size=[0.04, 0, 0])
+
+        for joint, gear, k, f_max in zip(
+            names, gears, p.foot_stiffness, p.force_limit, strict=True
+        ):
+            # A position servo in actuator units: joint-space stiffness = gear^2 * kp.
+            act = spec.add_actuator(
+                name=joint,
+                target=joint,
+                trntype=mujoco.mjtTrn.mjTRN_JOINT,
+                gear=[gear, 0, 0, 0, 0, 0],
+            )
+            kp = k / gear**2
+            act.set_to_position(kp=kp)
+            act.forcelimited = True
+            act.forcerange = [-f_max / gear, f_max / gear]
+            act.ctrlrange = list(p.joint_ranges[JOINT_NAMES.index(joint.split("_")[1])])
+            act.ctrllimited = True
+            spec.add_sensor(
+                name=f"{joint}_pos",
+                type=mujoco.mjtSensor.mjSENS_ACTUATORPOS,
+                objtype=mujoco.mjtObj.mjOBJ_ACTUATOR,
+                objname=joint,
+            )
+        spec.add_sensor(
+            name=f"{leg}_foot_force",
+            type=mujoco.mjtSensor.mjSENS_FORCE,
+            objtype=mujoco.mjtObj.mjOBJ_SITE,
+            objname=f"{leg}_foot",
+        )
+
+    spec.add_sensor(name="imu_gyro", type=mujoco.mjtSensor.mjSENS_GYRO,
+                    objtype=mujoco.mjtObj.mjOBJ_SITE, objname="imu")
+    spec.add_sensor(name="imu_accel", type=mujoco.mjtSensor.mjSENS_ACCELEROMETER,
+                    objtype=mujoco.mjtObj.mjOBJ_SITE, objname="imu")
+    spec.add_sensor(name="imu_quat", type=mujoco.mjtSensor.mjSENS_FRAMEQUAT,
+                    objtype=mujoco.mjtObj.mjOBJ_SITE, objname="imu")
+    return HeavyDutyHandles(legs=LEG_NAMES, joints=leg_joints, gears=gears)

@@ -1,0 +1,113 @@
+"""HexapodCliffWalk-v0: the seed-000 §5.1 numbers, env contract and bad input."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import hexapod_envs  # noqa: F401  (registers the env ids)
+from agents.tripod_gait import TripodGaitPolicy
+
+
+def run(env, policy, steps):
+    obs, info = env.reset(seed=0)
+    policy.reset()
+    infos = [info]
+    for _ in range(steps):
+        obs, _, terminated, truncated, info = env.step(policy(obs))
+        infos.append(info)
+        if terminated or truncated:
+            break
+    return infos
+
+
+@pytest.fixture(scope="module")
+def flat_walk():
+    env = gym.make("HexapodCliffWalk-v0", terrain="flat", action_mode="joint",
+                   max_episode_steps=150 + 5 * 300 + 10)
+    infos = run(env, TripodGaitPolicy(env), 150 + 5 * 300 + 10)
+    env.close()
+    return infos
+
+
+def test_six_leg_standing_margin_is_about_48_deg(flat_walk):
+    standing = [i["fasm_margin_deg"] for i in flat_walk[10:150]]
+    assert all(len(i["stance_legs"]) == 6 for i in flat_walk[10:150])
+    assert 47.0 <= np.median(standing) <= 49.0
+
+
+def test_margin_at_switch_to_tripod_is_about_31_deg(flat_walk):
+    """First control step on three legs after six-leg support (paper: 31.41 deg)."""
+    switches = [
+        k for k in range(151, len(flat_walk))
+        if len(flat_walk[k - 1]["stance_legs"]) > 3 and len(flat_walk[k]["stance_legs"]) == 3
+    ]
+    assert len(switches) >= 9
+    for k in switches:
+        assert 29.5 <= flat_walk[k]["fasm_margin_deg"] <= 32.5
+
+
+def test_flat_tripod_gait_margin_stays_in_band_for_five_cycles(flat_walk):
+    walking = np.array([i["fasm_margin_deg"] for i in flat_walk[151:]])
+    assert len(walking) >= 5 * 300
+    assert walking.min() >= 20.0 and walking.max() <= 52.0
+    assert walking.max() - walking.min() > 15.0  # it varies periodically, it is not flat
+    assert not any(i["is_tipped_over"] for i in flat_walk)
+    assert flat_walk[-1]["distance"] > 5 * 0.5 / (14 / 24) * 0.9  # ~ stroke/beta per cycle
+
+
+@pytest.mark.slow
+def test_cliff_leg_steps_into_void_tipping_flagged_then_tips_over():
+    env = gym.make("HexapodCliffWalk-v0")
+    infos = run(env, TripodGaitPolicy(env), 3000)
+    first_tipping = next(k for k, i in enumerate(infos) if k > 150 and i["is_tipping"])
+    tipped = next(k for k, i in enumerate(infos) if i["is_tipped_over"])
+    assert first_tipping < tipped
+    assert infos[first_tipping]["fasm_margin_deg"] < 20.0
+    assert infos[-1]["is_tipped_over"] and not infos[-1]["is_success"]
+    assert min(i["fasm_margin_deg"] for i in infos[tipped - 50 : tipped]) <= 0.0
+
+
+def test_zero_residual_and_joint_gait_walk_identically():
+    results = []
+    for mode in ("residual", "joint"):
+        env = gym.make("HexapodCliffWalk-v0", terrain="flat", action_mode=mode)
+        infos = run(env, TripodGaitPolicy(env), 200)
+        results.append(np.array([i["cog"] for i in infos]))
+    np.testing.assert_allclose(results[0], results[1], atol=1e-6)
+
+
+def test_unknown_keyword_is_named_with_valid_choices():
+    with pytest.raises(TypeError, match=r"cliff_hieght.*valid.*cliff_drop"):
+        gym.make("HexapodCliffWalk-v0", cliff_hieght=2.0)
+
+
+def test_nan_action_is_a_clear_error():
+    env = gym.make("HexapodCliffWalk-v0")
+    env.reset(seed=0)
+    action = np.zeros(18)
+    action[4] = np.nan
+    with pytest.raises(ValueError, match=r"NaN.*\[4\]"):
+        env.step(action)
+
+
+def test_cliff_behind_the_robot_is_refused():
+    with pytest.raises(ValueError, match="behind"):
+        gym.make("HexapodCliffWalk-v0", cliff_x=-3.0)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [({"action_mode": "torque"}, "joint"), ({"cliff_side": "up"}, "right"),
+     ({"terrain": "ice"}, "flat"), ({"physics_dt": 0.003}, "whole multiple")],
+)
+def test_bad_choices_list_the_valid_ones(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        gym.make("HexapodCliffWalk-v0", **kwargs)
+
+
+def test_unstable_simulation_truncates_with_a_flag():
+    env = gym.make("HexapodCliffWalk-v0")
+    env.reset(seed=0)
+    env.unwrapped.data.qvel[:] = 1e12  # blow the simulation up
+    _, _, terminated, truncated, info = env.step(np.zeros(18))
+    assert truncated and not terminated and info["sim_unstable"]
