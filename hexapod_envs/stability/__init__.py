@@ -1,0 +1,32 @@
+"""Stability measures for legged robots, pure numpy (no MuJoCo).
+
+All functions take contact points in one frame (metres) and are cheap enough to run every
+control step:
+
+- :func:`support_polygon` - convex hull of the contacts, counter-clockwise seen from above.
+- :func:`fasm` - Force-Angle Stability Measure (seed 000 eqs. 5-9), degrees.
+- :func:`static_stability_margin` - CoG projection to support polygon boundary, metres.
+- :func:`zmp`, :func:`zmp_margin` - force-weighted ZMP and its margin (seed 002 eqs. 32-33).
+- :func:`nesm` - Hirose's normalised energy stability margin, metres.
+- :func:`fit_plane` - least-squares ground plane z = a x + b y + c (seed 000 §4.2).
+"""
+
+from hexapod_envs.stability.fasm import FasmResult, fasm
+from hexapod_envs.stability.nesm import nesm, nesm_per_edge
+from hexapod_envs.stability.plane_fit import Plane, fit_plane
+from hexapod_envs.stability.static_margin import static_stability_margin
+from hexapod_envs.stability.support_polygon import support_polygon
+from hexapod_envs.stability.zmp import zmp, zmp_margin
+
+__all__ = [
+    "FasmResult",
+    "Plane",
+    "fasm",
+    "fit_plane",
+    "nesm",
+    "nesm_per_edge",
+    "static_stability_margin",
+    "support_polygon",
+    "zmp",
+    "zmp_margin",
+]

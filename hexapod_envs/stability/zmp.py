@@ -1,0 +1,99 @@
+"""Zero-moment point estimated from normal foot forces, and its margin (seed 002, eqs. 32-33).
+
+Seed 002 (ATHENA) cannot use the torso acceleration in its simulator and estimates the ZMP as
+the normal-force-weighted mean of the foot positions, in the horizontal (x, y) coordinates of the
+frame the feet are given in (the torso frame in the paper):
+
+    p_ZMP = ( Σ f_n,i x_i / Σ f_n,i ,  Σ f_n,i y_i / Σ f_n,i )                        (32)
+    s_ZMP = min(d_1, ..., d_e)                                                      (33)
+
+with d_j the distance of the ZMP to edge j of the support polygon. Because (32) is a convex
+combination of the loaded feet, this ZMP (really a centre of pressure) always lies in the support
+polygon of the loaded feet: s_ZMP >= 0, and it measures how centred the load is rather than
+predicting a tip-over.
+
+Unloaded feet: a foot with normal force <= ``min_force`` (default 1e-6 N; negative readings,
+i.e. sensor noise, included - a foot cannot pull) is not in contact. It gets no weight in (32)
+and is not a vertex of the support polygon in (33). If fewer than 3 loaded feet remain, or the
+loaded feet are collinear, the support polygon has no interior and the ZMP lies on it, so
+``zmp_margin`` returns 0.0 (critical) instead of raising. No loaded foot at all: ValueError
+(the ZMP is undefined).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from hexapod_envs.stability._geometry import REL_TOL, as_points, hull_2d, signed_distance_2d
+
+DEFAULT_MIN_FORCE = 1e-6  # [N] normal force at or below which a foot counts as unloaded
+
+
+def _loaded(feet, normal_forces, min_force: float):
+    pts = as_points(feet, "feet", dims=(2, 3))
+    forces = np.asarray(normal_forces, dtype=float)
+    if forces.shape != (len(pts),):
+        raise ValueError(
+            f"normal_forces must have shape ({len(pts)},) (one per foot), got {forces.shape}"
+        )
+    values = forces.tolist()
+    if not math.isfinite(sum(values)):
+        raise ValueError("normal_forces contains NaN or infinite values")
+    loaded = [(p[0], p[1], f) for p, f in zip(pts, values, strict=True) if f > min_force]
+    if not loaded:
+        raise ValueError(
+            f"no foot carries a normal force above min_force={min_force} N: the ZMP is undefined"
+        )
+    return loaded
+
+
+def _weighted_mean(loaded) -> tuple[float, float]:
+    total = sum(f for _, _, f in loaded)
+    return sum(x * f for x, _, f in loaded) / total, sum(y * f for _, y, f in loaded) / total
+
+
+def zmp(feet, normal_forces, min_force: float = DEFAULT_MIN_FORCE) -> np.ndarray:
+    """ZMP estimate of seed 002 eq. 32: normal-force-weighted mean of the foot (x, y) [m].
+
+    Args:
+        feet: (k, 3) or (k, 2) foot positions [m]; only x and y are used (projection along the
+            frame's z axis, as in the paper).
+        normal_forces: (k,) normal contact force of each foot [N].
+        min_force: feet at or below this force [N] are unloaded and get no weight.
+
+    Returns:
+        (2,) array: the ZMP's x, y [m].
+
+    Raises:
+        ValueError: no loaded foot, shape mismatch, or non-finite input.
+    """
+    return np.array(_weighted_mean(_loaded(feet, normal_forces, min_force)))
+
+
+def zmp_margin(feet, normal_forces, min_force: float = DEFAULT_MIN_FORCE) -> float:
+    """Seed 002 eq. 33: signed distance [m] of the ZMP (eq. 32) to the loaded feet's polygon.
+
+    The support polygon is the convex hull of the loaded feet's (x, y); the margin is the smallest
+    distance from the ZMP to its edges, positive inside (negative outside, which eq. 32 cannot
+    produce). Fewer than 3 loaded feet or collinear loaded feet: 0.0 (see module docstring).
+
+    Args:
+        feet: (k, 3) or (k, 2) foot positions [m]; only x and y are used.
+        normal_forces: (k,) normal contact forces [N].
+        min_force: feet at or below this force [N] are unloaded.
+    """
+    loaded = _loaded(feet, normal_forces, min_force)
+    px, py = _weighted_mean(loaded)
+    if len(loaded) < 3:
+        return 0.0
+    xs = [x for x, _, _ in loaded]
+    ys = [y for _, y, _ in loaded]
+    try:
+        hull = hull_2d(xs, ys)
+    except ValueError:  # loaded feet collinear: a polygon without interior
+        return 0.0
+    margin = signed_distance_2d(xs, ys, hull, px, py)
+    span = max(max(xs) - min(xs), max(ys) - min(ys))
+    return 0.0 if abs(margin) <= REL_TOL * span else margin
