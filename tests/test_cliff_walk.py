@@ -22,8 +22,12 @@ def run(env, policy, steps):
 
 @pytest.fixture(scope="module")
 def flat_walk():
-    env = gym.make("HexapodCliffWalk-v0", terrain="flat", action_mode="joint",
-                   max_episode_steps=150 + 5 * 300 + 10)
+    env = gym.make(
+        "HexapodCliffWalk-v0",
+        terrain="flat",
+        action_mode="joint",
+        max_episode_steps=150 + 5 * 300 + 10,
+    )
     infos = run(env, TripodGaitPolicy(env), 150 + 5 * 300 + 10)
     env.close()
     return infos
@@ -38,7 +42,8 @@ def test_six_leg_standing_margin_is_about_48_deg(flat_walk):
 def test_margin_at_switch_to_tripod_is_about_31_deg(flat_walk):
     """First control step on three legs after six-leg support (paper: 31.41 deg)."""
     switches = [
-        k for k in range(151, len(flat_walk))
+        k
+        for k in range(151, len(flat_walk))
         if len(flat_walk[k - 1]["stance_legs"]) > 3 and len(flat_walk[k]["stance_legs"]) == 3
     ]
     assert len(switches) >= 9
@@ -97,8 +102,12 @@ def test_cliff_behind_the_robot_is_refused():
 
 @pytest.mark.parametrize(
     ("kwargs", "match"),
-    [({"action_mode": "torque"}, "joint"), ({"cliff_side": "up"}, "right"),
-     ({"terrain": "ice"}, "flat"), ({"physics_dt": 0.003}, "whole multiple")],
+    [
+        ({"action_mode": "torque"}, "joint"),
+        ({"cliff_side": "up"}, "right"),
+        ({"terrain": "ice"}, "flat"),
+        ({"physics_dt": 0.003}, "whole multiple"),
+    ],
 )
 def test_bad_choices_list_the_valid_ones(kwargs, match):
     with pytest.raises(ValueError, match=match):

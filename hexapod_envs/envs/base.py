@@ -8,6 +8,7 @@ observation pieces (`_observation_pieces`), the reward terms and the termination
 from __future__ import annotations
 
 import inspect
+import math
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
@@ -138,25 +139,35 @@ class HexapodEnv(gym.Env):
     # --- stepping ------------------------------------------------------------------------
     @staticmethod
     def _validate_action(action: Any, space: spaces.Box) -> np.ndarray:
+        """Check shape and finiteness (clear errors), then clip into the action space."""
         a = np.asarray(action, dtype=np.float64)
         if a.shape != space.shape:
             raise ValueError(f"action has shape {a.shape}; this env expects {space.shape}")
-        if not np.all(np.isfinite(a)):
+        if not math.isfinite(a.sum()):  # one reduction instead of an element-wise test
             bad = np.flatnonzero(~np.isfinite(a)).tolist()
-            raise ValueError(f"action contains NaN or inf at indices {bad}")
+            if bad:
+                raise ValueError(f"action contains NaN or inf at indices {bad}")
         return np.clip(a, space.low, space.high)
 
-    def _simulate(self, ctrl: np.ndarray) -> bool:
-        """Run the physics for one control period; False if the simulation went unstable."""
-        self.data.ctrl[:] = ctrl
+    _UNSTABLE_WARNINGS = [
+        int(mujoco.mjtWarning.mjWARN_BADQACC),
+        int(mujoco.mjtWarning.mjWARN_BADQVEL),
+        int(mujoco.mjtWarning.mjWARN_BADQPOS),
+    ]
+
+    def _simulate(self, ctrl: np.ndarray | None = None) -> bool:
+        """Run the physics for one control period; False if the simulation went unstable.
+
+        MuJoCo resets the state when it meets NaN/huge values and counts a warning; either sign
+        (a warning or a clock that did not advance by one control period) means unstable.
+        """
+        if ctrl is not None:
+            self.data.ctrl[:] = ctrl
+        t_expected = self.data.time + self.control_dt
         mujoco.mj_step(self.model, self.data, nstep=self.n_substeps)
-        w = self.data.warning
-        unstable = (
-            w[mujoco.mjtWarning.mjWARN_BADQACC].number
-            + w[mujoco.mjtWarning.mjWARN_BADQVEL].number
-            + w[mujoco.mjtWarning.mjWARN_BADQPOS].number
-        ) > 0
-        return not (unstable or not np.isfinite(self.data.qpos).all())
+        if abs(self.data.time - t_expected) > 1e-6:
+            return False
+        return not self.data.warning.number[self._UNSTABLE_WARNINGS].any()
 
     def _observation_pieces(self) -> dict[str, np.ndarray]:  # pragma: no cover - abstract
         raise NotImplementedError

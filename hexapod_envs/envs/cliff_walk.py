@@ -62,8 +62,12 @@ class CliffWalkEnv(HeavyDutyEnv):
                 f"(x <= {front_feet_x} m); the robot walks along +x, put the cliff ahead of it"
             )
         self.terrain = terrain
-        self.cliff = {"start_x": cliff_x, "side": cliff_side, "drop": cliff_drop,
-                      "edge_y": cliff_edge_y}
+        self.cliff = {
+            "start_x": cliff_x,
+            "side": cliff_side,
+            "drop": cliff_drop,
+            "edge_y": cliff_edge_y,
+        }
         self.friction = friction
         super().__init__(**kwargs)
 

@@ -59,7 +59,7 @@ class RobotSensors:
         """
         local = self.data.sensordata[self._force_idx]
         rot = self.data.site_xmat[self._foot_site].reshape(-1, 3, 3)
-        return -np.einsum("kij,kj->ki", rot, local)
+        return -(rot @ local[:, :, None])[:, :, 0]
 
     def foot_positions(self) -> np.ndarray:
         """(n_legs, 3) foot (sole) points in the world frame [m] (FK of the encoders + IMU)."""

@@ -39,8 +39,11 @@ def add_cliff(
     back = -length / 2
     # Before the cliff: full width.
     spec.worldbody.add_geom(
-        name="ground", type=box, size=[(start_x - back) / 2, width / 2, thick / 2],
-        pos=[(start_x + back) / 2, 0, -thick / 2], **kw,
+        name="ground",
+        type=box,
+        size=[(start_x - back) / 2, width / 2, thick / 2],
+        pos=[(start_x + back) / 2, 0, -thick / 2],
+        **kw,
     )
     sign = 1.0 if side == "right" else -1.0
     y_edge = sign * edge_y  # world y of the edge
@@ -50,13 +53,17 @@ def add_cliff(
     void_lo, void_hi = (-far, y_edge) if side == "right" else (y_edge, far)
     end = length / 2
     spec.worldbody.add_geom(
-        name="ground_safe", type=box,
+        name="ground_safe",
+        type=box,
         size=[(end - start_x) / 2, (safe_hi - safe_lo) / 2, thick / 2],
-        pos=[(end + start_x) / 2, (safe_hi + safe_lo) / 2, -thick / 2], **kw,
+        pos=[(end + start_x) / 2, (safe_hi + safe_lo) / 2, -thick / 2],
+        **kw,
     )
     void_kw = {**kw, "rgba": [0.35, 0.3, 0.28, 1.0]}
     spec.worldbody.add_geom(
-        name="cliff_floor", type=box,
+        name="cliff_floor",
+        type=box,
         size=[(end - start_x) / 2, (void_hi - void_lo) / 2, thick / 2],
-        pos=[(end + start_x) / 2, (void_hi + void_lo) / 2, -drop - thick / 2], **void_kw,
+        pos=[(end + start_x) / 2, (void_hi + void_lo) / 2, -drop - thick / 2],
+        **void_kw,
     )

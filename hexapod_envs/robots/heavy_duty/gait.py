@@ -41,7 +41,9 @@ class TripodGaitParams:
 
     def __post_init__(self) -> None:
         if not 0.5 <= self.duty_factor < 1.0:
-            raise ValueError(f"duty_factor must be in [0.5, 1) for a tripod gait, got {self.duty_factor}")
+            raise ValueError(
+                f"duty_factor must be in [0.5, 1) for a tripod gait, got {self.duty_factor}"
+            )
         if self.period <= 0 or self.stroke < 0 or self.stand_time < 0:
             raise ValueError("period must be > 0, stroke and stand_time >= 0")
 

@@ -70,7 +70,6 @@ def within_limits(joints: np.ndarray, params: HeavyDutyParams, tol: float = 1e-9
 def standing_feet(params: HeavyDutyParams) -> dict[str, np.ndarray]:
     """Neutral standing footholds in the body frame: (±hip_x | 0, ±(hip_y+L1), −stand_height)."""
     return {
-        leg: params.hip_offsets[leg]
-        + np.array([0.0, params.signed_l1(leg), -params.stand_height])
+        leg: params.hip_offsets[leg] + np.array([0.0, params.signed_l1(leg), -params.stand_height])
         for leg in LEG_NAMES
     }

@@ -1,0 +1,40 @@
+"""HexapodCliffWalk-v0 speed: raw mj_step rate vs the env's rate with substeps counted, and FASM.
+
+Targets (issue 2): env/raw ratio >= 0.9 (Gymnasium's Ant-v5 is measured alongside for context),
+FASM <= 20 us per call. Run: python benchmarks/bench_cliff_walk.py
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run as a script from anywhere
+
+import hexapod_envs  # noqa: F401
+from benchmarks.common import env_vs_raw, per_call_us
+from hexapod_envs.stability import fasm
+
+
+def main() -> None:
+    rows = [("HexapodCliffWalk-v0", *env_vs_raw("HexapodCliffWalk-v0"))]
+    try:
+        rows.append(("Ant-v5 (Gymnasium)", *env_vs_raw("Ant-v5")))
+    except Exception as exc:  # pragma: no cover - Ant needs gymnasium's mujoco extras
+        print(f"Ant-v5 not measured: {exc}")
+    print(f"{'env':24s} {'raw mj_step/s':>14s} {'env physics steps/s':>20s} {'env/raw':>8s}")
+    for name, raw, env_rate in rows:
+        print(f"{name:24s} {raw:14.0f} {env_rate:20.0f} {env_rate / raw:8.2f}")
+
+    tripod = np.array([[2.4, 1.9, -1.75], [-2.4, 1.9, -1.75], [0.0, -1.9, -1.75]])
+    six = np.array([[x, y, -1.75] for y in (1.9, -1.9) for x in (2.4, 0.0, -2.4)])
+    cog, weight = np.zeros(3), np.array([0.0, 0.0, -5000 * 9.81])
+    moment = np.array([100.0, -50.0, 0.0])
+    print(f"FASM, 3 feet: {per_call_us(fasm, tripod, cog, weight, moment):6.1f} us per call")
+    print(f"FASM, 6 feet: {per_call_us(fasm, six, cog, weight, moment):6.1f} us per call")
+
+
+if __name__ == "__main__":
+    main()
