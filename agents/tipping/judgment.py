@@ -174,7 +174,8 @@ def select_adjustment_leg(stance_legs: Iterable[str], tipping_edge: tuple[str, s
             tuple(sorted(k, key=CCW_LEG_ORDER.index)) for k in ADJUSTMENT_LEG if k <= set(tripod)
         ]
         raise ValueError(
-            f"tipping_edge {edge} is not an edge of the stance tripod {tripod}; valid edges: {valid}"
+            f"tipping_edge {edge} is not an edge of the stance tripod {tripod}; "
+            f"valid edges: {valid}"
         )
     return ADJUSTMENT_LEG[frozenset(edge)]
 
