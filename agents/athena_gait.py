@@ -1,0 +1,447 @@
+"""ATHENA's tripod gait and posture controller (seed 002, Section 4), pure numpy.
+
+Gait (Section 4.1). A tripod gait in phases of t_g = 1 s at 20 Hz: in each phase one tripod swings
+along a cubic Bezier curve (eqs. 19-22, stride s, height h) while the other tripod's feet move
+linearly backwards by s (eq. 23). All foot paths are in the body frame and start where the foot
+is at the start of the phase (p_{i,0}, eq. 12 on the measured joint angles); joint targets come
+from the analytic inverse kinematics.
+
+Posture control (Section 4.2), evaluated at the start of every phase:
+  1. contacts from the foot force sensors; the ground plane (eq. 24) through three feet in
+     contact (exactly three normally; more -> choose three; fewer -> the legs that should be in
+     contact are extended downwards until they touch, then the plane is fitted);
+  2. pitch and roll of the torso relative to that plane, delta_alpha and delta_beta
+     (eqs. 25-26), and the height deviation delta_z = torso-height reading - standing height;
+  3. swing end point p_{i,3} = p_{i,0} + (s, 0, k_z delta_z) (eq. 27) and stance end point
+     p_{i,f} = R_y(k_alpha delta_alpha) R_x(k_beta delta_beta) (p_{i,0} + (-s, 0, k_z delta_z))
+     reached linearly (eqs. 28-31); k_z = k_alpha = k_beta = 0 is the paper's "simple control".
+As the paper says, the controller needs only contact forces, joint angles and the torso height
+(no IMU).
+
+Reading of the garbled or ambiguous equations (all choices documented here, once):
+  * Frames: the paper's stride axis is its y; ours is x (x forward, y left, z up), so the paper's
+    (0, s, .) is our (s, 0, .) and its R_x (pitch, about the lateral axis) is our R_y.
+  * Eq. (19) lacks the binomial coefficients and the normalisation by t_g^n; we use the standard
+    cubic Bezier B(u) = sum_j C(3, j) (1-u)^(3-j) u^j p_j with u = t / t_g. With eqs. (20)-(21)'s
+    control points at height h/3 the curve's apex is h/4 above the chord (`swing_apex`).
+  * Eqs. (25)-(26) give unsigned angles (arccos); we use the signed angles of the plane normal g
+    (body frame) projected on the x-z and y-z planes: delta_alpha = atan2(-g_x, g_z) (torso pitch
+    relative to the ground, positive nose down, right-hand rule about y) and delta_beta =
+    atan2(g_y, g_z) (roll relative to the ground, positive left side up). Rotating the stance feet
+    by R_y(k delta_alpha) turns the torso by -k delta_alpha relative to the ground, so k = 1 makes
+    the torso parallel to the estimated ground plane (the paper: with large k_alpha "the torso
+    has the same inclination as the ground").
+  * Eqs. (28)-(31): t_r is a transform; applied as a pure displacement it could not turn the
+    torso, so we apply it to the foot position (rotation about the torso centre) and move the foot
+    linearly from p_{i,0} to p_{i,f}.
+  * "More than three legs in contact -> a random subset of three": with an `rng` we do exactly
+    that (among non-degenerate triples); without one (default) we take the expected stance
+    tripod if all three touch, else the contact triple with the largest support triangle, which
+    is deterministic and never nearly collinear.
+  * Start-up: the first phase moves half a stride, so that afterwards the feet oscillate
+    symmetrically about the standing footholds (the paper does not say how it starts).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from hexapod_envs.robots.athena.kinematics import (
+    forward_kinematics_all,
+    inverse_kinematics,
+)
+from hexapod_envs.robots.athena.params import ATHENA, LEG_NAMES, TRIPODS, AthenaParams
+from hexapod_envs.stability.plane_fit import fit_plane
+
+_TRIPOD_INDICES = tuple(tuple(LEG_NAMES.index(leg) for leg in tripod) for tripod in TRIPODS)
+_MIN_TRIANGLE_AREA = 1e-4  # m², a triple of feet closer to collinear gives no usable plane
+
+
+# ----- pure geometry (eqs. 19-31) ------------------------------------------------------------
+def cubic_bezier(control_points: np.ndarray, u: float) -> np.ndarray:
+    """Point of the cubic Bezier curve with (4, 3) `control_points` at u in [0, 1]."""
+    p = np.asarray(control_points, dtype=float)
+    v = 1.0 - u
+    return v**3 * p[0] + 3 * v * v * u * p[1] + 3 * v * u * u * p[2] + u**3 * p[3]
+
+
+def cubic_bezier_derivative(control_points: np.ndarray, u: float) -> np.ndarray:
+    """dB/du of the cubic Bezier curve at u (divide by t_g for a velocity in m/s)."""
+    p = np.asarray(control_points, dtype=float)
+    v = 1.0 - u
+    return 3 * (v * v * (p[1] - p[0]) + 2 * v * u * (p[2] - p[1]) + u * u * (p[3] - p[2]))
+
+
+def swing_control_points(
+    p0: np.ndarray, stride: float, height: float, height_correction: float = 0.0
+) -> np.ndarray:
+    """(4, 3) control points of eqs. (20)-(22) and (27) in our frame (stride along +x), m.
+
+    `height_correction` is k_z delta_z of eq. (27): it moves only the end point.
+    """
+    p0 = np.asarray(p0, dtype=float)
+    offsets = np.array(
+        [
+            [0.0, 0.0, 0.0],
+            [stride / 4, 0.0, height / 3],
+            [3 * stride / 4, 0.0, height / 3],
+            [stride, 0.0, height_correction],
+        ]
+    )
+    return p0 + offsets
+
+
+def rotation_xyz(axis: str, angle: float) -> np.ndarray:
+    """3x3 right-handed rotation about body axis `axis` ('x' or 'y') by `angle` rad."""
+    c, s = math.cos(angle), math.sin(angle)
+    if axis == "x":
+        return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    if axis == "y":
+        return np.array([[c, 0.0, s], [0.0, 1.0, 0.0], [-s, 0.0, c]])
+    raise ValueError(f"axis must be 'x' or 'y', got {axis!r}")
+
+
+def posture_rotation(pitch: float, roll: float) -> np.ndarray:
+    """R_y(pitch) R_x(roll): eq. (29)'s rotations in our frame (pitch about y, roll about x)."""
+    return rotation_xyz("y", pitch) @ rotation_xyz("x", roll)
+
+
+def stance_end_point(
+    p0: np.ndarray, stride: float, height_correction: float, rotation: np.ndarray
+) -> np.ndarray:
+    """Eqs. (28)-(30): p_f = R (p0 + (-stride, 0, k_z delta_z)), body frame, m."""
+    return np.asarray(rotation) @ (np.asarray(p0, dtype=float) + [-stride, 0.0, height_correction])
+
+
+def torso_deviation_from_plane(normal: np.ndarray) -> tuple[float, float]:
+    """(delta_alpha, delta_beta) of eqs. (25)-(26), signed, from the ground normal g in the body
+    frame: torso pitch (positive nose down) and roll (positive left side up) relative to the
+    plane, rad."""
+    g = np.asarray(normal, dtype=float)
+    if g[2] <= 0:
+        raise ValueError(f"ground normal must point up in the body frame (g_z > 0), got {g}")
+    return math.atan2(-g[0], g[2]), math.atan2(g[1], g[2])
+
+
+def triangle_area_xy(points: np.ndarray) -> float:
+    """Area of the triangle of three points projected on the body x-y plane, m²."""
+    a, b, c = np.asarray(points, dtype=float)[:, :2]
+    return 0.5 * abs((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+
+
+# ----- controller ------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class AthenaSensors:
+    """What the controller reads at each control tick (the paper's sensors).
+
+    joint_angles: (6, 3) encoder angles, rows `LEG_NAMES`, columns (TC, CTr, FTi), rad.
+    foot_forces: (6,) normal contact forces or (6, 3) force vectors (their norm is used), N.
+    torso_height: infrared torso-height reading, m; NaN or negative means "no reading".
+    """
+
+    joint_angles: np.ndarray
+    foot_forces: np.ndarray
+    torso_height: float
+
+
+@dataclass(frozen=True)
+class PostureEstimate:
+    """The posture controller's evaluation at the start of one phase (for logs and `info`)."""
+
+    phase_index: int
+    stance_legs: tuple[str, ...]
+    contact_legs: tuple[str, ...]
+    plane_legs: tuple[str, ...]
+    """The three legs whose feet defined the ground plane (empty: no plane, no tilt correction)."""
+    ground_normal: np.ndarray
+    """Unit normal of the fitted ground plane in the body frame (+z if no plane)."""
+    delta_pitch: float
+    """delta_alpha, rad (positive: torso nose down relative to the ground)."""
+    delta_roll: float
+    """delta_beta, rad (positive: torso left side up relative to the ground)."""
+    delta_z: float
+    """Torso-height reading minus the standing reference, m (0 without a reading)."""
+    gains: tuple[float, float, float]
+    """(k_z, k_alpha, k_beta) used in this phase."""
+    extension: float
+    """How far the landing legs were extended to find the ground before this phase, m."""
+
+
+@dataclass
+class _Plan:
+    start: np.ndarray  # (6, 3) p_{i,0}
+    swing_points: dict[int, np.ndarray] = field(default_factory=dict)  # leg -> (4, 3)
+    stance_end: dict[int, np.ndarray] = field(default_factory=dict)  # leg -> (3,)
+
+
+class AthenaPostureController:
+    """Seed 002's tripod gait with height/pitch/roll posture control; joint targets at 20 Hz.
+
+    Call `step(sensors)` once per control tick; it returns (6, 3) joint-angle targets (rad,
+    rows `LEG_NAMES`, columns TC, CTr, FTi) for the position servos. A phase lasts
+    `phase_time` (t_g); the tripod {LF, LR, RM} swings first. Gains set with `set_gains` take
+    effect at the start of the next phase (the env's "gains" action mode sets them once per gait
+    cycle). Parameters (SI units):
+
+    stride: s, foot travel per phase along body x, m (not given in the paper).
+    swing_height: h of eqs. (20)-(21), m; the swing apex is h/4 (see `swing_apex`).
+    phase_time: t_g, s. control_dt: control period, s (20 Hz in the paper).
+    kz, k_alpha, k_beta: posture gains in [0, 1]; all 0 = "simple control".
+    reference_height: torso-height reading of the standing posture, m (default from params).
+    contact_threshold: force above which a foot counts as in contact, N.
+    touchdown_wait: ticks to hold a landing leg that has not touched yet before extending it.
+    extend_step: downward extension per tick of a landing leg that has not found the ground, m.
+    max_extension: give up extending after this much, m.
+    start_from: "measured" (the paper: p_{i,0} from the encoders via eq. 12) or "commanded"
+        (the previous phase's commanded end points, immune to servo tracking errors).
+    rng: optional generator; if given, the plane's three legs are a random choice among the
+        feet in contact, as in the paper; otherwise deterministic (see the module docstring).
+    """
+
+    def __init__(
+        self,
+        params: AthenaParams = ATHENA,
+        *,
+        stride: float = 0.06,
+        swing_height: float = 0.16,
+        phase_time: float = 1.0,
+        control_dt: float = 0.05,
+        kz: float = 0.0,
+        k_alpha: float = 0.0,
+        k_beta: float = 0.0,
+        reference_height: float | None = None,
+        contact_threshold: float = 0.5,
+        touchdown_wait: int = 1,
+        extend_step: float = 0.002,
+        max_extension: float = 0.06,
+        start_from: str = "measured",
+        rng: np.random.Generator | None = None,
+    ):
+        ticks = phase_time / control_dt
+        if control_dt <= 0 or phase_time <= 0 or abs(ticks - round(ticks)) > 1e-9 or ticks < 1:
+            raise ValueError(
+                f"phase_time / control_dt must be a positive whole number, got "
+                f"{phase_time} / {control_dt} = {ticks}"
+            )
+        if start_from not in ("measured", "commanded"):
+            raise ValueError(f"start_from must be 'measured' or 'commanded', got {start_from!r}")
+        for label, value in (
+            ("stride", stride),
+            ("swing_height", swing_height),
+            ("contact_threshold", contact_threshold),
+            ("touchdown_wait", touchdown_wait),
+            ("extend_step", extend_step),
+            ("max_extension", max_extension),
+        ):
+            if not value >= 0:
+                raise ValueError(f"{label} must be >= 0, got {value}")
+        if rng is not None and not isinstance(rng, np.random.Generator):
+            raise ValueError(f"rng must be a numpy.random.Generator or None, got {type(rng)}")
+        self.params = params
+        self.stride = float(stride)
+        self.swing_height = float(swing_height)
+        self.phase_time = float(phase_time)
+        self.control_dt = float(control_dt)
+        self.ticks_per_phase = round(ticks)
+        self.reference_height = (
+            params.standing_torso_height if reference_height is None else float(reference_height)
+        )
+        self.contact_threshold = float(contact_threshold)
+        self.touchdown_wait = int(touchdown_wait)
+        self.extend_step = float(extend_step)
+        self.max_extension = float(max_extension)
+        self.start_from = start_from
+        self.rng = rng
+        self._gains = _checked_gains(kz, k_alpha, k_beta)
+        self.reset()
+
+    # ----- public state -------------------------------------------------------------------
+    @property
+    def gains(self) -> tuple[float, float, float]:
+        """(k_z, k_alpha, k_beta) that the next phase will use."""
+        return self._gains
+
+    @property
+    def swing_apex(self) -> float:
+        """Lift of the swing foot above its start at mid-swing for a level end point (k_z delta_z
+        = 0): h/4 with eqs. (20)-(21)'s control points, m."""
+        return self.swing_height / 4
+
+    @property
+    def ticks_per_cycle(self) -> int:
+        """Control ticks of one gait cycle (both tripods swing once: 2 t_g)."""
+        return 2 * self.ticks_per_phase
+
+    @property
+    def phase_index(self) -> int:
+        """Number of phases started so far minus one (-1 before the first step)."""
+        return self._phase_index
+
+    @property
+    def at_phase_start(self) -> bool:
+        """True if the next `step` begins a new phase (and so uses newly set gains)."""
+        return self._tick == 0
+
+    @property
+    def stance_legs(self) -> tuple[str, ...]:
+        """Legs in stance in the current (or, at a phase start, the coming) phase."""
+        return TRIPODS[(self._phase_index + (1 if self._tick == 0 else 0) + 1) % 2]
+
+    @property
+    def last_estimate(self) -> PostureEstimate | None:
+        """The posture evaluation of the current phase (None before the first phase)."""
+        return self._estimate
+
+    @property
+    def commanded_feet(self) -> np.ndarray:
+        """(6, 3) foot positions (body frame, m) of the last command, before IK clamping."""
+        return self._command.copy()
+
+    def set_gains(self, kz: float, k_alpha: float, k_beta: float) -> None:
+        """Set (k_z, k_alpha, k_beta) in [0, 1] for the next phase."""
+        self._gains = _checked_gains(kz, k_alpha, k_beta)
+
+    def reset(self, joint_angles: np.ndarray | None = None) -> None:
+        """Start again from the standing posture (or `joint_angles`), before the first phase."""
+        q = (
+            np.tile(self.params.standing_posture, (6, 1))
+            if joint_angles is None
+            else np.asarray(joint_angles, dtype=float)
+        )
+        self._command = forward_kinematics_all(q, self.params)
+        self._phase_index = -1
+        self._tick = 0
+        self._extension = 0.0
+        self._waited = 0
+        self._plan: _Plan | None = None
+        self._estimate: PostureEstimate | None = None
+        self.clamped_legs: tuple[str, ...] = ()
+
+    # ----- the control tick ----------------------------------------------------------------
+    def step(self, sensors: AthenaSensors) -> np.ndarray:
+        """One control tick: (6, 3) joint-angle targets from the current sensor readings."""
+        q, forces, height = _checked_sensors(sensors)
+        contact = forces > self.contact_threshold
+        if self._tick == 0:
+            stance = _TRIPOD_INDICES[(self._phase_index + 2) % 2]
+            missing = [i for i in stance if not contact[i]]
+            if missing and self._extension < self.max_extension:
+                # Fewer legs on the ground than planned: extend them until they touch. The first
+                # `touchdown_wait` ticks only hold the command, so that a foot lagging behind its
+                # servo target lands without being pushed into the ground.
+                self._waited += 1
+                if self._waited > self.touchdown_wait:
+                    step = min(self.extend_step, self.max_extension - self._extension)
+                    self._extension += step
+                    self._command[missing, 2] -= step
+                return self._joint_targets()
+            self._waited = 0
+            self._begin_phase(q, contact, forces, height)
+        u = (self._tick + 1) / self.ticks_per_phase
+        plan = self._plan
+        for i, points in plan.swing_points.items():
+            self._command[i] = cubic_bezier(points, u)
+        for i, end in plan.stance_end.items():
+            self._command[i] = plan.start[i] + u * (end - plan.start[i])
+        self._tick = (self._tick + 1) % self.ticks_per_phase
+        return self._joint_targets()
+
+    def _begin_phase(
+        self, q: np.ndarray, contact: np.ndarray, forces: np.ndarray, height: float
+    ) -> None:
+        self._phase_index += 1
+        stance = _TRIPOD_INDICES[(self._phase_index + 1) % 2]
+        swing = _TRIPOD_INDICES[self._phase_index % 2]
+        kz, ka, kb = self._gains
+        start = (
+            forward_kinematics_all(q, self.params)
+            if self.start_from == "measured"
+            else self._command.copy()
+        )
+        plane_legs = self._choose_plane_legs(start, contact, stance)
+        if plane_legs:
+            plane = fit_plane(start[list(plane_legs)])
+            normal = plane.normal
+            d_pitch, d_roll = torso_deviation_from_plane(normal)
+        else:
+            normal, d_pitch, d_roll = np.array([0.0, 0.0, 1.0]), 0.0, 0.0
+        d_z = height - self.reference_height if np.isfinite(height) and height >= 0 else 0.0
+
+        stride = self.stride / 2 if self._phase_index == 0 else self.stride
+        rotation = posture_rotation(ka * d_pitch, kb * d_roll)
+        plan = _Plan(start=start)
+        for i in swing:
+            plan.swing_points[i] = swing_control_points(
+                start[i], stride, self.swing_height, kz * d_z
+            )
+        for i in stance:
+            plan.stance_end[i] = stance_end_point(start[i], stride, kz * d_z, rotation)
+        self._plan = plan
+        self._command = start.copy()
+        self._estimate = PostureEstimate(
+            phase_index=self._phase_index,
+            stance_legs=tuple(LEG_NAMES[i] for i in stance),
+            contact_legs=tuple(LEG_NAMES[i] for i in np.flatnonzero(contact)),
+            plane_legs=tuple(LEG_NAMES[i] for i in plane_legs),
+            ground_normal=np.asarray(normal, dtype=float),
+            delta_pitch=d_pitch,
+            delta_roll=d_roll,
+            delta_z=d_z,
+            gains=(kz, ka, kb),
+            extension=self._extension,
+        )
+        self._extension = 0.0
+
+    def _choose_plane_legs(
+        self, feet: np.ndarray, contact: np.ndarray, stance: tuple[int, ...]
+    ) -> tuple[int, ...]:
+        """Indices of the three feet that define the ground plane (eq. 24), () if none."""
+        in_contact = [int(i) for i in np.flatnonzero(contact)]
+        if all(contact[i] for i in stance) and self.rng is None:
+            return tuple(stance)
+        triples = [
+            t
+            for t in itertools.combinations(in_contact, 3)
+            if triangle_area_xy(feet[list(t)]) > _MIN_TRIANGLE_AREA
+        ]
+        if not triples:
+            return ()
+        if self.rng is not None:
+            return triples[int(self.rng.integers(len(triples)))]
+        return max(triples, key=lambda t: triangle_area_xy(feet[list(t)]))
+
+    def _joint_targets(self) -> np.ndarray:
+        targets = np.empty((6, 3))
+        clamped = []
+        for i, leg in enumerate(LEG_NAMES):
+            try:
+                targets[i] = inverse_kinematics(leg, self._command[i], self.params)
+            except ValueError:
+                targets[i] = inverse_kinematics(leg, self._command[i], self.params, clamp=True)
+                clamped.append(leg)
+        self.clamped_legs = tuple(clamped)
+        return targets
+
+
+def _checked_gains(kz: float, k_alpha: float, k_beta: float) -> tuple[float, float, float]:
+    gains = (float(kz), float(k_alpha), float(k_beta))
+    for label, value in zip(("kz", "k_alpha", "k_beta"), gains, strict=True):
+        if not 0.0 <= value <= 1.0:
+            raise ValueError(f"{label} must be in [0, 1], got {value}")
+    return gains
+
+
+def _checked_sensors(sensors: AthenaSensors) -> tuple[np.ndarray, np.ndarray, float]:
+    q = np.asarray(sensors.joint_angles, dtype=float)
+    if q.shape != (6, 3):
+        raise ValueError(f"joint_angles must have shape (6, 3) (rows {LEG_NAMES}), got {q.shape}")
+    f = np.asarray(sensors.foot_forces, dtype=float)
+    if f.shape == (6, 3):
+        f = np.linalg.norm(f, axis=1)
+    elif f.shape != (6,):
+        raise ValueError(f"foot_forces must have shape (6,) or (6, 3), got {f.shape}")
+    return q, f, float(sensors.torso_height)

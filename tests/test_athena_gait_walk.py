@@ -1,0 +1,89 @@
+"""Closed loop in MuJoCo: ATHENA walks with the seed-002 gait, and the posture gains act in the
+right direction on the 10 degree ramp (direction checks, not the paper's figures)."""
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from agents.athena_gait import AthenaPostureController, AthenaSensors
+from hexapod_envs.robots.athena.model import add_athena
+from hexapod_envs.robots.athena.params import ATHENA, JOINT_NAMES, LEG_NAMES
+from hexapod_envs.terrain.irregular import add_ramp
+
+DT, CONTROL_DT = 0.002, 0.05
+
+
+def _walk(ctrl, duration, ramp_start=None):
+    spec = mujoco.MjSpec()
+    spec.option.timestep = DT
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    spec.option.impratio = 10.0
+    if ramp_start is None:
+        spec.worldbody.add_geom(
+            name="ground",
+            type=mujoco.mjtGeom.mjGEOM_PLANE,
+            size=[5, 5, 0.1],
+            contype=0,
+            conaffinity=1,
+            friction=[0.9, 0.005, 0.0001],
+        )
+    else:
+        add_ramp(spec, start_x=ramp_start)
+    add_athena(spec)
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    pos_ids = [[model.sensor(f"{leg}_{j}_pos").adr[0] for j in JOINT_NAMES] for leg in LEG_NAMES]
+    force_ids = [model.sensor(f"{leg}_foot_force").adr[0] for leg in LEG_NAMES]
+    height_id = model.sensor("torso_height").adr[0]
+    torso_geom = model.geom("torso").id
+    log, torso_contact = [], False
+    for _ in range(round(duration / CONTROL_DT)):
+        s = data.sensordata
+        sensors = AthenaSensors(
+            joint_angles=s[np.array(pos_ids)],
+            foot_forces=np.array([s[a : a + 3] for a in force_ids]),
+            torso_height=float(s[height_id]),
+        )
+        data.ctrl[:] = ctrl.step(sensors).reshape(-1)  # actuators were added leg by leg
+        for _ in range(round(CONTROL_DT / DT)):
+            mujoco.mj_step(model, data)
+            geoms = data.contact.geom[: data.ncon]
+            torso_contact |= bool(np.any(geoms == torso_geom))
+        rot = data.body("torso").xmat.reshape(3, 3)
+        nose_up = math.degrees(math.asin(rot[2, 0]))
+        roll = math.degrees(math.atan2(rot[2, 1], rot[2, 2]))
+        log.append((*data.body("torso").xpos, float(s[height_id]), nose_up, roll))
+    return np.array(log), torso_contact
+
+
+def test_simple_control_walks_straight_on_flat_ground():
+    stride = 0.06
+    ctrl = AthenaPostureController(stride=stride)
+    log, torso_contact = _walk(ctrl, duration=6.0)
+    expected = stride / 2 + 5 * stride  # six phases, the first one a half step
+    assert log[-1, 0] == pytest.approx(expected, rel=0.15)
+    assert abs(log[-1, 1]) < 0.02
+    assert np.all(np.abs(log[:, 4:6]) < 3.0)  # pitch and roll within 3 degrees
+    assert np.all(np.abs(log[:, 3] - ATHENA.standing_torso_height) < 0.01)
+    assert not torso_contact
+
+
+def test_posture_gains_align_the_torso_with_the_ramp_and_hold_its_height():
+    def climb(gains):
+        ctrl = AthenaPostureController(kz=gains[0], k_alpha=gains[1], k_beta=gains[2])
+        log, _ = _walk(ctrl, duration=20.0, ramp_start=0.3)
+        return log[-80:], ctrl.last_estimate  # the last 4 s: all feet on the slope
+
+    simple, simple_est = climb((0.0, 0.0, 0.0))
+    posture, posture_est = climb((0.8, 0.6, 0.0))
+    assert np.all(simple[:, 0] > 0.6) and np.all(posture[:, 0] > 0.6)  # rear feet past 0.3 m
+    # k_alpha pitches the nose up towards the 10 degree slope; the residual estimate shrinks.
+    assert posture[:, 4].mean() > simple[:, 4].mean() + 1.5
+    assert posture[:, 4].mean() == pytest.approx(10.0, abs=2.5)
+    assert abs(posture_est.delta_pitch) < abs(simple_est.delta_pitch)
+    # k_z brings the torso-height reading closer to the standing reference.
+    ref = ATHENA.standing_torso_height
+    assert abs(np.median(posture[:, 3]) - ref) < abs(np.median(simple[:, 3]) - ref)
