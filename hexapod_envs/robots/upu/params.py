@@ -93,12 +93,15 @@ class UpuParams:
     """Hooke-joint angle limit: theta_1, theta_2 in [-hooke_limit, hooke_limit] [rad] (paper)."""
     initial_height: float = 0.363
     """z of the upper platform centre O' above the lower one O in the initial assembly [m]
-    (paper §7). At (0, 0, 0.363) every limb is sqrt(0.035² + 0.363²) = 0.36468 m, 0.32 mm
-    shorter than limb_min: the paper rounds. Limit checks accept `limit_tolerance` of slack."""
-    limit_tolerance: float = 5e-4
+    (paper §7), also the height of the paper's gait paths (eqs. 20-21). At (0, 0, 0.363) every
+    limb is sqrt(0.035² + 0.363²) = 0.36468 m, and moving along x at this height limbs 2 and 3
+    shrink to sqrt((sqrt(3)/2 * 0.035)² + 0.363²) = 0.36426 m at x = Delta/2: 0.32 and 0.74 mm
+    short of limb_min. The paper rounds; limit checks accept `limit_tolerance` of slack, and the
+    MuJoCo limb servos (ctrlrange = limits) then hold the platform < 1 mm higher."""
+    limit_tolerance: float = 1e-3
     """Slack [m] allowed on the limb-length limits (and, divided by limb_min, [rad] on the Hooke
-    angles) by the limit checks, so the paper's own initial pose counts as reachable; well below
-    the resolution of the paper's figures."""
+    angles) by the limit checks, so that the paper's own initial pose and gait count as
+    reachable (see `initial_height`); below the resolution of the paper's figures."""
     step_lift: float = 0.08
     """Apex height of the upper platform's quadratic step path above its start [m]: the paper's
     80 mm maximum obstacle height, apex (80, 443) mm of eq. (20)."""

@@ -1,0 +1,600 @@
+"""Gait-planning math of the 3-UPU hexapod's "3-3" gait (seed 003 §5-7), pure numpy.
+
+The robot walks by moving one platform while the other stands on its three legs (duty factor
+0.5, Fig. 6-7): stage I the upper platform lifts its legs, travels forward along a quadratic
+path (eq. 19) and lands; stage II the lower platform does the same. This module plans those
+steps: platform paths, stride limits (eq. 17), the static stability margin of the CoG
+projection in the support triangle (eqs. 12-14), and a ditch-crossing planner that shortens
+steps so that no foot lands on a ditch edge and extends legs into the ditch (§7, Fig. 13-14).
+It knows nothing about MuJoCo or the env; a gait policy turns a `GaitPlan` into commands (limb
+lengths from `PlatformStep.limb_lengths`, leg extensions from the step's fields).
+
+Conventions: SI units; world x forward along the walk, both platform centres stay on y = 0;
+"extension" of a leg is its length beyond nominal (+ = longer, foot lower; see
+`hexapod_envs.robots.upu.params`). Flat ground is at z = 0 and a ditch lowers it to -depth.
+
+Deviation from the paper, stated once: eq. (21) moves the lower platform through
+(-80, -283) mm relative to the upper one, which needs limb 1 = 305 mm < l_min = 365 mm (the
+initial height 363 mm is already the bottom of the workspace on the z axis). So the lower
+platform cannot rise relative to the upper; in stage II it travels at constant relative height
+and its feet clear the ground by retracting the legs (`GaitSettings.lower_swing_retract`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections import deque
+from dataclasses import dataclass
+from functools import cache
+
+import numpy as np
+
+from hexapod_envs.robots.upu.kinematics import inside_limits, inverse_kinematics
+from hexapod_envs.robots.upu.params import PLATFORM_LEGS, UpuParams, check_platform
+from hexapod_envs.stability import static_stability_margin
+
+PLAN_STATUSES: tuple[str, ...] = ("ok", "too_deep", "too_wide", "no_plan")
+"""`GaitPlan.status` values: "too_deep": a foot must stand in the ditch (it is too wide to step
+over) but the bottom is beyond the legs' reach; "too_wide": a foot cannot stand in the ditch
+(too narrow for a foot with clearance, or too deep) and the ditch is too wide to step over;
+"no_plan": the search found no step sequence for another reason (see `GaitPlan.reason`)."""
+
+
+# --- Paths and limits -----------------------------------------------------------------------
+@dataclass(frozen=True)
+class QuadraticPath:
+    """Platform path z = a x^2 + b x + c (eq. 19) from x_start to x_end [m]."""
+
+    a: float
+    """[1/m]"""
+    b: float
+    """[-]"""
+    c: float
+    """[m]"""
+    x_start: float
+    x_end: float
+
+    @classmethod
+    def through(cls, start, apex, end) -> QuadraticPath:
+        """The parabola through three (x, z) points [m] (eqs. 20-21 use start, apex, end)."""
+        pts = np.array([start, apex, end], dtype=float)
+        if pts.shape != (3, 2) or not np.all(np.isfinite(pts)):
+            raise ValueError(f"start, apex, end must be finite (x, z) pairs [m], got {pts}")
+        if len(set(pts[:, 0].tolist())) < 3:
+            raise ValueError(f"the three points need distinct x values, got {pts[:, 0]}")
+        a, b, c = np.linalg.solve(np.vander(pts[:, 0], 3), pts[:, 1])
+        return cls(float(a), float(b), float(c), float(pts[0, 0]), float(pts[2, 0]))
+
+    def z(self, x):
+        """Path height at `x` [m] (scalar or array)."""
+        x = np.asarray(x, dtype=float)
+        return self.a * x**2 + self.b * x + self.c
+
+    def sample(self, n: int = 21) -> np.ndarray:
+        """(n, 2) evenly spaced (x, z) points from start to end [m]."""
+        x = np.linspace(self.x_start, self.x_end, n)
+        return np.stack([x, self.z(x)], axis=-1)
+
+
+def step_path(x_start: float, x_end: float, height: float, lift: float) -> QuadraticPath:
+    """Symmetric step: from (x_start, height) over the apex (midpoint, height + lift) to
+    (x_end, height) [m]. lift = 0 gives the straight path at constant height."""
+    if lift == 0:
+        return QuadraticPath(0.0, 0.0, float(height), float(x_start), float(x_end))
+    mid = (x_start + x_end) / 2
+    return QuadraticPath.through((x_start, height), (mid, height + lift), (x_end, height))
+
+
+def case_study_path(params: UpuParams | None = None) -> QuadraticPath:
+    """Eq. (20): the upper platform from (0, 363) via (80, 443) to (160, 363) mm, in metres:
+    z = -12.5 x^2 + 2 x + 0.363 (= -0.0125 x^2 + 2 x + 363 in mm)."""
+    p = params or UpuParams()
+    return step_path(
+        0.0, max_stride(p.support_inradius, p.leg_radius), p.initial_height, p.step_lift
+    )
+
+
+def max_stride(support_inradius: float, leg_radius: float) -> float:
+    """Eq. (17): l_max1 = 2 (x_G3 - R_T) [m], moving along x toward a triangle side.
+
+    `support_inradius` is the paper's x_G3 = OJ, the distance from a platform centre to the
+    side of its support triangle; `leg_radius` is R_T. Paper: 160 mm.
+    """
+    if not support_inradius > leg_radius > 0:
+        raise ValueError(
+            f"need support_inradius > leg_radius > 0 [m], got {support_inradius}, {leg_radius}"
+        )
+    return 2.0 * (support_inradius - leg_radius)
+
+
+def max_stride_diagonal(support_inradius: float, leg_radius: float) -> float:
+    """Eq. (18): l_max2 = x_G3 - R_T [m], moving along a triangle's side direction (LH)."""
+    return max_stride(support_inradius, leg_radius) / 2
+
+
+# --- Centre of gravity and static margin ----------------------------------------------------
+def combined_cog(upper_cog, lower_cog, upper_mass: float, lower_mass: float) -> np.ndarray:
+    """G3 on the segment G1 G2 (eqs. 12-13): (m1 G1 + m2 G2) / (m1 + m2) [m]."""
+    if not (upper_mass > 0 and lower_mass > 0):
+        raise ValueError(f"masses must be > 0 kg, got {upper_mass}, {lower_mass}")
+    g1 = np.asarray(upper_cog, dtype=float)
+    g2 = np.asarray(lower_cog, dtype=float)
+    return (upper_mass * g1 + lower_mass * g2) / (upper_mass + lower_mass)
+
+
+def foot_positions(params: UpuParams, x_upper: float, x_lower: float, legs=None):
+    """Leg name -> (x, y) of its foot [m] for platform centres at world x_upper, x_lower."""
+    legs = PLATFORM_LEGS["upper"] + PLATFORM_LEGS["lower"] if legs is None else legs
+    out = {}
+    for leg in legs:
+        centre = x_upper if leg in PLATFORM_LEGS["upper"] else x_lower
+        out[leg] = np.array([centre, 0.0]) + params.foot_offset(leg)
+    return out
+
+
+def support_margin(feet_xy, cog_xy) -> float:
+    """Static stability margin d = min_i d_i (eq. 14 and Fig. 5) [m]: distance from the CoG
+    projection to the nearest side of the support polygon, negative outside.
+
+    Uses `hexapod_envs.stability.static_stability_margin` with gravity along -z.
+    """
+    feet = np.asarray(feet_xy, dtype=float)
+    if feet.ndim != 2 or feet.shape[1] != 2:
+        raise ValueError(f"feet_xy must have shape (k, 2) [m], got {feet.shape}")
+    feet3 = np.column_stack([feet, np.zeros(len(feet))])
+    cog = np.asarray(cog_xy, dtype=float)
+    if cog.shape != (2,):
+        raise ValueError(f"cog_xy must have shape (2,) [m], got {cog.shape}")
+    return static_stability_margin(feet3, np.array([cog[0], cog[1], 0.0]))
+
+
+def stance_margin(params: UpuParams, x_upper: float, x_lower: float, support: str) -> float:
+    """Static margin [m] with the CoG of eq. (13) and support on 'upper', 'lower' or 'all'
+    legs, platform centres at world x_upper, x_lower (y = 0)."""
+    if support == "all":
+        legs = PLATFORM_LEGS["upper"] + PLATFORM_LEGS["lower"]
+    else:
+        legs = PLATFORM_LEGS[check_platform(support, "support")]
+    feet = foot_positions(params, x_upper, x_lower, legs)
+    cog_x = (params.upper_half_mass * x_upper + params.lower_half_mass * x_lower) / (
+        params.total_mass
+    )
+    return support_margin(np.array(list(feet.values())), np.array([cog_x, 0.0]))
+
+
+# --- Steps and plans ------------------------------------------------------------------------
+@dataclass(frozen=True)
+class GaitSettings:
+    """Tunable choices of the planner (SI units)."""
+
+    lift: float = 0.08
+    """Apex of the upper platform's path above its start [m] (paper: 80 mm, eq. 20). Reduced
+    automatically where the workspace does not allow it (short steps far from the centre)."""
+    upper_swing_retract: float = 0.02
+    """The upper legs retract by this much before their transfer [m], so their feet clear the
+    ground at the path ends where the path itself has no lift."""
+    lower_swing_retract: float = 0.08
+    """The lower legs retract by this much before their transfer [m]: the lower platform cannot
+    rise (see module doc), so retraction gives the paper's 80 mm foot clearance."""
+    edge_clearance: float = 0.02
+    """Minimum gap between a foot's edge and a ditch edge when it lands [m]."""
+    min_margin: float = 0.01
+    """Required static margin during every three-leg support phase [m]."""
+    max_stride: float | None = None
+    """Longest platform step [m]; None: eq. (17) from the robot's parameters (0.16 m)."""
+    grid: float = 0.005
+    """Resolution of the step lengths searched by the ditch planner [m]."""
+
+    def __post_init__(self) -> None:
+        for name in (
+            "lift",
+            "upper_swing_retract",
+            "lower_swing_retract",
+            "edge_clearance",
+            "min_margin",
+        ):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"GaitSettings.{name} must be a finite number >= 0, got {value}")
+        if not (math.isfinite(self.grid) and self.grid > 0):
+            raise ValueError(f"GaitSettings.grid must be > 0 m, got {self.grid}")
+        if self.max_stride is not None and not self.max_stride > 0:
+            raise ValueError(
+                f"GaitSettings.max_stride must be > 0 m or None, got {self.max_stride}"
+            )
+
+
+@dataclass(frozen=True)
+class Ditch:
+    """A ditch across the walking direction: ground at z = -depth for start_x < x < start_x +
+    width, z = 0 elsewhere [m] (as `hexapod_envs.terrain.ditch.add_ditch` builds it)."""
+
+    start_x: float
+    width: float
+    depth: float
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(self.start_x):
+            raise ValueError(f"ditch start_x must be finite, got {self.start_x}")
+        for name in ("width", "depth"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"ditch {name} must be a finite number > 0 m, got {value}")
+
+    @property
+    def end_x(self) -> float:
+        return self.start_x + self.width
+
+    def ground_height(self, x: float) -> float:
+        """Terrain height at x [m]."""
+        return -self.depth if self.start_x < x < self.end_x else 0.0
+
+
+@dataclass(frozen=True)
+class PlatformStep:
+    """One step of the 3-3 gait: the `moving` platform's legs retract (lift-off), the platform
+    travels from start_x to end_x along `path`, and its legs extend to `landing_extension`
+    until they touch down. The other platform stands still on its legs throughout."""
+
+    moving: str
+    """'upper' or 'lower'."""
+    start_x: float
+    """World x of the moving platform's centre before the step [m]."""
+    end_x: float
+    """World x of the moving platform's centre after the step [m]."""
+    support_x: float
+    """World x of the supporting platform's centre [m]."""
+    lift: float
+    """Apex of the moving platform's relative path above its start height [m]."""
+    swing_extension: float
+    """Extension the moving legs hold during the transfer [m] (negative: retracted)."""
+    landing_extension: dict[str, float]
+    """Moving leg -> extension at touchdown [m] (the ditch depth for a foot in the ditch)."""
+    support_extension: dict[str, float]
+    """Supporting leg -> its (unchanged) extension [m]."""
+    min_margin: float
+    """Smallest static margin while the moving legs are off the ground [m]."""
+
+    @property
+    def stride(self) -> float:
+        """Distance travelled by the moving platform [m]."""
+        return self.end_x - self.start_x
+
+    @property
+    def support(self) -> str:
+        return "lower" if self.moving == "upper" else "upper"
+
+    def path(self, params: UpuParams) -> QuadraticPath:
+        """Relative path of the moving centre in the supporting platform's frame (x, z) [m]:
+        the upper in the lower frame (eqs. 6, 19-20) or the lower in the upper frame (eq. 8)."""
+        x0 = self.start_x - self.support_x
+        x1 = self.end_x - self.support_x
+        h = params.initial_height if self.moving == "upper" else -params.initial_height
+        return step_path(x0, x1, h, self.lift)
+
+    def relative_poses(self, params: UpuParams, n: int = 21) -> np.ndarray:
+        """(n, 3) moving-platform positions along the path in the supporting frame [m]."""
+        xz = self.path(params).sample(n)
+        return np.column_stack([xz[:, 0], np.zeros(n), xz[:, 1]])
+
+    def limb_lengths(self, params: UpuParams, n: int = 21) -> np.ndarray:
+        """(n, 3) limb-length commands along the path [m] (eq. 15 or 16, Fig. 10)."""
+        return inverse_kinematics(self.relative_poses(params, n), params, moving=self.moving)
+
+
+@dataclass(frozen=True)
+class GaitPlan:
+    """A sequence of platform steps, or the reason there is none."""
+
+    status: str
+    """One of `PLAN_STATUSES`."""
+    reason: str
+    steps: tuple[PlatformStep, ...] = ()
+    ditch: Ditch | None = None
+
+    @property
+    def ok(self) -> bool:
+        return self.status == "ok"
+
+    @property
+    def min_margin(self) -> float:
+        """Smallest three-leg-support margin over the plan [m] (nan without steps)."""
+        return min((s.min_margin for s in self.steps), default=math.nan)
+
+    @property
+    def strides(self) -> np.ndarray:
+        return np.array([s.stride for s in self.steps])
+
+
+@dataclass(frozen=True)
+class MarginProfile:
+    """Static margin through a plan, sampled per phase (for plots like Fig. 12 and 14)."""
+
+    step: np.ndarray
+    """(n,) index of the step each sample belongs to."""
+    phase: tuple[str, ...]
+    """(n,) 'lift' (moving legs retracting), 'transfer', 'land' (legs extending), 'six' (all
+    six legs down after landing)."""
+    margin: np.ndarray
+    """(n,) static margin [m]."""
+
+
+def margin_profile(plan: GaitPlan, params: UpuParams, samples: int = 11) -> MarginProfile:
+    """Static margin before, during and after each transfer of `plan` (`samples` per transfer).
+
+    During 'lift' and 'land' the platforms stand still and only legs move, so the margin stays
+    constant there, as in the paper's Fig. 14.
+    """
+    steps, phases, margins = [], [], []
+    for k, s in enumerate(plan.steps):
+        xs = np.linspace(s.start_x, s.end_x, samples)
+        values = []
+        for x in xs:
+            xu, xl = (x, s.support_x) if s.moving == "upper" else (s.support_x, x)
+            values.append(stance_margin(params, xu, xl, s.support))
+        xu, xl = (s.end_x, s.support_x) if s.moving == "upper" else (s.support_x, s.end_x)
+        six = stance_margin(params, xu, xl, "all")
+        labels = ["lift"] + ["transfer"] * samples + ["land", "six"]
+        vals = [values[0], *values, values[-1], six]
+        steps += [k] * len(labels)
+        phases += labels
+        margins += vals
+    return MarginProfile(np.array(steps, dtype=int), tuple(phases), np.array(margins))
+
+
+def _stride_limit(params: UpuParams, settings: GaitSettings) -> float:
+    limit = max_stride(params.support_inradius, params.leg_radius)
+    return limit if settings.max_stride is None else min(limit, settings.max_stride)
+
+
+def _swing_extension(moving: str, params: UpuParams, settings: GaitSettings) -> float:
+    retract = settings.upper_swing_retract if moving == "upper" else settings.lower_swing_retract
+    return -min(retract, params.leg_retract)
+
+
+def _feasible_lift(params: UpuParams, settings: GaitSettings, moving: str, x0: float, x1: float):
+    """Largest lift <= settings.lift (1 mm steps) keeping the whole path inside the workspace;
+    None if even the straight path leaves it. Relative coordinates [m]."""
+    h = params.initial_height if moving == "upper" else -params.initial_height
+    candidates = [0.0]
+    if moving == "upper" and settings.lift > 0:
+        candidates = np.linspace(settings.lift, 0.0, int(round(settings.lift / 0.001)) + 1)
+    for lift in candidates:
+        pose = step_path(x0, x1, h, float(lift)).sample(21)
+        pts = np.column_stack([pose[:, 0], np.zeros(len(pose)), pose[:, 1]])
+        if np.all(inside_limits(pts, params, moving=moving)):
+            return float(lift)
+    return None
+
+
+def _transfer_margin(params: UpuParams, moving: str, x0: float, x1: float, n: int = 11) -> float:
+    """Min static margin while the `moving` centre goes from x0 to x1 relative to the other."""
+    support = "lower" if moving == "upper" else "upper"
+    values = []
+    for x in np.linspace(x0, x1, n):
+        xu, xl = (x, 0.0) if moving == "upper" else (0.0, x)
+        values.append(stance_margin(params, xu, xl, support))
+    return min(values)
+
+
+def plan_flat_walk(
+    params: UpuParams,
+    n_cycles: int,
+    stride: float | None = None,
+    x_start: float = 0.0,
+    settings: GaitSettings | None = None,
+) -> GaitPlan:
+    """The paper's flat-ground gait: `n_cycles` x (upper step, lower step) of `stride` [m]
+    (default: eq. 17's maximum), upper path eq. (20)."""
+    settings = settings or GaitSettings()
+    if not (isinstance(n_cycles, int | np.integer) and n_cycles >= 1):
+        raise ValueError(f"n_cycles must be an integer >= 1, got {n_cycles!r}")
+    limit = _stride_limit(params, settings)
+    stride = limit if stride is None else float(stride)
+    if not 0 < stride <= limit + 1e-12:
+        raise ValueError(f"stride must be in (0, {limit:.4f}] m (eq. 17), got {stride}")
+    steps = []
+    x_lower = x_upper = float(x_start)
+    zero = {leg: 0.0 for leg in PLATFORM_LEGS["upper"] + PLATFORM_LEGS["lower"]}
+    for _ in range(n_cycles):
+        for moving in ("upper", "lower"):
+            x0 = x_upper if moving == "upper" else x_lower
+            support_x = x_lower if moving == "upper" else x_upper
+            lift = _feasible_lift(params, settings, moving, x0 - support_x, x0 + stride - support_x)
+            if lift is None:
+                return GaitPlan("no_plan", f"the {moving} step of {stride} m leaves the workspace")
+            margin = _transfer_margin(params, moving, x0 - support_x, x0 + stride - support_x)
+            if margin < settings.min_margin:
+                return GaitPlan(
+                    "no_plan",
+                    f"stride {stride} m drops the static margin to {margin:.4f} m "
+                    f"< min_margin {settings.min_margin} m",
+                )
+            steps.append(
+                PlatformStep(
+                    moving=moving,
+                    start_x=x0,
+                    end_x=x0 + stride,
+                    support_x=support_x,
+                    lift=lift,
+                    swing_extension=_swing_extension(moving, params, settings),
+                    landing_extension={leg: 0.0 for leg in PLATFORM_LEGS[moving]},
+                    support_extension={
+                        leg: zero[leg]
+                        for leg in PLATFORM_LEGS["lower" if moving == "upper" else "upper"]
+                    },
+                    min_margin=margin,
+                )
+            )
+            if moving == "upper":
+                x_upper += stride
+            else:
+                x_lower += stride
+    return GaitPlan("ok", f"{n_cycles} cycles of {stride} m on flat ground", tuple(steps))
+
+
+def plan_ditch_crossing(
+    params: UpuParams,
+    ditch: Ditch,
+    x_start: float = 0.0,
+    settings: GaitSettings | None = None,
+) -> GaitPlan:
+    """Plan 3-3 gait steps that carry the robot across `ditch` (§7, Fig. 13).
+
+    The robot starts standing with both platform centres at world x = `x_start` (all six feet
+    on the near ground) and ends standing the same way with every foot past the far edge.
+    Feet must land either on the ground or on the ditch bottom, at least `edge_clearance` from
+    an edge (so steps are shortened near the ditch); a foot on the bottom lands with its leg
+    extended by the depth, and retracts again before its next transfer. Breadth-first search
+    over step lengths on a `grid` finds the plan with the fewest steps (longest steps first on
+    ties), subject to the stride limit (eq. 17), the workspace (the upper path's lift is
+    reduced where needed) and `min_margin`.
+    """
+    settings = settings or GaitSettings()
+    g = settings.grid
+    band = params.foot_radius + settings.edge_clearance
+    limit = _stride_limit(params, settings)
+    reach = params.leg_extend
+    can_stand = ditch.depth <= reach and ditch.width >= 2 * band + g
+    can_step_over = ditch.width + 2 * band <= limit
+    step_over_note = (
+        f"stepping over needs a stride of width + 2 (foot radius + clearance) = "
+        f"{ditch.width + 2 * band:.3f} m > {limit:.3f} m (eq. 17)"
+    )
+    if not can_stand and not can_step_over:
+        if ditch.depth > reach:
+            return GaitPlan(
+                "too_deep",
+                f"the ditch is {ditch.depth:.3f} m deep but a leg extends at most {reach:.3f} m, "
+                f"so no foot can stand on its bottom; {step_over_note}",
+                ditch=ditch,
+            )
+        return GaitPlan(
+            "too_wide",
+            f"the ditch ({ditch.width:.3f} m) is too narrow for a foot with "
+            f"{settings.edge_clearance} m clearance on each side, and {step_over_note}",
+            ditch=ditch,
+        )
+
+    def foot_ok(x: float) -> bool:
+        if not can_stand:
+            return not (ditch.start_x - band < x < ditch.end_x + band)
+        return all(abs(x - e) >= band for e in (ditch.start_x, ditch.end_x))
+
+    upper_offsets = sorted({float(params.foot_offset(leg)[0]) for leg in PLATFORM_LEGS["upper"]})
+    lower_offsets = sorted({float(params.foot_offset(leg)[0]) for leg in PLATFORM_LEGS["lower"]})
+    rear = min(upper_offsets + lower_offsets)
+    if max(upper_offsets + lower_offsets) + x_start > ditch.start_x - band:
+        raise ValueError(
+            f"the robot must start with every foot before the ditch: its front feet at "
+            f"x = {x_start + max(upper_offsets + lower_offsets):.3f} m are within "
+            f"{band:.3f} m of (or past) the ditch start {ditch.start_x} m"
+        )
+    goal_x = ditch.end_x + band - rear  # centre x that puts the rearmost foot past the ditch
+    n_goal = int(math.ceil((goal_x - x_start) / g - 1e-9))
+    n_d = int(math.floor(limit / g + 1e-9))
+    n_x = n_goal + n_d + 1
+
+    def platform_ok(offsets):
+        return np.array(
+            [all(foot_ok(x_start + i * g + o) for o in offsets) for i in range(n_x + n_d + 1)]
+        )
+
+    ok_upper = platform_ok(upper_offsets)
+    ok_lower = platform_ok(lower_offsets)
+
+    @cache
+    def move(moving: str, j0: int, j1: int):
+        """(lift, margin) for the moving centre going from offset j0 g to j1 g relative to the
+        other platform's centre, or None if infeasible."""
+        x0, x1 = j0 * g, j1 * g
+        if moving == "lower":
+            x0, x1 = -x0, -x1  # the lower centre relative to the upper one
+        lift = _feasible_lift(params, settings, moving, x0, x1)
+        if lift is None:
+            return None
+        margin = _transfer_margin(params, moving, x0, x1)
+        return None if margin < settings.min_margin else (lift, margin)
+
+    # State: (i_lower, j = (x_upper - x_lower) / g, next mover). Start standing, upper first.
+    start = (0, 0, "upper")
+    parent = {start: None}
+    queue = deque([start])
+    goal = None
+    while queue:
+        state = queue.popleft()
+        i, j, mover = state
+        if mover == "upper":
+            successors = [
+                (i, j1, "lower")
+                for j1 in range(n_d, j, -1)
+                if ok_upper[i + j1] and move("upper", j, j1) is not None
+            ]
+        else:
+            successors = []
+            for s in range(j, 0, -1):
+                if i + s < n_x and ok_lower[i + s] and move("lower", j, j - s) is not None:
+                    successors.append((i + s, j - s, "upper"))
+        for nxt in successors:
+            if nxt in parent:
+                continue
+            parent[nxt] = state
+            if nxt[1] == 0 and nxt[0] >= n_goal:
+                goal = nxt
+                queue.clear()
+                break
+            queue.append(nxt)
+    if goal is None:
+        return GaitPlan(
+            "no_plan",
+            f"no sequence of steps <= {limit:.3f} m keeps every foot {band:.3f} m from the "
+            f"ditch edges with margin >= {settings.min_margin} m",
+            ditch=ditch,
+        )
+
+    chain = []
+    state = goal
+    while state is not None:
+        chain.append(state)
+        state = parent[state]
+    chain.reverse()
+
+    extension = {leg: 0.0 for leg in PLATFORM_LEGS["upper"] + PLATFORM_LEGS["lower"]}
+    steps = []
+    for (i0, j0, mover), (i1, j1, _) in zip(chain, chain[1:], strict=False):
+        x_lower0 = x_start + i0 * g
+        x_upper0 = x_start + (i0 + j0) * g
+        x_lower1 = x_start + i1 * g
+        x_upper1 = x_start + (i1 + j1) * g
+        if mover == "upper":
+            lift, margin = move("upper", j0, j1)
+            start_x, end_x, support_x = x_upper0, x_upper1, x_lower0
+        else:
+            lift, margin = move("lower", j0, j1)
+            start_x, end_x, support_x = x_lower0, x_lower1, x_upper0
+        landing = {}
+        for leg in PLATFORM_LEGS[mover]:
+            foot_x = end_x + float(params.foot_offset(leg)[0])
+            landing[leg] = ditch.depth if ditch.ground_height(foot_x) < 0 else 0.0
+        support = "lower" if mover == "upper" else "upper"
+        steps.append(
+            PlatformStep(
+                moving=mover,
+                start_x=start_x,
+                end_x=end_x,
+                support_x=support_x,
+                lift=lift,
+                swing_extension=_swing_extension(mover, params, settings),
+                landing_extension=landing,
+                support_extension={leg: extension[leg] for leg in PLATFORM_LEGS[support]},
+                min_margin=margin,
+            )
+        )
+        extension.update(landing)
+    how = "standing in the ditch" if can_stand else "stepping over it"
+    return GaitPlan(
+        "ok",
+        f"{len(steps)} steps cross the {ditch.width} m x {ditch.depth} m ditch, {how}",
+        tuple(steps),
+        ditch,
+    )

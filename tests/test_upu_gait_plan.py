@@ -1,0 +1,225 @@
+"""Tests of the 3-UPU "3-3" gait-planning math (seed 003 §5-7)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from agents.upu_gait_plan import (
+    PLAN_STATUSES,
+    Ditch,
+    GaitSettings,
+    QuadraticPath,
+    case_study_path,
+    combined_cog,
+    foot_positions,
+    margin_profile,
+    max_stride,
+    max_stride_diagonal,
+    plan_ditch_crossing,
+    plan_flat_walk,
+    stance_margin,
+    step_path,
+    support_margin,
+)
+from hexapod_envs.robots.upu.kinematics import check_limits
+from hexapod_envs.robots.upu.params import LEG_NAMES, PLATFORM_LEGS, UpuParams
+
+P = UpuParams()
+PAPER_DITCH = Ditch(start_x=0.6, width=0.35, depth=0.14)
+
+
+@pytest.fixture(scope="module")
+def ditch_plan():
+    return plan_ditch_crossing(P, PAPER_DITCH)
+
+
+def test_eq20_case_study_path():
+    """z = -0.0125 x^2 + 2 x + 363 [mm] -> a = -12.5 1/m, b = 2, c = 0.363 m."""
+    path = case_study_path(P)
+    assert path.a == pytest.approx(-12.5)
+    assert path.b == pytest.approx(2.0)
+    assert path.c == pytest.approx(0.363)
+    assert (path.x_start, path.x_end) == pytest.approx((0.0, 0.16))
+    np.testing.assert_allclose(path.z([0.0, 0.08, 0.16]), [0.363, 0.443, 0.363])
+
+
+def test_eq21_lower_platform_path_coefficients_and_infeasibility():
+    """Eq. (21) through (-160, -363), (-80, -283), (0, -363) mm: z = -0.0125 x^2 - 2 x - 363.
+    Its apex needs limb 1 = 305 mm < l_min, which is why the planner keeps the lower path flat."""
+    path = QuadraticPath.through((-0.16, -0.363), (-0.08, -0.283), (0.0, -0.363))
+    assert (path.a, path.b, path.c) == pytest.approx((-12.5, -2.0, -0.363))
+    assert not check_limits([-0.08, 0.0, -0.283], P, moving="lower").ok
+
+
+def test_quadratic_path_validation_and_flat_case():
+    with pytest.raises(ValueError, match="distinct x"):
+        QuadraticPath.through((0, 0), (0, 1), (1, 0))
+    flat = step_path(-0.1, 0.0, -0.363, 0.0)
+    np.testing.assert_allclose(flat.sample(5)[:, 1], -0.363)
+
+
+def test_eq17_eq18_stride_limits():
+    assert max_stride(P.support_inradius, P.leg_radius) == pytest.approx(0.160)
+    assert max_stride_diagonal(P.support_inradius, P.leg_radius) == pytest.approx(0.080)
+    with pytest.raises(ValueError, match="support_inradius"):
+        max_stride(0.01, 0.02)
+
+
+def test_eq13_combined_cog():
+    g3 = combined_cog([0.16, 0.0, 0.5], [0.0, 0.0, 0.2], 3.0, 1.0)
+    np.testing.assert_allclose(g3, [0.12, 0.0, 0.425])
+    assert combined_cog([0.1, 0, 0], [0, 0, 0], 2.0, 2.0)[0] == pytest.approx(0.05)
+    with pytest.raises(ValueError, match="masses"):
+        combined_cog([0, 0, 0], [0, 0, 0], 0.0, 1.0)
+
+
+def test_support_margin_closed_form_triangle():
+    """Lower support triangle (vertices at 180°, ±60°, radius rho): inradius rho/2 at the
+    centre; moving the CoG by t toward the front side leaves rho/2 - t; outside is negative."""
+    feet = np.array([P.foot_offset(leg) for leg in PLATFORM_LEGS["lower"]])
+    rho = P.leg_circle_radius
+    assert support_margin(feet, [0.0, 0.0]) == pytest.approx(rho / 2)
+    assert support_margin(feet, [0.03, 0.0]) == pytest.approx(rho / 2 - 0.03)
+    assert support_margin(feet, [rho / 2 + 0.01, 0.0]) == pytest.approx(-0.01)
+    with pytest.raises(ValueError, match="feet_xy"):
+        support_margin(np.zeros((3, 3)), [0, 0])
+
+
+def test_stage_margins_follow_eq13():
+    """Upper moving by d over the lower triangle: margin = rho/2 - d m1/M; lower moving with the
+    upper ahead by d: margin = rho/2 - d m2/M."""
+    m1, m2, total = P.upper_half_mass, P.lower_half_mass, P.total_mass
+    for d in (0.0, 0.08, 0.16):
+        assert stance_margin(P, d, 0.0, "lower") == pytest.approx(0.1 - d * m1 / total)
+        assert stance_margin(P, d, 0.0, "upper") == pytest.approx(0.1 - d * m2 / total)
+    assert stance_margin(P, 0.16, 0.0, "all") > stance_margin(P, 0.16, 0.0, "lower")
+
+
+def test_foot_positions_layout():
+    feet = foot_positions(P, x_upper=0.1, x_lower=0.0)
+    assert set(feet) == set(LEG_NAMES)
+    np.testing.assert_allclose(feet["U1"], [0.3, 0.0], atol=1e-12)
+    np.testing.assert_allclose(feet["L1"], [-0.2, 0.0], atol=1e-12)
+    # Eq. (17): after the maximum stride the upper rear feet are 2 R_T from the lower front ones.
+    feet = foot_positions(P, x_upper=0.16, x_lower=0.0)
+    gap = np.linalg.norm(feet["U2"] - feet["L2"])
+    assert gap == pytest.approx(2 * P.leg_radius)
+
+
+def test_flat_walk_reproduces_paper_gait():
+    plan = plan_flat_walk(P, n_cycles=3)
+    assert plan.ok
+    assert [s.moving for s in plan.steps] == ["upper", "lower"] * 3
+    np.testing.assert_allclose(plan.strides, 0.16)
+    assert plan.steps[0].lift == pytest.approx(0.08)
+    path = plan.steps[0].path(P)
+    assert (path.a, path.b, path.c) == pytest.approx((-12.5, 2.0, 0.363))
+    assert plan.min_margin > 0  # Fig. 12: the margin stays positive
+    for step in plan.steps:
+        assert all(check_limits(q, P, moving=step.moving).ok for q in step.relative_poses(P))
+    lengths = plan.steps[0].limb_lengths(P, n=3)
+    np.testing.assert_allclose(lengths[1, 0], math.hypot(0.115, 0.443))  # apex, limb 1
+
+
+def test_flat_walk_rejects_bad_stride():
+    with pytest.raises(ValueError, match="stride"):
+        plan_flat_walk(P, 1, stride=0.2)
+    with pytest.raises(ValueError, match="n_cycles"):
+        plan_flat_walk(P, 0)
+    plan = plan_flat_walk(P, 1, settings=GaitSettings(min_margin=0.05))
+    assert plan.status == "no_plan" and "margin" in plan.reason
+
+
+def test_paper_ditch_is_crossed_with_positive_margin(ditch_plan):
+    plan = ditch_plan
+    assert plan.ok, plan.reason
+    assert plan.status in PLAN_STATUSES
+    assert plan.min_margin >= GaitSettings().min_margin > 0  # Fig. 14
+    assert np.all(plan.strides > 0) and np.all(plan.strides <= 0.16 + 1e-9)
+    assert np.any(plan.strides < 0.16 - 1e-9)  # steps shortened to fit the ditch
+    moving = [s.moving for s in plan.steps]
+    assert moving == ["upper", "lower"] * (len(moving) // 2)
+
+
+def test_ditch_plan_feet_avoid_edges_and_extend_into_ditch(ditch_plan):
+    settings = GaitSettings()
+    band = P.foot_radius + settings.edge_clearance
+    x_upper = x_lower = 0.0
+    extension = dict.fromkeys(LEG_NAMES, 0.0)
+    in_ditch = 0
+    for step in ditch_plan.steps:
+        # Continuity: the step starts where the previous one left the platforms.
+        start = x_upper if step.moving == "upper" else x_lower
+        support = x_lower if step.moving == "upper" else x_upper
+        assert step.start_x == pytest.approx(start)
+        assert step.support_x == pytest.approx(support)
+        assert step.support_extension == pytest.approx(
+            {leg: extension[leg] for leg in PLATFORM_LEGS[step.support]}
+        )
+        if step.moving == "upper":
+            x_upper = step.end_x
+        else:
+            x_lower = step.end_x
+        assert -1e-9 <= x_upper - x_lower <= 0.16 + 1e-9
+        feet = foot_positions(P, x_upper, x_lower, PLATFORM_LEGS[step.moving])
+        for leg, (x, _) in feet.items():
+            assert min(abs(x - PAPER_DITCH.start_x), abs(x - PAPER_DITCH.end_x)) >= band - 1e-9
+            expected = PAPER_DITCH.depth if PAPER_DITCH.start_x < x < PAPER_DITCH.end_x else 0.0
+            assert step.landing_extension[leg] == pytest.approx(expected)
+            in_ditch += expected > 0
+            lo, hi = P.extension_range
+            assert lo <= step.landing_extension[leg] <= hi
+            assert lo <= step.swing_extension <= 0
+        extension.update(step.landing_extension)
+        for q in step.relative_poses(P):
+            assert check_limits(q, P, moving=step.moving).ok
+    assert in_ditch > 0  # legs extended into the ditch (§7)
+    # Finish standing (platforms aligned) with every foot past the ditch, legs at nominal.
+    assert x_upper == pytest.approx(x_lower)
+    final = foot_positions(P, x_upper, x_lower)
+    assert min(x for x, _ in final.values()) >= PAPER_DITCH.end_x + band - 1e-9
+    assert all(v == 0.0 for v in extension.values())
+
+
+def test_margin_profile_phases(ditch_plan):
+    prof = margin_profile(ditch_plan, P, samples=5)
+    n_steps = len(ditch_plan.steps)
+    assert len(prof.margin) == n_steps * (5 + 3) == len(prof.phase) == len(prof.step)
+    three_leg = np.array([ph != "six" for ph in prof.phase])
+    assert prof.margin[three_leg].min() == pytest.approx(ditch_plan.min_margin)
+    assert np.all(prof.margin[~three_leg] > prof.margin[three_leg].min())
+    first = prof.margin[prof.step == 0]
+    assert first[0] == first[1] and first[-2] == first[-3]  # legs move, platforms do not
+
+
+def test_deep_ditch_reports_too_deep():
+    plan = plan_ditch_crossing(P, Ditch(0.6, 0.35, 0.2))
+    assert plan.status == "too_deep" and not plan.ok and plan.steps == ()
+    assert "0.160" in plan.reason
+
+
+def test_narrow_deep_ditch_is_stepped_over():
+    ditch = Ditch(0.6, 0.05, 0.3)
+    plan = plan_ditch_crossing(P, ditch)
+    assert plan.ok and "stepping over" in plan.reason
+    for step in plan.steps:
+        assert all(v == 0.0 for v in step.landing_extension.values())
+
+
+def test_too_wide_when_no_foot_fits_and_stride_too_short():
+    settings = GaitSettings(edge_clearance=0.05)  # a foot needs 0.14 m of ditch bottom
+    plan = plan_ditch_crossing(P, Ditch(0.6, 0.13, 0.1), settings=settings)
+    assert plan.status == "too_wide"
+    assert "step" in plan.reason
+
+
+def test_ditch_validation():
+    with pytest.raises(ValueError, match="width"):
+        Ditch(0.6, 0.0, 0.1)
+    with pytest.raises(ValueError, match="depth"):
+        Ditch(0.6, 0.3, float("nan"))
+    with pytest.raises(ValueError, match="before the ditch"):
+        plan_ditch_crossing(P, Ditch(0.2, 0.3, 0.1))
+    with pytest.raises(ValueError, match="grid"):
+        GaitSettings(grid=0.0)
