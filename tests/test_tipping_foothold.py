@@ -127,6 +127,18 @@ def test_no_reachable_ground_is_a_status():
         assert reachable_region("RR", deep, PARAMS, model=model).status == "no_reachable_ground"
 
 
+def test_ground_at_exactly_l_max_makes_h_the_target():
+    # Paper model: ‖B_iH‖ = L_max -> H is the target location.
+    drop = PARAMS.max_leg_length - HEIGHT
+    feet = {name: FEET[name] + [0.0, 0.0, -drop] for name in TRIPOD_1}
+    choice = select_foothold("RR", feet, ("LR", "RM"), PARAMS, model="paper")
+    assert choice.status == "ok" and choice.point == "H"
+    np.testing.assert_allclose(
+        choice.foothold, PARAMS.hip_offsets["RR"] + [0.0, 0.0, -PARAMS.max_leg_length]
+    )
+    assert "L_max" in choice.reason
+
+
 # §5.2 of the paper: (stance, tipping edge, adjustment leg, paper's foothold [m], tolerance [m]).
 # The forward case of the first tripod prints x = -2490 for the right front leg, impossible for a
 # front leg (its hip is at x = +2.4); the sign is read as a typo. The paper's front/rear footholds

@@ -109,12 +109,13 @@ class FootholdChoice:
             (``foothold`` is None).
         leg: the adjustment leg.
         foothold: chosen target ^C P_tar (3,) in the body frame [m], or None.
-        point: which boundary point was chosen ("A".."D", "L", "R"), or None.
+        point: which boundary point was chosen ("A".."D", "L", "R"; "H" when the region
+            collapses to H because ‖B_iH‖ = L_max), or None.
         reason: a sentence saying why.
         tipping_edge: the axis legs, counter-clockwise seen from above.
         axis_angle_deg: smallest angle between a boundary segment and the axis [deg] (nan when
             the region has no segment).
-        distances: signed distance of every boundary point to the axis [m], > 0 outside.
+        distances: signed distance of H and every boundary point to the axis [m], > 0 outside.
         joints: [J_x, J_z, J_θ] that put the foot on ``foothold`` (None if no IK solution).
         within_joint_limits: whether ``joints`` respect the robot's joint ranges (the region is
             an approximation: on tilted ground the J_x shift also changes the leg length).
@@ -232,13 +233,13 @@ def reachable_region(
     lateral /= np.linalg.norm(lateral)
     l_max = params.max_leg_length
 
-    def region(status: str, s_right: float, s_left: float) -> ReachableRegion:
+    def region(status: str, s_right: float, s_left: float, only_h: bool = False):
         right = h_point + s_right * lateral
         left = h_point + s_left * lateral
         proj = np.eye(3) - np.outer(normal, normal)
         front = rho * proj @ np.array([params.k_x * params.j_x_range[1], 0.0, 0.0])
         rear = rho * proj @ np.array([params.k_x * params.j_x_range[0], 0.0, 0.0])
-        if status != "ok":
+        if status != "ok" or only_h:
             front = rear = np.zeros(3)
         points = {
             "H": h_point,
@@ -256,7 +257,7 @@ def reachable_region(
 
     if model == "paper":
         if h_dist >= l_max * (1.0 - _TOL):
-            return region("ok", 0.0, 0.0)  # ‖B_iH‖ = L_max: H is the only target
+            return region("ok", 0.0, 0.0, only_h=True)  # ‖B_iH‖ = L_max: H is the target
         to_hip = (hip - h_point) / h_dist
         cos_beta_r = float(lateral @ to_hip)
         theta_lo, theta_hi = params.j_theta_range
@@ -321,7 +322,9 @@ def select_foothold(
     axis = (p_j - p_i) / np.linalg.norm(p_j - p_i)
     pts = region.points
     # Eq. (14): Θ = (P'_i->X × P'_i->P'_j)·z > 0 on the right; measured in the plane (·n).
-    distances = {name: float(np.cross(pts[name] - p_i, axis) @ normal) for name in BOUNDARY_POINTS}
+    distances = {
+        name: float(np.cross(pts[name] - p_i, axis) @ normal) for name in ("H", *BOUNDARY_POINTS)
+    }
     edge_name = f"{edge[0]}-{edge[1]}"
 
     if region.status != "ok":
@@ -358,7 +361,14 @@ def select_foothold(
         candidates,
         key=lambda n: (round(distances[n], 9), -float(np.linalg.norm(pts[n] - h_point))),
     )
-    if near_parallel:
+    collapsed = all(np.linalg.norm(pts[n] - h_point) < 1e-9 for n in BOUNDARY_POINTS)
+    if collapsed:
+        best = "H"
+        why = (
+            f"‖B_iH‖ = L_max = {params.max_leg_length:.3f} m: the reachable region shrinks to H, "
+            f"which is the target ({distances[best]:+.3f} m from the tipping axis {edge_name})"
+        )
+    elif near_parallel:
         segment = min(angles, key=angles.get)
         why = (
             f"segment {segment} makes {axis_angle:.1f}° (< {angle_threshold_deg:g}°) with the "
