@@ -13,5 +13,11 @@ __version__ = "0.1.0"
 register(
     id="HexapodCliffWalk-v0",
     entry_point="hexapod_envs.envs.cliff_walk:CliffWalkEnv",
-    max_episode_steps=3000,
+    max_episode_steps=1500,
+)
+
+register(
+    id="HexapodStewartTilt-v0",
+    entry_point="hexapod_envs.envs.stewart_tilt:StewartTiltEnv",
+    max_episode_steps=1600,
 )

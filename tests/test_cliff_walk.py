@@ -63,7 +63,7 @@ def test_flat_tripod_gait_margin_stays_in_band_for_five_cycles(flat_walk):
 @pytest.mark.slow
 def test_cliff_leg_steps_into_void_tipping_flagged_then_tips_over():
     env = gym.make("HexapodCliffWalk-v0")
-    infos = run(env, TripodGaitPolicy(env), 3000)
+    infos = run(env, TripodGaitPolicy(env), 1500)
     first_tipping = next(k for k, i in enumerate(infos) if k > 150 and i["is_tipping"])
     tipped = next(k for k, i in enumerate(infos) if i["is_tipped_over"])
     assert first_tipping < tipped

@@ -112,6 +112,10 @@ class HexapodEnv(gym.Env):
         """Compile `spec` with the env's physics timestep and (re)create data."""
         spec.option.timestep = self.physics_dt
         spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+        # Elliptic friction cones with a high impedance ratio: the default pyramidal cone lets a
+        # loaded foot creep down a slope at several cm/s, far below its friction limit.
+        spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+        spec.option.impratio = 10.0
         spec.visual.global_.offwidth = max(self._render_size[0], 640)
         spec.visual.global_.offheight = max(self._render_size[1], 480)
         self.model = spec.compile()

@@ -73,6 +73,9 @@ def fasm_from_feet(
 class HeavyDutyEnv(HexapodEnv):
     """Base for the heavy-duty hexapod scenarios: robot, sensors, FASM, action modes, rewards."""
 
+    walks: bool = True
+    """Walking scenarios follow the reference tripod gait and observe its phase."""
+
     def __init__(
         self,
         *,
@@ -86,7 +89,7 @@ class HeavyDutyEnv(HexapodEnv):
         tip_over_penalty: float = 100.0,
         effort_weight: float = 0.05,
         contact_threshold: float = 0.02,
-        tip_over_angle_deg: float = 30.0,
+        tip_over_angle_deg: float = 20.0,
         reset_noise_scale: float = 0.01,
         render_mode: str | None = None,
         width: int = 640,
@@ -145,7 +148,7 @@ class HeavyDutyEnv(HexapodEnv):
                 "imu_gyro": 3,
                 "imu_accel": 3,
                 "imu_quat": 4,
-                "gait_phase": 3,
+                **({"gait_phase": 3} if self.walks else {}),
                 **self._extra_observation_sizes(),
             }
         )
@@ -159,6 +162,7 @@ class HeavyDutyEnv(HexapodEnv):
 
     def _build(self) -> None:
         spec = mujoco.MjSpec()
+        spec.compiler.degree = False  # MjSpec defaults to degrees like MJCF; we use radians
         spec.modelname = type(self).__name__
         self._add_terrain(spec)
         self.handles = add_heavy_duty(spec, self.robot, pos=(0.0, 0.0, self._robot_start_height()))
@@ -202,13 +206,15 @@ class HeavyDutyEnv(HexapodEnv):
         super().reset(seed=seed)
         mujoco.mj_resetData(self.model, self.data)
         self._step_count = 0
-        joints = self._initial_joints().copy()
+        self._on_reset()
+        # The initial joint state is perturbed; the servo targets are not, and the settling
+        # below lets the perturbation decay into a seed-dependent resting state.
+        targets = self._initial_joints()
         noise = self.reset_noise_scale * self.action_map.half
-        joints += self.np_random.uniform(-noise, noise)
+        joints = targets + self.np_random.uniform(-noise, noise)
         joints = np.clip(joints, self.action_map.low, self.action_map.high)
         self.data.qpos[self._joint_qpos] = joints / self._gears
-        self.data.ctrl[self._act_ids] = joints
-        self._on_reset()
+        self.data.ctrl[self._act_ids] = targets
         mujoco.mj_forward(self.model, self.data)
         # Let the robot settle onto its feet before the episode starts (not part of the episode).
         for _ in range(int(round(self.settle_time / self.control_dt))):

@@ -47,6 +47,8 @@ def add_heavy_duty(
 
     `joints` optionally gives the initial [J_x, J_z, J_theta] per leg (default: standing pose).
     """
+    if spec.compiler.degree:
+        raise ValueError("set spec.compiler.degree = False: this builder gives angles in radians")
     p = params or HeavyDutyParams()
     gears = (1.0 / p.k_x, 1.0 / p.k_z, 1.0)
     torso = spec.worldbody.add_body(name="torso", pos=list(pos))

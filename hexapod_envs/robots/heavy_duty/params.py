@@ -60,11 +60,11 @@ class HeavyDutyParams:
     """Feet below the coxa origin when standing [m] (§5.2 footholds: z ≈ −1.74 to −1.78)."""
     foot_radius: float = 0.12
     """Foot sphere radius [m]."""
-    foot_stiffness: tuple[float, float, float] = (2.0e6, 4.0e6, 4.0e6)
+    foot_stiffness: tuple[float, float, float] = (2.0e6, 4.0e6, 5.0e7)
     """Servo stiffness of each joint expressed at the foot: x [N/m], leg length [N/m],
     swing [N·m/rad]. The force distribution controller uses these "known stiffnesses" to make
     planned foot forces act (seed 000 §4.3)."""
-    foot_damping: tuple[float, float, float] = (1.0e5, 1.5e5, 1.5e5)
+    foot_damping: tuple[float, float, float] = (1.0e5, 1.5e5, 1.0e6)
     """Joint damping at the foot: [N·s/m], [N·s/m], [N·m·s/rad]."""
     force_limit: tuple[float, float, float] = (6.0e4, 1.2e5, 2.0e5)
     """Servo force limits at the foot: [N], [N], [N·m]."""

@@ -1,0 +1,242 @@
+"""HexapodStewartTilt-v0: the heavy-duty hexapod on a tilting 6-UPS Stewart platform (seed 000 §5.2).
+
+The robot stands on one tripod with the other tripod lifted in swing posture. After
+`settle_time` the platform tilts at `tilt_rate_deg` [deg/s] up to `max_tilt_deg` and holds
+there. Held on its tripod the robot tips over; a controller that lands a swing leg in time keeps
+it up. Scenarios are defined by what the robot feels:
+
+| scenario | platform motion | the held tripod tips |
+|---|---|---|
+| climb | nose up (pitch) | backward |
+| descend | nose down | forward |
+| side | roll toward the tripod's two-foot side (left for LF-LR-RM, right for LM-RF-RR) | about that long edge |
+| random | axis, rate and stance sampled from np_random at reset | (training) |
+
+The hold posture is a little taller and narrower than the walking stance (feet at |y| = 1.7 m,
+1.95 m below the hips) so that the side case tips within the platform's reach (the 6-UPS
+platform tilts at most ~44-46 deg; the walking stance would need 48.5 deg).
+
+Observation: as HexapodCliffWalk-v0 without the gait phase (joint_pos, joint_vel, foot_force,
+foot_contact, fasm_margin_deg, imu_gyro, imu_accel, imu_quat). Action: 18 values in [-1, 1];
+``"residual"`` (default) offsets the hold posture by residual_scale x half range (default 2, so
+any joint target is reachable), ``"joint"`` gives targets directly. Reward terms: stability,
+tip_over, effort. `info` adds platform_tilt_deg, platform_rpy, actuator_lengths (6, m),
+adjustment_leg (the first lifted leg to land after tipping was flagged) and recovery_time [s].
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from ..robots.heavy_duty import LEG_NAMES, TRIPODS, joints_for_foot
+from ..terrain.stewart import add_stewart_platform
+from ..terrain.stewart_kinematics import DEFAULT_PLATFORM
+from .heavy_duty import XI_F_DEG, HeavyDutyEnv
+
+SCENARIOS = ("climb", "descend", "side", "random")
+STANCES = {"LF-LR-RM": TRIPODS[0], "LM-RF-RR": TRIPODS[1]}
+
+HOLD_FOOT_Y = 1.7
+"""|y| of the feet in the hold posture [m]."""
+HOLD_DEPTH = 1.95
+"""Feet below the coxa origins in the hold posture [m]."""
+SWING_LIFT = 0.45
+"""Lift of the swing tripod's feet in the hold posture [m]."""
+DEFAULT_MAX_TILT_DEG = {"climb": 38.0, "descend": 38.0, "side": 44.0}
+RAMP_TIME = 1.0
+"""Time to reach (and leave) the tilt rate [s]."""
+
+
+def tilt_axis(scenario: str, stance: tuple[str, ...]) -> np.ndarray:
+    """Unit axis (platform frame, horizontal) about which a positive tilt gives the scenario."""
+    if scenario == "climb":
+        return np.array([0.0, -1.0, 0.0])  # nose up: rotate about -y
+    if scenario == "descend":
+        return np.array([0.0, 1.0, 0.0])
+    if scenario == "side":
+        two_foot_side_left = sum(leg[0] == "L" for leg in stance) == 2
+        return np.array([-1.0, 0.0, 0.0]) if two_foot_side_left else np.array([1.0, 0.0, 0.0])
+    raise ValueError(f"scenario must be one of {SCENARIOS}, got {scenario!r}")
+
+
+class StewartTiltEnv(HeavyDutyEnv):
+    """See the module docstring."""
+
+    walks = False
+
+    def __init__(
+        self,
+        *,
+        scenario: str = "random",
+        stance: str = "LF-LR-RM",
+        tilt_rate_deg: float = 2.0,
+        max_tilt_deg: float | None = None,
+        settle_time: float = 3.0,
+        platform_friction: float = 1.5,
+        action_mode: str = "residual",
+        residual_scale: float = 2.0,
+        stability_weight: float = 1.0,
+        tip_over_penalty: float = 100.0,
+        tip_over_angle_deg: float = 10.0,
+        **kwargs,
+    ):
+        if scenario not in SCENARIOS:
+            raise ValueError(f"scenario must be one of {SCENARIOS}, got {scenario!r}")
+        if stance not in STANCES:
+            raise ValueError(f"stance must be one of {sorted(STANCES)}, got {stance!r}")
+        if tilt_rate_deg <= 0:
+            raise ValueError(f"tilt_rate_deg must be > 0, got {tilt_rate_deg}")
+        self.scenario, self.stance_name = scenario, stance
+        self.tilt_rate = np.radians(tilt_rate_deg)
+        self.settle = settle_time
+        self.platform_friction = platform_friction
+        self._max_tilt_arg = max_tilt_deg
+        self.platform = DEFAULT_PLATFORM
+        super().__init__(
+            action_mode=action_mode,
+            residual_scale=residual_scale,
+            stability_weight=stability_weight,
+            tip_over_penalty=tip_over_penalty,
+            tip_over_angle_deg=tip_over_angle_deg,
+            forward_weight=0.0,
+            **kwargs,
+        )
+        self._platform_act = np.array(
+            [self.model.actuator(j).id for j in self.platform_handles.joints]
+        )
+        self._platform_qpos = np.array(
+            [self.model.jnt_qposadr[self.model.joint(j).id] for j in self.platform_handles.joints]
+        )
+        self._platform_body = self.model.body("platform").id
+        # Validate the fixed scenarios' whole motion up front: a pose the actuators cannot reach
+        # is refused here, not discovered mid-episode.
+        if scenario != "random":
+            self._configure(scenario, STANCES[stance], self.tilt_rate)
+            self._check_reachable()
+
+    # --- scenario ------------------------------------------------------------------------
+    def _configure(self, scenario: str, stance: tuple[str, ...], rate: float, axis=None) -> None:
+        self.stance = stance
+        self.swing = tuple(leg for leg in LEG_NAMES if leg not in stance)
+        self.axis = tilt_axis(scenario, stance) if axis is None else axis
+        self.rate = rate
+        if self._max_tilt_arg is not None:
+            self.max_tilt = np.radians(self._max_tilt_arg)
+        elif scenario in DEFAULT_MAX_TILT_DEG:
+            self.max_tilt = np.radians(DEFAULT_MAX_TILT_DEG[scenario])
+        else:
+            self.max_tilt = np.radians(40.0)
+        self._hold = self._hold_posture(stance)
+
+    def _check_reachable(self) -> None:
+        for tilt in np.linspace(0.0, self.max_tilt, 25):
+            self.platform.check_pose(self.platform.neutral_position, self._rpy(tilt))
+
+    def _hold_posture(self, stance: tuple[str, ...]) -> np.ndarray:
+        joints = []
+        for leg in LEG_NAMES:
+            side = 1.0 if leg[0] == "L" else -1.0
+            foot = self.robot.hip_offsets[leg] + np.array([0.0, 0.0, -HOLD_DEPTH])
+            foot[1] = side * HOLD_FOOT_Y
+            if leg not in stance:
+                foot[2] += SWING_LIFT
+            joints.append(joints_for_foot(leg, foot, self.robot))
+        return np.concatenate(joints)
+
+    def _rpy(self, tilt: float) -> np.ndarray:
+        """Roll and pitch for a tilt about the scenario axis (R = Ry(pitch) Rx(roll))."""
+        return np.array([tilt * self.axis[0], tilt * self.axis[1], 0.0])
+
+    def tilt_at(self, t: float) -> float:
+        """Platform tilt [rad] at time t: level while settling, then the scenario rate reached
+        and left with a constant (de)celeration over RAMP_TIME so the plate never jerks."""
+        ramp = RAMP_TIME
+        tau = t - self.settle
+        if tau <= 0.0:
+            return 0.0
+        total = self.max_tilt / self.rate + ramp  # time to reach max_tilt with both ramps
+        if tau >= total:
+            return self.max_tilt
+        accel = self.rate / ramp
+        if tau < ramp:
+            return 0.5 * accel * tau**2
+        if tau > total - ramp:
+            return self.max_tilt - 0.5 * accel * (total - tau) ** 2
+        return self.rate * (tau - ramp / 2)
+
+    # --- model hooks ---------------------------------------------------------------------
+    def _add_terrain(self, spec: mujoco.MjSpec) -> None:
+        self.platform_handles = add_stewart_platform(
+            spec, self.platform, friction=self.platform_friction
+        )
+
+    def _robot_start_height(self) -> float:
+        return self.platform.neutral_height + HOLD_DEPTH + 0.005
+
+    def reference_joints(self) -> np.ndarray:
+        return self._hold
+
+    def _initial_joints(self) -> np.ndarray:
+        return self._hold
+
+    def _on_reset(self) -> None:
+        if self.scenario == "random":
+            rng = self.np_random
+            stance = STANCES[sorted(STANCES)[int(rng.integers(2))]]
+            angle = rng.uniform(0, 2 * np.pi)
+            rate = np.radians(rng.uniform(1.0, 3.0))
+            axis = np.array([np.cos(angle), np.sin(angle), 0.0])
+            self._configure("random", stance, rate, axis)
+            reach = self.platform.max_tilt(axis)
+            self.max_tilt = min(self.max_tilt, 0.95 * reach)
+        self.data.qpos[self._platform_qpos] = 0.0
+        self.data.ctrl[self._platform_act] = 0.0
+        self._first_tipping_time = None
+        self._adjustment_leg = None
+        self._recovery_time = None
+
+    def _before_physics(self) -> None:
+        roll, pitch, _ = self._rpy(self.tilt_at(self.time + self.control_dt))
+        self.data.ctrl[self._platform_act] = (pitch, roll)
+
+    # --- stability, termination, reward ---------------------------------------------------
+    def _platform_up(self) -> np.ndarray:
+        return self.data.xmat[self._platform_body].reshape(3, 3)[:, 2]
+
+    def _is_tipped_over(self) -> bool:
+        """Tipped when the body leans more than tip_over_angle_deg relative to the platform."""
+        body_up = self.data.xmat[self.sensors.torso_id].reshape(3, 3)[:, 2]
+        return bool(body_up @ self._platform_up() < self.tip_over_cos)
+
+    def _update_stability(self) -> None:
+        super()._update_stability()
+        if self._step_count == 0:
+            return
+        if self._first_tipping_time is None and self._fasm_deg < XI_F_DEG:
+            self._first_tipping_time = self.time
+        if self._first_tipping_time is not None and self._adjustment_leg is None:
+            for i, leg in enumerate(LEG_NAMES):
+                if leg in self.swing and self._loaded[i]:
+                    self._adjustment_leg = leg
+                    self._recovery_time = self.time - self._first_tipping_time
+                    break
+
+    def _reward_terms(self, tipped: bool) -> dict[str, float]:
+        terms = super()._reward_terms(tipped)
+        del terms["forward"]
+        return terms
+
+    def _extra_info(self) -> dict:
+        rpy = np.array(
+            [self.data.qpos[self._platform_qpos[1]], self.data.qpos[self._platform_qpos[0]], 0.0]
+        )
+        return {
+            "scenario": self.scenario,
+            "stance": self.stance,
+            "platform_tilt_deg": float(np.degrees(np.arccos(min(1.0, self._platform_up()[2])))),
+            "platform_rpy": rpy,
+            "actuator_lengths": self.platform.actuator_lengths(self.platform.neutral_position, rpy),
+            "adjustment_leg": self._adjustment_leg,
+            "recovery_time": self._recovery_time,
+        }

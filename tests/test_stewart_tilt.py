@@ -1,0 +1,71 @@
+"""HexapodStewartTilt-v0 scenarios without a controller: the held tripod tips in every case."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import hexapod_envs  # noqa: F401
+from hexapod_envs.envs.stewart_tilt import STANCES
+
+CASES = [(s, st) for s in ("climb", "descend", "side") for st in sorted(STANCES)]
+EXPECTED_EDGE = {  # the tripod edge the held robot tips about, counter-clockwise pair
+    ("climb", "LF-LR-RM"): {"LR", "RM"},
+    ("descend", "LF-LR-RM"): {"RM", "LF"},
+    ("side", "LF-LR-RM"): {"LF", "LR"},
+    ("climb", "LM-RF-RR"): {"RR", "LM"},
+    ("descend", "LM-RF-RR"): {"LM", "RF"},
+    ("side", "LM-RF-RR"): {"RF", "RR"},
+}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("scenario", "stance"), CASES)
+def test_held_tripod_tips_over_about_the_expected_edge(scenario, stance):
+    env = gym.make("HexapodStewartTilt-v0", scenario=scenario, stance=stance)
+    env.reset(seed=0)
+    first_tipping = None
+    while True:
+        _, _, terminated, truncated, info = env.step(np.zeros(18))
+        if info["is_tipping"] and first_tipping is None:
+            first_tipping = info
+        if terminated or truncated:
+            break
+    assert (
+        first_tipping is not None
+        and set(first_tipping["fasm_edge"]) == EXPECTED_EDGE[(scenario, stance)]
+    )
+    assert terminated and info["is_tipped_over"] and not info["is_success"]
+    assert info["adjustment_leg"] is None  # nothing landed
+
+
+def test_actuator_lengths_reported_and_within_stroke():
+    env = gym.make("HexapodStewartTilt-v0", scenario="climb")
+    env.reset(seed=0)
+    for _ in range(400):
+        *_, info = env.step(np.zeros(18))
+    lengths = info["actuator_lengths"]
+    assert lengths.shape == (6,) and np.all((lengths >= 9.0) & (lengths <= 14.0))
+    assert info["platform_tilt_deg"] > 5.0
+
+
+def test_unreachable_platform_pose_is_refused():
+    with pytest.raises(ValueError, match="actuator"):
+        gym.make("HexapodStewartTilt-v0", scenario="side", max_tilt_deg=60.0)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [({"scenario": "upside"}, "climb"), ({"stance": "LF-LM-LR"}, "LF-LR-RM")],
+)
+def test_bad_choices_list_the_valid_ones(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        gym.make("HexapodStewartTilt-v0", **kwargs)
+
+
+def test_random_scenario_is_seeded():
+    env = gym.make("HexapodStewartTilt-v0")
+    axes = []
+    for seed in (1, 1, 2):
+        env.reset(seed=seed)
+        axes.append(tuple(env.unwrapped.axis.round(6)))
+    assert axes[0] == axes[1] != axes[2]
