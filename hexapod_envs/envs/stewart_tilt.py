@@ -1,4 +1,6 @@
-"""HexapodStewartTilt-v0: the heavy-duty hexapod on a tilting 6-UPS Stewart platform (seed 000 §5.2).
+"""HexapodStewartTilt-v0: the heavy-duty hexapod on a tilting 6-UPS Stewart platform.
+
+Seed 000 §5.2.
 
 The robot stands on one tripod with the other tripod lifted in swing posture. After
 `settle_time` the platform tilts at `tilt_rate_deg` [deg/s] up to `max_tilt_deg` and holds
@@ -9,8 +11,10 @@ it up. Scenarios are defined by what the robot feels:
 |---|---|---|
 | climb | nose up (pitch) | backward |
 | descend | nose down | forward |
-| side | roll toward the tripod's two-foot side (left for LF-LR-RM, right for LM-RF-RR) | about that long edge |
+| side | roll toward the tripod's two-foot side (1) | about that long edge |
 | random | axis, rate and stance sampled from np_random at reset | (training) |
+
+(1) left for LF-LR-RM, right for LM-RF-RR.
 
 The hold posture is a little taller and narrower than the walking stance (feet at |y| = 1.7 m,
 1.95 m below the hips) so that the side case tips within the platform's reach (the 6-UPS
