@@ -65,3 +65,19 @@ def test_rgb_render_headless(env_id):
     frame = env.render()
     env.close()
     assert frame.shape == (64, 96, 3) and frame.std() > 0
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_docstring_tables_name_every_observation_piece_and_reward_term(env_id):
+    """The user-facing docstring (module + class) must describe what the env really returns."""
+    import inspect
+
+    env = gym.make(env_id)
+    base = env.unwrapped
+    doc = (inspect.getmodule(type(base)).__doc__ or "") + (type(base).__doc__ or "")
+    _, info = env.reset(seed=0)
+    _, _, _, _, info = env.step(env.action_space.sample())
+    missing = [name for name in base.observation_structure if name not in doc]
+    missing += [k for k in info if k.startswith("reward_") and k[len("reward_"):] not in doc]
+    env.close()
+    assert not missing, f"{env_id} docstring does not mention {missing}"
