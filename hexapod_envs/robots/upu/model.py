@@ -13,8 +13,11 @@ Structure (names follow the package's model-building contract where it applies):
 - The limbs ``limb1..3``: spatial tendons from the Hooke-joint sites ``hooke_A<i>`` (torso) to
   ``hooke_B<i>`` (upper), each driven by a position actuator of the same name whose control is
   the limb length [m], ctrlrange = [limb_min, limb_max]; the tendons also have end stops at
-  those limits. Sensors ``limb<i>_length`` (tendon length). The Hooke-joint angle limits are
-  not enforced by the model (the slide joints replace the joints); planners check them with
+  those limits. The servo is PD by default: under the upper half's weight the platform settles
+  up to ~3 mm (mostly horizontally) from the IK pose, as the closed-form compliance predicts;
+  `UpuParams.limb_integral_gain` > 0 switches to MuJoCo 4's PID actuator. Sensors
+  ``limb<i>_length`` (tendon length). The Hooke-joint angle limits are not enforced by the
+  model (the slide joints replace the joints); planners check them with
   `kinematics.check_limits`.
 - Per leg ``U1 U2 U3`` (upper) and ``L1 L2 L3`` (lower): body ``<leg>_leg`` with the slide
   joint ``<leg>_extend`` along -z (extension [m], + = longer leg, range
@@ -24,7 +27,8 @@ Structure (names follow the package's model-building contract where it applies):
   ``<leg>_foot_touch`` (the paper's per-leg pressure switch: normal contact force [N]). The
   force sensor reads the force the leg exerts on the foot, in the site frame (parallel to its
   platform's frame); for a foot at rest the ground reaction force on it is
-  -R_site @ sensor - foot_mass * g (world frame), checked by tests/test_upu_model.py.
+  -R_site @ sensor - foot_mass * g with g = (0, 0, -9.81) m/s^2 (world frame), checked by
+  tests/test_upu_model.py.
 
 Collisions: robot geoms have contype 1 / conaffinity 0 and terrain geoms contype 0 /
 conaffinity 1, so the robot touches only the terrain, never itself (the upper legs pass beside
@@ -50,8 +54,8 @@ from .params import (
 )
 
 RECOMMENDED_TIMESTEP = 0.002
-"""[s] The limb servos (2e5 N/m on a ~4 kg platform) are stable with explicit stiffness up to
-~8 ms; 2 ms leaves room for contacts."""
+"""[s] Largest timestep tested with the stiff limb servos (5e5 N/m, explicit in MuJoCo) and the
+implicitfast integrator (which treats the servo damping implicitly)."""
 
 UPPER_JOINTS: tuple[str, str, str] = ("upper_x", "upper_y", "upper_z")
 _ROBOT_COLLISION = {"contype": 1, "conaffinity": 0}
@@ -150,19 +154,23 @@ def _add_plate(body, name: str, hub_radius: float, arm_ends, rgba) -> None:
 
 
 def _set_limb_servo(act, p: UpuParams) -> None:
-    """PID length servo (MuJoCo >= 4: position input, integral with anti-windup at the force
-    limit). Older MuJoCo without `mjtCtrlInput` gets a PD position servo: the platform then
-    sags up to ~7 mm horizontally under its weight (see `UpuParams.limb_integral_gain`)."""
-    if hasattr(mujoco, "mjtCtrlInput") and p.limb_integral_gain > 0:
-        act.set_to_pid(
-            kp=p.limb_stiffness,
-            kv=p.limb_damping,
-            ki=p.limb_integral_gain,
-            imax=p.limb_force_limit,
-            ctrlspec=int(mujoco.mjtCtrlInput.mjINPUT_POS),
-        )
-    else:
+    """PD length servo, or with `limb_integral_gain` > 0 MuJoCo's PID actuator (position input,
+    integral clamped at `limb_integral_limit`), which needs MuJoCo >= 4."""
+    if p.limb_integral_gain == 0:
         act.set_to_position(kp=p.limb_stiffness, kv=p.limb_damping)
+        return
+    if not hasattr(mujoco, "mjtCtrlInput"):
+        raise ValueError(
+            "UpuParams.limb_integral_gain > 0 needs MuJoCo's PID actuator (MuJoCo >= 4, "
+            f"found {mujoco.__version__}); set limb_integral_gain=0 for a PD servo"
+        )
+    act.set_to_pid(
+        kp=p.limb_stiffness,
+        kv=p.limb_damping,
+        ki=p.limb_integral_gain,
+        imax=p.limb_integral_limit,
+        ctrlspec=int(mujoco.mjtCtrlInput.mjINPUT_POS),
+    )
 
 
 def _add_leg(spec: mujoco.MjSpec, platform_body, leg: str, p: UpuParams) -> None:
@@ -287,7 +295,7 @@ def add_upu(
             axis=axis.tolist(),
             range=[lo, hi],
             limited=mujoco.mjtLimited.mjLIMITED_TRUE,
-            damping=5.0,
+            damping=p.upper_slide_damping,
             armature=0.01,
         )
     upper_arms = [p.foot_offset(leg) for leg in UPPER_LEGS]

@@ -54,7 +54,7 @@ LEG_AZIMUTHS: dict[str, float] = {
 """Azimuth of each leg's foot about its platform centre [rad] (see the module docstring)."""
 
 
-_NON_NEGATIVE = frozenset({"limit_tolerance", "limb_integral_gain"})
+_NON_NEGATIVE = frozenset({"limit_tolerance", "limb_integral_gain", "upper_slide_damping"})
 
 
 def leg_platform(leg: str) -> str:
@@ -141,17 +141,24 @@ class UpuParams:
     """Foot with its pressure sensor [kg]."""
 
     # --- Servo properties for the MuJoCo model (not in the paper) -------------------------
-    limb_stiffness: float = 2.0e5
+    limb_stiffness: float = 5.0e5
     """Position-servo stiffness of a limb's prismatic pair [N/m]. High because the three limbs
     are nearly parallel near the initial pose, so the platform's horizontal stiffness is only
-    ~1.4 % of this (sum of squared limb slopes)."""
+    ~1.4 % of this (sum of squared limb slopes): the weight of the upper half then shifts the
+    platform by <= ~3 mm horizontally at the edges of the gait (a screw-driven limb is stiffer
+    still; MuJoCo's explicit stiffness needs timestep <= 2 ms at this value)."""
     limb_damping: float = 1.0e4
-    """Limb servo damping [N s/m]."""
-    limb_integral_gain: float = 1.0e6
-    """Integral gain of the limb servo [N/(m s)] (MuJoCo PID actuator; time constant
-    kp/ki = 0.2 s). A real limb servo closes its loop on an encoder and holds the commanded
-    length; without the integral term the ~0.3 mm elastic limb error under the platform's weight
-    becomes a ~7 mm horizontal error of the platform (nearly parallel limbs amplify it)."""
+    """Limb servo damping [N s/m] (integrated implicitly by MuJoCo's implicitfast)."""
+    limb_integral_gain: float = 0.0
+    """Integral gain of the limb servo [N/(m s)]. 0 (default): PD position servo. > 0: MuJoCo's
+    PID actuator (needs MuJoCo >= 4), which removes the static error (2e6 brings it below
+    1 mm within 0.6 s) but stores internal forces while all six feet are down, which makes
+    the robot rock when a platform lifts its legs; hence off by default."""
+    limb_integral_limit: float = 400.0
+    """Anti-windup clamp of the integral term [N] (PID mode only)."""
+    upper_slide_damping: float = 5.0
+    """Viscous damping of the upper platform's x/y/z slide joints [N s/m] (joint friction of
+    the mechanism)."""
     limb_force_limit: float = 400.0
     """Limb servo force limit [N] (the robot weighs ~75 N)."""
     leg_stiffness: float = 5.0e4
