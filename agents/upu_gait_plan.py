@@ -167,9 +167,10 @@ def stance_margin(params: UpuParams, x_upper: float, x_lower: float, support: st
 class GaitSettings:
     """Tunable choices of the planner (SI units)."""
 
-    lift: float = 0.08
-    """Apex of the upper platform's path above its start [m] (paper: 80 mm, eq. 20). Reduced
-    automatically where the workspace does not allow it (short steps far from the centre)."""
+    lift: float | None = None
+    """Apex of the upper platform's path above its start [m]; None: `UpuParams.step_lift` (the
+    paper's 80 mm, eq. 20). Reduced automatically where the workspace does not allow it (steps
+    that end far from the lower platform's centre)."""
     upper_swing_retract: float = 0.02
     """The upper legs retract by this much before their transfer [m], so their feet clear the
     ground at the path ends where the path itself has no lift."""
@@ -187,7 +188,6 @@ class GaitSettings:
 
     def __post_init__(self) -> None:
         for name in (
-            "lift",
             "upper_swing_retract",
             "lower_swing_retract",
             "edge_clearance",
@@ -198,6 +198,10 @@ class GaitSettings:
                 raise ValueError(f"GaitSettings.{name} must be a finite number >= 0, got {value}")
         if not (math.isfinite(self.grid) and self.grid > 0):
             raise ValueError(f"GaitSettings.grid must be > 0 m, got {self.grid}")
+        if self.lift is not None and not (math.isfinite(self.lift) and self.lift >= 0):
+            raise ValueError(
+                f"GaitSettings.lift must be a finite number >= 0 m or None, got {self.lift}"
+            )
         if self.max_stride is not None and not self.max_stride > 0:
             raise ValueError(
                 f"GaitSettings.max_stride must be > 0 m or None, got {self.max_stride}"
@@ -262,7 +266,8 @@ class PlatformStep:
 
     @property
     def support(self) -> str:
-        return "lower" if self.moving == "upper" else "upper"
+        """The platform standing on its legs during this step."""
+        return _other(self.moving)
 
     def path(self, params: UpuParams) -> QuadraticPath:
         """Relative path of the moving centre in the supporting platform's frame (x, z) [m]:
@@ -342,6 +347,10 @@ def margin_profile(plan: GaitPlan, params: UpuParams, samples: int = 11) -> Marg
     return MarginProfile(np.array(steps, dtype=int), tuple(phases), np.array(margins))
 
 
+def _other(platform: str) -> str:
+    return "lower" if platform == "upper" else "upper"
+
+
 def _stride_limit(params: UpuParams, settings: GaitSettings) -> float:
     limit = max_stride(params.support_inradius, params.leg_radius)
     return limit if settings.max_stride is None else min(limit, settings.max_stride)
@@ -353,12 +362,13 @@ def _swing_extension(moving: str, params: UpuParams, settings: GaitSettings) -> 
 
 
 def _feasible_lift(params: UpuParams, settings: GaitSettings, moving: str, x0: float, x1: float):
-    """Largest lift <= settings.lift (1 mm steps) keeping the whole path inside the workspace;
+    """Largest lift <= the target lift (1 mm steps) keeping the whole path inside the workspace;
     None if even the straight path leaves it. Relative coordinates [m]."""
     h = params.initial_height if moving == "upper" else -params.initial_height
+    target = params.step_lift if settings.lift is None else settings.lift
     candidates = [0.0]
-    if moving == "upper" and settings.lift > 0:
-        candidates = np.linspace(settings.lift, 0.0, int(round(settings.lift / 0.001)) + 1)
+    if moving == "upper" and target > 0:
+        candidates = np.linspace(target, 0.0, int(round(target / 0.001)) + 1)
     for lift in candidates:
         pose = step_path(x0, x1, h, float(lift)).sample(21)
         pts = np.column_stack([pose[:, 0], np.zeros(len(pose)), pose[:, 1]])
@@ -369,7 +379,7 @@ def _feasible_lift(params: UpuParams, settings: GaitSettings, moving: str, x0: f
 
 def _transfer_margin(params: UpuParams, moving: str, x0: float, x1: float, n: int = 11) -> float:
     """Min static margin while the `moving` centre goes from x0 to x1 relative to the other."""
-    support = "lower" if moving == "upper" else "upper"
+    support = _other(moving)
     values = []
     for x in np.linspace(x0, x1, n):
         xu, xl = (x, 0.0) if moving == "upper" else (0.0, x)
@@ -395,7 +405,6 @@ def plan_flat_walk(
         raise ValueError(f"stride must be in (0, {limit:.4f}] m (eq. 17), got {stride}")
     steps = []
     x_lower = x_upper = float(x_start)
-    zero = {leg: 0.0 for leg in PLATFORM_LEGS["upper"] + PLATFORM_LEGS["lower"]}
     for _ in range(n_cycles):
         for moving in ("upper", "lower"):
             x0 = x_upper if moving == "upper" else x_lower
@@ -419,10 +428,7 @@ def plan_flat_walk(
                     lift=lift,
                     swing_extension=_swing_extension(moving, params, settings),
                     landing_extension={leg: 0.0 for leg in PLATFORM_LEGS[moving]},
-                    support_extension={
-                        leg: zero[leg]
-                        for leg in PLATFORM_LEGS["lower" if moving == "upper" else "upper"]
-                    },
+                    support_extension=dict.fromkeys(PLATFORM_LEGS[_other(moving)], 0.0),
                     min_margin=margin,
                 )
             )
@@ -576,7 +582,7 @@ def plan_ditch_crossing(
         for leg in PLATFORM_LEGS[mover]:
             foot_x = end_x + float(params.foot_offset(leg)[0])
             landing[leg] = ditch.depth if ditch.ground_height(foot_x) < 0 else 0.0
-        support = "lower" if mover == "upper" else "upper"
+        support = _other(mover)
         steps.append(
             PlatformStep(
                 moving=mover,

@@ -223,3 +223,12 @@ def test_ditch_validation():
         plan_ditch_crossing(P, Ditch(0.2, 0.3, 0.1))
     with pytest.raises(ValueError, match="grid"):
         GaitSettings(grid=0.0)
+
+
+def test_lift_setting_overrides_paper_apex():
+    plan = plan_flat_walk(P, 1, settings=GaitSettings(lift=0.05))
+    assert plan.steps[0].lift == pytest.approx(0.05)
+    assert plan.steps[1].lift == 0.0  # the lower platform cannot rise (see module doc)
+    assert plan.steps[1].swing_extension == pytest.approx(-0.08)
+    with pytest.raises(ValueError, match="lift"):
+        GaitSettings(lift=-0.01)
