@@ -152,8 +152,8 @@ class UpuParams:
     limb_integral_gain: float = 0.0
     """Integral gain of the limb servo [N/(m s)]. 0 (default): PD position servo. > 0: MuJoCo's
     PID actuator (needs MuJoCo >= 4), which removes the static error (2e6 brings it below
-    1 mm within 0.6 s) but stores internal forces while all six feet are down, which makes
-    the robot rock when a platform lifts its legs; hence off by default."""
+    1 mm within 0.6 s). Off by default so that the model is the same on every supported
+    MuJoCo version; the PD servo's sag is predictable (closed-form compliance)."""
     limb_integral_limit: float = 400.0
     """Anti-windup clamp of the integral term [N] (PID mode only)."""
     upper_slide_damping: float = 5.0
