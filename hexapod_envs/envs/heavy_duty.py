@@ -49,14 +49,17 @@ def fasm_from_feet(
 
     Returns (0, None) when fewer than three feet carry load: no support polygon exists.
     """
-    idx = np.flatnonzero(loaded)
+    idx = [i for i, on in enumerate(loaded.tolist()) if on]
     if len(idx) < 3:
         return 0.0, None
     # Plain floats: at k <= 6 feet this is several times faster than numpy calls.
-    p, f, c = feet[idx].tolist(), forces[idx].tolist(), cog.tolist()
+    all_p, all_f = feet.tolist(), forces.tolist()
+    p = [all_p[i] for i in idx]
+    cx, cy, cz = cog.tolist()
     fx = fy = fz = mx = my = mz = 0.0
-    for (px, py, pz), (gx, gy, gz) in zip(p, f, strict=True):
-        rx, ry, rz = px - c[0], py - c[1], pz - c[2]
+    for i, (px, py, pz) in zip(idx, p, strict=True):
+        gx, gy, gz = all_f[i]
+        rx, ry, rz = px - cx, py - cy, pz - cz
         fx -= gx
         fy -= gy
         fz -= gz
@@ -64,10 +67,10 @@ def fasm_from_feet(
         my -= rz * gx - rx * gz
         mz -= rx * gy - ry * gx
     try:
-        result = fasm(p, c, (fx, fy, fz), (mx, my, mz))
+        result = fasm(p, (cx, cy, cz), (fx, fy, fz), (mx, my, mz))
     except ValueError:  # collinear feet: the robot is balanced on a line
         return 0.0, None
-    return float(result.margin_deg), (int(idx[result.edge[0]]), int(idx[result.edge[1]]))
+    return float(result.margin_deg), (idx[result.edge[0]], idx[result.edge[1]])
 
 
 class HeavyDutyEnv(HexapodEnv):
