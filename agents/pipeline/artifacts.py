@@ -1,0 +1,182 @@
+"""Where models live on disk: run directories and self-describing model directories.
+
+A **model directory** holds everything needed to use or resume one saved model::
+
+    model.zip          SB3 PPO model (weights, optimiser, num_timesteps)
+    vecnormalize.pkl   VecNormalize statistics (absent when normalisation is off)
+    config.yaml        the resolved training config (env id and kwargs included)
+    command.txt        the command line that produced it
+    meta.json          num_timesteps, observation/action shapes, kind, eval reward (if best)
+
+A **run directory** (``runs/{env}__ppo__{seed}__{time}``)::
+
+    config.yaml, command.txt    resolved config; every command run on it, one per line
+    tb/                         TensorBoard event files (a resumed run appends here)
+    checkpoints/step_<N>/       periodic and Ctrl-C checkpoints (model directories)
+    best/                       best model by EvalCallback's mean reward (model directory)
+    final/                      model at the end of training (model directory)
+    evaluations.npz             EvalCallback's log
+
+Shipped models (``models/<env_id>/``) are model directories.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import shlex
+import shutil
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from .configtools import dump_yaml, load_yaml
+from .errors import UserError
+
+MODEL_FILE = "model.zip"
+VECNORM_FILE = "vecnormalize.pkl"
+CONFIG_FILE = "config.yaml"
+COMMAND_FILE = "command.txt"
+META_FILE = "meta.json"
+CHECKPOINTS = "checkpoints"
+BEST, FINAL = "best", "final"
+
+
+def command_line(argv: list[str] | None = None) -> str:
+    """The command as typed (``python train.py --config ...``), shell-quoted."""
+    argv = sys.argv if argv is None else argv
+    return shlex.join(["python", *argv])
+
+
+def run_name(env_id: str, seed: int, now: float | None = None) -> str:
+    stamp = time.strftime("%Y%m%d-%H%M%S", time.localtime(now))
+    return f"{env_id}__ppo__{seed}__{stamp}"
+
+
+def prepare_new_dir(path: Path, force: bool, what: str) -> Path:
+    """Create `path`; an existing non-empty directory is an error unless `force` (then emptied)."""
+    path = Path(path)
+    if path.exists() and (not path.is_dir() or any(path.iterdir())):
+        if not force:
+            raise UserError(f"{what} {path} already exists; pass --force to overwrite it")
+        if path.is_dir():
+            shutil.rmtree(path)
+        else:
+            path.unlink()
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def save_model_dir(
+    path: Path,
+    model: Any,
+    vec_normalize: Any | None,
+    config: Any,
+    command: str,
+    kind: str,
+    extra_meta: dict[str, Any] | None = None,
+) -> Path:
+    """Write a model directory (see module docstring); files are replaced atomically-ish."""
+    path = Path(path)
+    path.mkdir(parents=True, exist_ok=True)
+    model.save(path / MODEL_FILE)
+    if vec_normalize is not None:
+        vec_normalize.save(str(path / VECNORM_FILE))
+    elif (path / VECNORM_FILE).exists():
+        (path / VECNORM_FILE).unlink()
+    (path / CONFIG_FILE).write_text(dump_yaml(config))
+    (path / COMMAND_FILE).write_text(command + "\n")
+    meta = {
+        "kind": kind,
+        "num_timesteps": int(model.num_timesteps),
+        "observation_shape": list(model.observation_space.shape),
+        "action_shape": list(model.action_space.shape),
+        "saved_at": time.strftime("%Y-%m-%dT%H:%M:%S"),
+        **(extra_meta or {}),
+    }
+    (path / META_FILE).write_text(json.dumps(meta, indent=2) + "\n")
+    return path
+
+
+def read_meta(model_dir: Path) -> dict[str, Any]:
+    path = Path(model_dir) / META_FILE
+    return json.loads(path.read_text()) if path.is_file() else {}
+
+
+def checkpoint_dir(run_dir: Path, num_timesteps: int) -> Path:
+    return Path(run_dir) / CHECKPOINTS / f"step_{num_timesteps:012d}"
+
+
+def _timesteps(model_dir: Path) -> int:
+    meta = read_meta(model_dir)
+    if "num_timesteps" in meta:
+        return int(meta["num_timesteps"])
+    match = re.search(r"(\d+)$", model_dir.name)
+    return int(match.group(1)) if match else -1
+
+
+def latest_model_dir(run_dir: Path) -> Path | None:
+    """The saved model with the most timesteps among checkpoints/* and final/ (None if none)."""
+    run_dir = Path(run_dir)
+    candidates = sorted((run_dir / CHECKPOINTS).glob("step_*")) + [run_dir / FINAL]
+    candidates = [c for c in candidates if (c / MODEL_FILE).is_file()]
+    if not candidates:
+        return None
+    return max(candidates, key=lambda c: (_timesteps(c), c.name == FINAL))
+
+
+def is_run_dir(path: Path) -> bool:
+    path = Path(path)
+    return any((path / sub).is_dir() for sub in (BEST, FINAL, CHECKPOINTS))
+
+
+@dataclass(frozen=True)
+class ModelFiles:
+    """The files of one saved model, found from a user-given path."""
+
+    directory: Path
+    model: Path
+    vec_normalize: Path | None
+    config: Path | None
+
+    def training_config(self) -> dict[str, Any] | None:
+        return load_yaml(self.config) if self.config is not None else None
+
+
+def find_model(path: str | Path) -> ModelFiles:
+    """Resolve a model file, a model directory or a run directory (best/ > final/ > latest
+    checkpoint) to its files; UserError naming the path otherwise."""
+    path = Path(path)
+    if not path.exists():
+        raise UserError(f"no PPO model at {path}: the path does not exist")
+    if path.is_file():
+        if path.suffix != ".zip":
+            raise UserError(f"{path} is not an SB3 model file (expected a .zip)")
+        directory, model = path.parent, path
+    elif (path / MODEL_FILE).is_file():
+        directory, model = path, path / MODEL_FILE
+    elif is_run_dir(path):
+        for sub in (path / BEST, path / FINAL):
+            if (sub / MODEL_FILE).is_file():
+                directory = sub
+                break
+        else:
+            directory = latest_model_dir(path)
+            if directory is None:
+                raise UserError(f"run directory {path} holds no saved model yet")
+        model = directory / MODEL_FILE
+    else:
+        raise UserError(
+            f"no PPO model at {path}: expected a .zip file, a directory with {MODEL_FILE}, "
+            f"or a run directory with {BEST}/, {FINAL}/ or {CHECKPOINTS}/"
+        )
+    vecnorm = directory / VECNORM_FILE
+    config = directory / CONFIG_FILE
+    return ModelFiles(
+        directory=directory,
+        model=model,
+        vec_normalize=vecnorm if vecnorm.is_file() else None,
+        config=config if config.is_file() else None,
+    )

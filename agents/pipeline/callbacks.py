@@ -1,0 +1,141 @@
+"""SB3 callbacks: episode statistics to TensorBoard, checkpoints, best model with its stats.
+
+TensorBoard tags written besides SB3's own (``rollout/``, ``train/``, ``eval/``, ``time/``):
+
+| tag | meaning (mean over the episodes finished since the last log) |
+|---|---|
+| ``hexapod/fasm_min_deg``, ``hexapod/fasm_mean_deg`` | per-episode min / mean FASM [deg] |
+| ``hexapod/time_below_xi_s`` | per-episode time with FASM < ξ_f = 20° [s] |
+| ``hexapod/success_rate``, ``hexapod/tip_over_rate`` | fraction of episodes |
+| ``hexapod/distance_m``, ``hexapod/energy_j`` | when the env reports them |
+| ``hexapod/<metric>`` | numeric env-specific episode metrics (see `episode`) |
+| ``reward_terms/reward_<term>`` | per-episode sum of each reward term from ``info`` |
+| ``eval/fasm_min_deg`` ... | the same FASM/success statistics over EvalCallback's episodes |
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any
+
+from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
+
+from .artifacts import BEST, checkpoint_dir, save_model_dir
+from .episode import EpisodeAccumulator, EpisodeRecord, MetricSpec
+
+
+def record_episode(logger: Any, prefix: str, record: EpisodeRecord) -> None:
+    """Add one episode's statistics to the logger's running means under `prefix`/."""
+    values = {
+        "fasm_min_deg": record.fasm_min_deg,
+        "fasm_mean_deg": record.fasm_mean_deg,
+        "time_below_xi_s": record.time_below_xi_s,
+        "success_rate": None if record.success is None else float(record.success),
+        "tip_over_rate": float(record.tipped_over),
+        "distance_m": record.distance_m,
+        "energy_j": record.energy_j,
+    }
+    for name, value in record.specifics.items():
+        if isinstance(value, int | float) and name not in values:
+            values[name] = float(value)
+    for name, value in values.items():
+        if value is not None:
+            logger.record_mean(f"{prefix}/{name}", value)
+    if prefix == "hexapod":
+        for term, total in record.reward_terms.items():
+            logger.record_mean(f"reward_terms/reward_{term}", total)
+
+
+class EpisodeStatsCallback(BaseCallback):
+    """Accumulates every training env's info dicts and logs each finished episode."""
+
+    def __init__(self, dt: float | None, specs: list[MetricSpec]):
+        super().__init__()
+        self.dt, self.specs = dt, specs
+        self.accumulators: list[EpisodeAccumulator] = []
+
+    def _on_training_start(self) -> None:
+        self.accumulators = [
+            EpisodeAccumulator(self.dt, self.specs) for _ in range(self.training_env.num_envs)
+        ]
+
+    def _on_step(self) -> bool:
+        infos, dones = self.locals["infos"], self.locals["dones"]
+        rewards = self.locals["rewards"]  # VecNormalize-scaled; only the info terms are logged
+        for acc, info, done, reward in zip(self.accumulators, infos, dones, rewards, strict=True):
+            acc.add(reward, info)
+            if done:
+                truncated = bool(info.get("TimeLimit.truncated", False))
+                record_episode(self.logger, "hexapod", acc.finish(not truncated, truncated))
+        return True
+
+
+class ModelSaver:
+    """Saves model directories of one run (model, VecNormalize stats, config, command, meta)."""
+
+    def __init__(self, run_dir: Path, config: Any, command: str):
+        self.run_dir, self.config, self.command = Path(run_dir), config, command
+
+    def save(self, model: Any, kind: str, path: Path | None = None, **meta: Any) -> Path:
+        if path is None:
+            path = checkpoint_dir(self.run_dir, model.num_timesteps)
+        return save_model_dir(
+            path, model, model.get_vec_normalize_env(), self.config, self.command, kind, meta
+        )
+
+
+class CheckpointEvery(BaseCallback):
+    """Saves a checkpoint each time num_timesteps passes a multiple of `freq` (resume-safe)."""
+
+    def __init__(self, freq: int, saver: ModelSaver):
+        super().__init__()
+        self.freq, self.saver = freq, saver
+        self._next = 0
+
+    def _on_training_start(self) -> None:
+        self._next = (self.num_timesteps // self.freq + 1) * self.freq
+
+    def _on_step(self) -> bool:
+        if self.num_timesteps >= self._next:
+            self.saver.save(self.model, "checkpoint")
+            self._next = (self.num_timesteps // self.freq + 1) * self.freq
+        return True
+
+
+class SaveBest(BaseCallback):
+    """EvalCallback's ``callback_on_new_best``: writes ``best/`` with the eval reward in meta."""
+
+    def __init__(self, saver: ModelSaver):
+        super().__init__()
+        self.saver = saver
+
+    def _on_step(self) -> bool:
+        reward = float(self.parent.best_mean_reward)
+        self.saver.save(self.model, "best", self.saver.run_dir / BEST, eval_mean_reward=reward)
+        return True
+
+
+class StatsEvalCallback(EvalCallback):
+    """EvalCallback that also logs FASM/success statistics of its evaluation episodes."""
+
+    def __init__(self, *args: Any, dt: float | None, specs: list[MetricSpec], **kwargs: Any):
+        super().__init__(*args, **kwargs)
+        self._make_accumulators: Callable[[], EpisodeAccumulator] = lambda: EpisodeAccumulator(
+            dt, specs
+        )
+        self._accumulators: dict[int, EpisodeAccumulator] = {}
+
+    def _on_step(self) -> bool:
+        self._accumulators = {}
+        return super()._on_step()
+
+    def _log_success_callback(self, locals_: dict[str, Any], globals_: dict[str, Any]) -> None:
+        super()._log_success_callback(locals_, globals_)
+        i = locals_["i"]
+        acc = self._accumulators.setdefault(i, self._make_accumulators())
+        info = locals_["info"]
+        acc.add(locals_["reward"], info)
+        if locals_["done"]:
+            truncated = bool(info.get("TimeLimit.truncated", False))
+            record_episode(self.logger, "eval", acc.finish(not truncated, truncated))

@@ -1,0 +1,180 @@
+"""Command-line front ends of `train.py` and `evaluate.py` (argument parsing and error reporting).
+
+User errors (`UserError`: bad config keys, unknown env ids, missing models, existing output
+directories) are printed on stderr as one ``<prog>: error: ...`` line and exit with code 2;
+Ctrl-C during training saves a checkpoint and exits with 130.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+from .errors import UserError
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+DEFAULT_SUITE = REPO_ROOT / "configs" / "evaluate_default.yaml"
+
+
+def _run(prog: str, body: Callable[[], int]) -> int:
+    try:
+        return body()
+    except UserError as exc:
+        print(f"{prog}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+# --- train.py ------------------------------------------------------------------------------
+def train_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="train.py",
+        description="Train PPO (stable-baselines3) on an env from a YAML config.",
+        epilog="examples:\n"
+        "  python train.py --config configs/cliff_walk_ppo.yaml\n"
+        "  python train.py --config configs/cliff_walk_ppo.yaml --set ppo.learning_rate=1e-4 "
+        "--set vec_env.n_envs=2\n"
+        "  python train.py --resume runs/HexapodCliffWalk-v0__ppo__0__20250101-120000 "
+        "--set train.total_timesteps=2000000",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    source = p.add_mutually_exclusive_group(required=True)
+    source.add_argument("--config", type=Path, help="training config (YAML)")
+    source.add_argument(
+        "--resume", type=Path, metavar="RUN_DIR", help="continue a run from its last checkpoint"
+    )
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a config key (dotted path, value read as YAML); repeatable",
+    )
+    p.add_argument("--output-dir", type=Path, default=Path("runs"), help="parent of run dirs")
+    p.add_argument("--run-name", help="run directory name (default {env}__ppo__{seed}__{time})")
+    p.add_argument("--force", action="store_true", help="overwrite an existing run directory")
+    return p
+
+
+def train_main(argv: Sequence[str] | None = None) -> int:
+    args = train_parser().parse_args(argv)
+    command = _command("train.py", argv)
+
+    def body() -> int:
+        from .train_config import load_train_config
+        from .training import resume_training, start_training
+
+        if args.resume is not None:
+            if args.run_name or args.force:
+                raise UserError("--run-name and --force do not apply to --resume")
+            result = resume_training(args.resume, args.overrides, command=command)
+        else:
+            config = load_train_config(args.config, args.overrides)
+            result = start_training(
+                config, args.output_dir, args.run_name, force=args.force, command=command
+            )
+        rate = result.steps_per_second
+        if result.interrupted:
+            print(
+                f"interrupted at {result.num_timesteps} steps; checkpoint saved to "
+                f"{result.saved_to}\nresume with: python train.py --resume {result.run_dir}",
+                file=sys.stderr,
+            )
+            return 130
+        print(
+            f"trained {result.steps_this_call} steps in {result.seconds:.1f} s "
+            f"({rate:.0f} steps/s), {result.num_timesteps} in total\n"
+            f"run directory: {result.run_dir}\nfinal model: {result.saved_to}"
+        )
+        return 0
+
+    return _run("train.py", body)
+
+
+def _command(script: str, argv: Sequence[str] | None) -> str:
+    from .artifacts import command_line
+
+    return command_line(sys.argv if argv is None else [script, *argv])
+
+
+# --- evaluate.py ---------------------------------------------------------------------------
+def evaluate_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(
+        prog="evaluate.py",
+        description="Run policies (analytical, ppo:<path>, zero, random) on envs over fixed seeds "
+        "and write metrics.json, report.md and report.html. Without arguments runs "
+        "configs/evaluate_default.yaml.",
+        epilog="examples:\n"
+        "  python evaluate.py\n"
+        "  python evaluate.py --envs HexapodCliffWalk-v0 --policies analytical zero "
+        "ppo:runs/HexapodCliffWalk-v0__ppo__0__20250101-120000 --episodes 3 "
+        "--output-dir reports/mine\n"
+        "  python evaluate.py --config configs/evaluate_default.yaml --set episodes=10 --force",
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("--config", type=Path, help="evaluation suite (YAML)")
+    p.add_argument("--envs", nargs="+", metavar="ENV_ID", help="env ids (replaces the suite's)")
+    p.add_argument(
+        "--policies",
+        nargs="+",
+        metavar="POLICY",
+        help="analytical | ppo:<model file, model dir or run dir> | zero | random",
+    )
+    p.add_argument("--episodes", type=int, help="episodes per policy and env")
+    p.add_argument("--seed", type=int, help="seed of the first episode (episode k: seed + k)")
+    p.add_argument("--max-episode-steps", type=int, help="override every env's time limit")
+    p.add_argument("--output-dir", type=Path, help="report directory")
+    p.add_argument("--frames", action="store_true", help="add a frame strip per policy (EGL)")
+    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help="override a suite key (dotted path, value read as YAML); repeatable",
+    )
+    p.add_argument("--force", action="store_true", help="overwrite an existing report directory")
+    return p
+
+
+def evaluate_main(argv: Sequence[str] | None = None) -> int:
+    args = evaluate_parser().parse_args(argv)
+
+    def body() -> int:
+        from .eval_config import load_suite
+        from .evaluation import run_suite
+        from .report import write_report
+
+        overrides = list(args.overrides)
+        for key, value in (
+            ("envs", args.envs),
+            ("policies", args.policies),
+            ("episodes", args.episodes),
+            ("seed", args.seed),
+            ("max_episode_steps", args.max_episode_steps),
+            ("output_dir", None if args.output_dir is None else str(args.output_dir)),
+        ):
+            if value is not None:
+                overrides.append(f"{key}={json.dumps(value)}")  # JSON is YAML
+        if args.frames:
+            overrides.append("frames=true")
+        suite = load_suite(args.config or DEFAULT_SUITE, overrides)
+        out = _prepare_report_dir(Path(suite.output_dir), args.force)
+        result = run_suite(suite, progress=not args.no_progress)
+        paths = write_report(result, out)
+        for line in result.warnings:
+            print(f"warning: {line}", file=sys.stderr)
+        print("wrote " + ", ".join(str(p) for p in paths))
+        return 0
+
+    return _run("evaluate.py", body)
+
+
+def _prepare_report_dir(path: Path, force: bool) -> Path:
+    from .artifacts import prepare_new_dir
+
+    return prepare_new_dir(path, force, "report directory")

@@ -1,0 +1,105 @@
+"""Env ids, env creation with clear errors, and SB3 vec-env building (Monitor, VecNormalize)."""
+
+from __future__ import annotations
+
+import difflib
+import importlib
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import gymnasium as gym
+
+from .errors import UserError
+
+
+def import_gym_packages(packages: Sequence[str]) -> None:
+    """Import the modules that register env ids (e.g. ``hexapod_envs``), by name."""
+    for name in packages:
+        try:
+            importlib.import_module(name)
+        except ImportError as exc:
+            raise UserError(f"cannot import gym package {name!r}: {exc}") from None
+
+
+def registered_ids(prefix: str = "Hexapod") -> list[str]:
+    return sorted(k for k in gym.registry if k.startswith(prefix))
+
+
+def check_env_id(env_id: str, packages: Sequence[str] = ()) -> None:
+    """UserError for an unregistered id, listing the registered Hexapod ids (and a close match)."""
+    import_gym_packages(packages)
+    if env_id in gym.registry:
+        return
+    hexapod = registered_ids()
+    close = difflib.get_close_matches(env_id, list(gym.registry), n=1)
+    hint = f" (did you mean {close[0]!r}?)" if close else ""
+    raise UserError(
+        f"unknown env id {env_id!r}{hint}; registered Hexapod env ids: "
+        f"{', '.join(hexapod) if hexapod else '(none)'}"
+    )
+
+
+def env_time_step(env: gym.Env) -> float | None:
+    """Seconds per env step: ``control_dt`` of the hexapod envs, ``dt`` of Gymnasium MuJoCo."""
+    for name in ("control_dt", "dt"):
+        try:
+            value = env.get_wrapper_attr(name)
+        except AttributeError:
+            continue
+        if isinstance(value, int | float):
+            return float(value)
+    return None
+
+
+@dataclass
+class EnvSpec:
+    """An env id with its keyword arguments: everything needed to build identical copies."""
+
+    id: str
+    kwargs: dict[str, Any] = field(default_factory=dict)
+    max_episode_steps: int | None = None
+    gym_packages: list[str] = field(default_factory=list)
+
+    def make(self, **extra: Any) -> gym.Env:
+        """gym.make with the env's own errors (bad kwargs) turned into a UserError."""
+        check_env_id(self.id, self.gym_packages)
+        kwargs = {**self.kwargs, **extra}
+        if self.max_episode_steps is not None:
+            kwargs["max_episode_steps"] = self.max_episode_steps
+        try:
+            return gym.make(self.id, **kwargs)
+        except (TypeError, ValueError) as exc:
+            raise UserError(f"cannot create {self.id} with {self.kwargs}: {exc}") from None
+
+
+class EnvFactory:
+    """Picklable env constructor for SB3 vec envs (runs in subprocess workers too)."""
+
+    def __init__(self, spec: EnvSpec):
+        self.spec = spec
+
+    def __call__(self) -> gym.Env:
+        from stable_baselines3.common.monitor import Monitor
+
+        return Monitor(self.spec.make())
+
+
+def make_vec_env(
+    spec: EnvSpec,
+    n_envs: int,
+    seed: int,
+    subprocess: bool,
+    start_method: str | None = None,
+):
+    """A DummyVecEnv/SubprocVecEnv of `n_envs` monitored copies of `spec`, seeded seed..seed+n-1."""
+    from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
+
+    spec.make().close()  # fail here, in the main process, with a clear error
+    factories = [EnvFactory(spec) for _ in range(n_envs)]
+    if subprocess:
+        venv = SubprocVecEnv(factories, start_method=start_method)
+    else:
+        venv = DummyVecEnv(factories)
+    venv.seed(seed)
+    return venv

@@ -1,0 +1,100 @@
+"""The evaluation suite (``configs/evaluate*.yaml``) as typed dataclasses.
+
+Policies are strings: ``analytical`` (the env's reference controller from
+`agents.registry`), ``ppo:<path>`` (model file, model directory or run directory; ``{env_id}`` in
+the path is replaced by each env's id, e.g. ``ppo:models/{env_id}``), ``zero`` and ``random``.
+Episode ``k`` of every policy uses seed ``seed + k``: identical seeds, hence identical terrain
+and initial states, for every policy.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from .configtools import apply_overrides, from_mapping, load_yaml
+from .errors import ConfigError
+from .train_config import DEFAULT_GYM_PACKAGES
+
+SIMPLE_POLICIES = ("analytical", "zero", "random")
+PPO_PREFIX = "ppo:"
+
+
+@dataclass
+class SuiteEnv:
+    id: str
+    kwargs: dict[str, Any] = field(default_factory=dict)
+    max_episode_steps: int | None = None  # None: the registered limit
+
+
+def _parse_envs(value: Any, where: str) -> list[SuiteEnv]:
+    """A list of env ids or of ``{id, kwargs, max_episode_steps}`` mappings."""
+    if not isinstance(value, list) or not value:
+        raise ConfigError(f"{where}: expected a non-empty list of env ids or mappings")
+    envs = []
+    for i, item in enumerate(value):
+        if isinstance(item, str):
+            item = {"id": item}
+        envs.append(from_mapping(SuiteEnv, item, f"{where}[{i}]"))
+    return envs
+
+
+def check_policy_name(name: str, where: str = "policies") -> str:
+    if name in SIMPLE_POLICIES or (name.startswith(PPO_PREFIX) and len(name) > len(PPO_PREFIX)):
+        return name
+    raise ConfigError(
+        f"{where}: unknown policy {name!r}; valid: {', '.join(SIMPLE_POLICIES)}, ppo:<path>"
+    )
+
+
+def _parse_policies(value: Any, where: str) -> list[str]:
+    if not isinstance(value, list) or not value:
+        raise ConfigError(f"{where}: expected a non-empty list of policy names")
+    names = [check_policy_name(str(v), f"{where}[{i}]") for i, v in enumerate(value)]
+    if len(set(names)) != len(names):
+        raise ConfigError(f"{where}: duplicate policy names in {names}")
+    return names
+
+
+@dataclass
+class EvaluationSuite:
+    envs: list[SuiteEnv] = field(metadata={"parse": _parse_envs})
+    policies: list[str] = field(
+        default_factory=lambda: ["analytical"], metadata={"parse": _parse_policies}
+    )
+    episodes: int = 5
+    seed: int = 0
+    max_episode_steps: int | None = None  # set: overrides every env's time limit (smoke runs)
+    output_dir: str = "reports/evaluation"
+    missing_models: Literal["error", "skip"] = "error"
+    # skip: a ppo:<path> that does not exist is left out with a warning line in the report
+    deterministic: bool = True  # PPO actions: the mean (true) or sampled
+    frames: bool = False  # frame strip per policy (rendered with MUJOCO_GL=egl)
+    frame_count: int = 6
+    frame_size: list[int] = field(default_factory=lambda: [320, 240])
+    xi_f_deg: float = 20.0
+    gym_packages: list[str] = field(default_factory=lambda: list(DEFAULT_GYM_PACKAGES))
+    title: str = "Hexapod policy evaluation"
+
+    def __post_init__(self):
+        if self.episodes < 1:
+            raise ValueError(f"episodes must be >= 1, got {self.episodes}")
+        if self.frame_count < 1 or len(self.frame_size) != 2:
+            raise ValueError("frame_count must be >= 1 and frame_size [width, height]")
+
+    @property
+    def seeds(self) -> list[int]:
+        return [self.seed + k for k in range(self.episodes)]
+
+    def env_time_limit(self, env: SuiteEnv) -> int | None:
+        """The suite-wide limit if set, else the env's own, else None (registered limit)."""
+        return (
+            self.max_episode_steps
+            if self.max_episode_steps is not None
+            else (env.max_episode_steps)
+        )
+
+
+def load_suite(path: str | Path, overrides: list[str] | tuple[str, ...] = ()) -> EvaluationSuite:
+    return from_mapping(EvaluationSuite, apply_overrides(load_yaml(path), list(overrides)))

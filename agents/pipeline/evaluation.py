@@ -1,0 +1,267 @@
+"""Run a suite: every policy on every env for the same seeds; collect per-episode records.
+
+Everything the suite names is checked before the first episode runs (unknown env ids, bad env
+kwargs, missing or mismatched models), so a typo fails in seconds with one clear message.
+"""
+
+from __future__ import annotations
+
+import inspect
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from ..policy import Policy, RandomPolicy, ZeroPolicy
+from .envs import EnvSpec, check_env_id, env_time_step, import_gym_packages
+from .episode import EpisodeAccumulator, EpisodeRecord, MetricSpec, metric_specs
+from .errors import UserError
+from .eval_config import PPO_PREFIX, EvaluationSuite, SuiteEnv
+
+
+class EpisodeSeededRandomPolicy(RandomPolicy):
+    """Uniform random actions, reseeded from each episode's seed (reproducible per episode)."""
+
+    def seed_episode(self, seed: int) -> None:
+        self.seed = seed
+
+
+@dataclass
+class PolicyRun:
+    """One policy on one env: its episodes (same seeds as every other policy)."""
+
+    name: str
+    source: str
+    episodes: list[EpisodeRecord] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    frames: list[np.ndarray] | None = None
+
+
+@dataclass
+class EnvResult:
+    env_id: str
+    kwargs: dict[str, Any]
+    max_episode_steps: int | None
+    dt: float | None
+    specs: list[MetricSpec]
+    runs: dict[str, PolicyRun] = field(default_factory=dict)
+
+
+@dataclass
+class SuiteResult:
+    suite: EvaluationSuite
+    envs: list[EnvResult]
+    warnings: list[str]
+    seconds: float
+
+
+def run_episode(
+    env: gym.Env,
+    policy: Policy,
+    seed: int,
+    accumulator: EpisodeAccumulator,
+    on_step: Any = None,
+) -> EpisodeRecord:
+    """One episode from ``reset(seed=seed)`` until terminated or truncated."""
+    seed_episode = getattr(policy, "seed_episode", None)
+    if seed_episode is not None:
+        seed_episode(seed)
+    policy.reset()
+    accumulator.reset()
+    obs, _ = env.reset(seed=seed)
+    if on_step is not None:
+        on_step(0)
+    step = 0
+    while True:
+        obs, reward, terminated, truncated, info = env.step(policy(obs))
+        step += 1
+        accumulator.add(reward, info)
+        if on_step is not None:
+            on_step(step)
+        if terminated or truncated:
+            return accumulator.finish(terminated, truncated)
+
+
+def _env_spec(suite: EvaluationSuite, env: SuiteEnv, **extra: Any) -> EnvSpec:
+    return EnvSpec(env.id, {**env.kwargs, **extra}, suite.env_time_limit(env), suite.gym_packages)
+
+
+def _ppo_path(name: str, env_id: str) -> Path:
+    return Path(name[len(PPO_PREFIX) :].replace("{env_id}", env_id))
+
+
+def build_policy(
+    name: str, env: gym.Env, env_id: str, suite: EvaluationSuite
+) -> tuple[Policy, str]:
+    """(policy, where it comes from) for a policy name of the suite."""
+    if name == "zero":
+        return ZeroPolicy(env.action_space), "zero action"
+    if name == "random":
+        return EpisodeSeededRandomPolicy(env.action_space), "uniform random actions"
+    if name == "analytical":
+        from ..registry import ANALYTICAL_POLICIES, analytical_factory
+
+        try:
+            factory = analytical_factory(env_id)
+        except ValueError as exc:
+            raise UserError(str(exc)) from None
+        entry = ANALYTICAL_POLICIES[env_id]
+        source = entry if isinstance(entry, str) else getattr(entry, "__qualname__", repr(entry))
+        return factory(env), str(source)
+    from ..ppo import PPOPolicy
+
+    path = _ppo_path(name, env_id)
+    policy = PPOPolicy.load(path, env, deterministic=suite.deterministic)
+    return policy, str(policy.files.model)
+
+
+def _check_env_ids(suite: EvaluationSuite) -> None:
+    import_gym_packages(suite.gym_packages)
+    unknown = [e.id for e in suite.envs if e.id not in gym.registry]
+    if len(unknown) == 1:
+        check_env_id(unknown[0])
+    if unknown:
+        from .envs import registered_ids
+
+        raise UserError(
+            f"unknown env ids {unknown}; registered Hexapod env ids: "
+            f"{', '.join(registered_ids()) or '(none)'}"
+        )
+
+
+def _constructor_defaults(env: gym.Env) -> dict[str, Any]:
+    """Keyword defaults of the env class's constructors along its MRO, plus registered kwargs."""
+    defaults: dict[str, Any] = {}
+    for klass in reversed(type(env.unwrapped).__mro__):
+        init = klass.__dict__.get("__init__")
+        if init is None:
+            continue
+        try:
+            params = inspect.signature(init).parameters.values()
+        except (TypeError, ValueError):
+            continue
+        defaults.update({p.name: p.default for p in params if p.default is not p.empty})
+    if env.spec is not None and env.spec.id in gym.registry:
+        defaults.update(gym.spec(env.spec.id).kwargs)
+    return defaults
+
+
+def _kwargs_note(
+    env: gym.Env, suite_env: SuiteEnv, name: str, trained: dict[str, Any] | None
+) -> str | None:
+    """A warning when a model was trained with env kwargs (defaults filled in) other than these."""
+    if trained is None:
+        return None
+    defaults = _constructor_defaults(env)
+    evaluated = suite_env.kwargs
+    differing = {}
+    for key in sorted(set(trained) | set(evaluated)):
+        a = trained.get(key, defaults.get(key))
+        b = evaluated.get(key, defaults.get(key))
+        if a != b:
+            differing[key] = (a, b)
+    if not differing:
+        return None
+    return (
+        f"{suite_env.id}: {name} was trained with other env kwargs than evaluated here "
+        "(key: trained -> evaluated): "
+        + ", ".join(f"{k}: {a!r} -> {b!r}" for k, (a, b) in differing.items())
+    )
+
+
+def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, gym.Env, dict]], list[str]]:
+    """Make every env and policy (all checks happen here); returns them and warning lines."""
+    _check_env_ids(suite)
+    warnings: list[str] = []
+    prepared = []
+    for suite_env in suite.envs:
+        env = _env_spec(suite, suite_env).make()
+        result = EnvResult(
+            env_id=suite_env.id,
+            kwargs=dict(suite_env.kwargs),
+            max_episode_steps=env.spec.max_episode_steps if env.spec else None,
+            dt=env_time_step(env),
+            specs=metric_specs(env),
+        )
+        policies = {}
+        for name in suite.policies:
+            if name.startswith(PPO_PREFIX) and suite.missing_models == "skip":
+                path = _ppo_path(name, suite_env.id)
+                if not path.exists():
+                    warnings.append(
+                        f"{suite_env.id}: skipped {name} - no model at {path} "
+                        "(train one and copy its model directory there)"
+                    )
+                    continue
+            policy, source = build_policy(name, env, suite_env.id, suite)
+            run = PolicyRun(name=name, source=source)
+            note = _kwargs_note(env, suite_env, name, getattr(policy, "train_env_kwargs", None))
+            if note:
+                run.notes.append(note)
+                warnings.append(note)
+            policies[name] = (policy, run)
+        result.runs = {name: run for name, (_, run) in policies.items()}
+        prepared.append((result, env, {n: p for n, (p, _) in policies.items()}))
+    return prepared, warnings
+
+
+def run_suite(suite: EvaluationSuite, progress: bool = True) -> SuiteResult:
+    from tqdm.auto import tqdm
+
+    start = time.perf_counter()
+    prepared, warnings = prepare(suite)
+    total = sum(len(policies) for _, _, policies in prepared) * suite.episodes
+    bar = tqdm(total=total, disable=not progress, unit="episode", dynamic_ncols=True)
+    try:
+        for result, env, policies in prepared:
+            for name, policy in policies.items():
+                bar.set_description(f"{result.env_id} {name}")
+                run = result.runs[name]
+                for k, seed in enumerate(suite.seeds):
+                    acc = EpisodeAccumulator(
+                        result.dt, result.specs, keep_trace=k == 0, xi_f_deg=suite.xi_f_deg
+                    )
+                    run.episodes.append(run_episode(env, policy, seed, acc))
+                    bar.update(1)
+            env.close()
+            if suite.frames:
+                warnings.extend(_render_frames(suite, result, policies))
+    finally:
+        bar.close()
+    return SuiteResult(suite, [r for r, _, _ in prepared], warnings, time.perf_counter() - start)
+
+
+def _render_frames(suite: EvaluationSuite, result: EnvResult, policies: dict) -> list[str]:
+    """Re-run the first seed of each policy with rendering; keep `frame_count` frames."""
+    width, height = suite.frame_size
+    suite_env = next(e for e in suite.envs if e.id == result.env_id)
+    try:
+        sized = _env_spec(suite, suite_env, render_mode="rgb_array", width=width, height=height)
+        env = sized.make()
+    except UserError:  # envs without width/height keywords
+        env = _env_spec(suite, suite_env, render_mode="rgb_array").make()
+    warnings = []
+    try:
+        for name, policy in policies.items():
+            run = result.runs[name]
+            length = run.episodes[0].length
+            wanted = set(np.linspace(0, length, suite.frame_count).round().astype(int).tolist())
+            frames: list[np.ndarray] = []
+
+            def grab(step: int, wanted=wanted, frames=frames) -> None:
+                if step in wanted:
+                    frames.append(np.asarray(env.render()))
+
+            acc = EpisodeAccumulator(result.dt, result.specs)
+            try:
+                run_episode(env, policy, suite.seeds[0], acc, on_step=grab)
+            except Exception as exc:  # rendering back ends fail in many ways (no EGL, ...)
+                warnings.append(f"{result.env_id} {name}: no frames ({type(exc).__name__}: {exc})")
+                return warnings
+            run.frames = frames
+    finally:
+        env.close()
+    return warnings

@@ -1,0 +1,147 @@
+"""Aggregates over episodes (mean ± std, median, min/max) and PPO-vs-analytical verdicts."""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .episode import EpisodeRecord, MetricSpec
+
+STANDARD_METRICS: dict[str, tuple[str, str, str | None]] = {
+    # key: (label, unit, better)
+    "success": ("success rate", "", "higher"),
+    "tipped_over": ("tip-over rate", "", "lower"),
+    "fasm_min_deg": ("min FASM", "deg", "higher"),
+    "fasm_mean_deg": ("mean FASM", "deg", "higher"),
+    "time_below_xi_s": ("time below ξ_f", "s", "lower"),
+    "distance_m": ("distance", "m", "higher"),
+    "energy_j": ("energy", "J", "lower"),
+    "episode_length": ("episode length", "steps", None),
+    "episode_return": ("return", "", "higher"),
+}
+
+
+TIE_TOLERANCE = 0.01
+"""Relative difference below which two policies count as equal on a metric (1 %)."""
+
+
+def summarize(values: Iterable[Any]) -> dict[str, float] | None:
+    """{n, mean, std, median, min, max} of the numeric values (None/NaN skipped; bools as 0/1)."""
+    xs = [float(v) for v in values if v is not None and not _is_nan(v)]
+    if not xs:
+        return None
+    a = np.asarray(xs)
+    return {
+        "n": len(xs),
+        "mean": float(a.mean()),
+        "std": float(a.std()),
+        "median": float(np.median(a)),
+        "min": float(a.min()),
+        "max": float(a.max()),
+    }
+
+
+def _is_nan(v: Any) -> bool:
+    return isinstance(v, float) and math.isnan(v)
+
+
+def _kind(values: list[Any]) -> str:
+    present = [v for v in values if v is not None]
+    if not present:
+        return "empty"
+    if all(isinstance(v, list) for v in present):
+        return "list"
+    if all(isinstance(v, bool | int | float) for v in present):
+        return "number"
+    return "category"
+
+
+def aggregate(records: list[EpisodeRecord]) -> dict[str, Any]:
+    """Per-policy aggregate: standard metrics, reward term sums, env-specific metrics."""
+    out: dict[str, Any] = {"episodes": len(records)}
+    scalars = [r.scalar_metrics() for r in records]
+    for key in scalars[0] if scalars else []:
+        out[key] = summarize(s.get(key) for s in scalars)
+    out["tip_overs"] = sum(r.tipped_over for r in records)
+    specifics: dict[str, Any] = {}
+    names = sorted({k for r in records for k in r.specifics})
+    for name in names:
+        values = [r.specifics.get(name) for r in records]
+        kind = _kind(values)
+        if kind == "number":
+            specifics[name] = {"kind": kind, **(summarize(values) or {})}
+        elif kind == "list":
+            pooled = [x for v in values if v for x in v if isinstance(x, int | float)]
+            specifics[name] = {"kind": kind, "pooled": True, **(summarize(pooled) or {})}
+        elif kind == "category":
+            counts = Counter("None" if v is None else str(v) for v in values)
+            specifics[name] = {"kind": kind, "counts": dict(counts.most_common())}
+    out["specifics"] = specifics
+    return out
+
+
+@dataclass
+class Verdict:
+    metric: str
+    label: str
+    better: str
+    challenger: str
+    baseline: str
+    challenger_value: float
+    baseline_value: float
+    outcome: str  # "better", "worse" or "tie"
+    within_spread: bool
+
+    def to_json(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+def _central(summary: dict[str, Any] | None, use_median: bool) -> float | None:
+    if not summary or "mean" not in summary:
+        return None
+    return summary["median"] if use_median else summary["mean"]
+
+
+def compare(
+    challenger: str,
+    baseline: str,
+    aggregates: dict[str, dict[str, Any]],
+    specs: list[MetricSpec],
+) -> list[Verdict]:
+    """Metric-by-metric verdicts of `challenger` against `baseline` (means; medians for pooled
+    per-cycle lists). Differences up to `TIE_TOLERANCE` of the larger magnitude are ties; a
+    difference smaller than the larger of the two standard deviations is flagged
+    ``within_spread``."""
+    a, b = aggregates[challenger], aggregates[baseline]
+    rows: list[tuple[str, str, str, dict | None, dict | None, bool]] = []
+    for key, (label, _, better) in STANDARD_METRICS.items():
+        if better is not None:
+            rows.append((key, label, better, a.get(key), b.get(key), False))
+    for spec in specs:
+        if spec.better is None:
+            continue
+        sa, sb = a["specifics"].get(spec.name), b["specifics"].get(spec.name)
+        pooled = bool(sa and sa.get("pooled")) or bool(sb and sb.get("pooled"))
+        rows.append((spec.name, spec.name, spec.better, sa, sb, pooled))
+    verdicts = []
+    for key, label, better, sa, sb, pooled in rows:
+        va, vb = _central(sa, pooled), _central(sb, pooled)
+        if va is None or vb is None:
+            continue
+        diff = va - vb
+        if abs(diff) <= TIE_TOLERANCE * max(abs(va), abs(vb)):
+            outcome = "tie"
+        elif (diff > 0) == (better == "higher"):
+            outcome = "better"
+        else:
+            outcome = "worse"
+        spread = max(sa.get("std", 0.0), sb.get("std", 0.0))
+        verdicts.append(
+            Verdict(key, label, better, challenger, baseline, va, vb, outcome, abs(diff) < spread)
+        )
+    return verdicts

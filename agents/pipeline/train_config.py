@@ -1,0 +1,200 @@
+"""The training config (``configs/<env>_ppo.yaml``) as typed dataclasses.
+
+Every level rejects unknown keys (listing the valid ones); see `configtools`. Frequencies are in
+environment steps summed over all parallel envs (the unit of ``total_timesteps``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from .configtools import apply_overrides, from_mapping, load_yaml
+from .errors import ConfigError
+from .schedules import Schedule, parse_optional_schedule, parse_schedule
+
+DEFAULT_GYM_PACKAGES = ["hexapod_envs"]
+
+
+@dataclass
+class EnvConfig:
+    """Which env to train on and how to build it."""
+
+    id: str
+    kwargs: dict[str, Any] = field(default_factory=dict)
+    max_episode_steps: int | None = None  # None: the registered time limit
+    gym_packages: list[str] = field(default_factory=lambda: list(DEFAULT_GYM_PACKAGES))
+    # modules imported (by name) before gym.make so that their env ids are registered
+
+
+@dataclass
+class VecEnvConfig:
+    n_envs: int = 1
+    type: Literal["auto", "subprocess", "dummy"] = "auto"  # auto: subprocess when n_envs > 1
+    start_method: Literal["forkserver", "spawn", "fork"] | None = None  # None: SB3's default
+
+    def __post_init__(self):
+        if self.n_envs < 1:
+            raise ValueError(f"vec_env.n_envs must be >= 1, got {self.n_envs}")
+
+    @property
+    def use_subprocess(self) -> bool:
+        return self.type == "subprocess" or (self.type == "auto" and self.n_envs > 1)
+
+
+@dataclass
+class NormalizeConfig:
+    """VecNormalize: running mean/std of observations and of the discounted return."""
+
+    observation: bool = True
+    reward: bool = True
+    clip_observation: float = 10.0
+    clip_reward: float = 10.0
+
+
+ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu", "gelu", "silu")
+
+
+@dataclass
+class PolicyConfig:
+    """SB3 MlpPolicy: separate actor (pi) and critic (vf) networks."""
+
+    pi: list[int] = field(default_factory=lambda: [256, 256])
+    vf: list[int] = field(default_factory=lambda: [256, 256])
+    activation: Literal["tanh", "relu", "elu", "leaky_relu", "gelu", "silu"] = "tanh"
+    log_std_init: float = 0.0
+    ortho_init: bool = True
+
+    def policy_kwargs(self) -> dict[str, Any]:
+        from torch import nn
+
+        activation = {
+            "tanh": nn.Tanh,
+            "relu": nn.ReLU,
+            "elu": nn.ELU,
+            "leaky_relu": nn.LeakyReLU,
+            "gelu": nn.GELU,
+            "silu": nn.SiLU,
+        }[self.activation]
+        return {
+            "net_arch": {"pi": list(self.pi), "vf": list(self.vf)},
+            "activation_fn": activation,
+            "log_std_init": self.log_std_init,
+            "ortho_init": self.ortho_init,
+        }
+
+
+@dataclass
+class PPOConfig:
+    """stable-baselines3 PPO hyperparameters (same names); schedules as in `schedules`."""
+
+    learning_rate: Schedule = field(
+        default_factory=lambda: Schedule("constant", 3e-4), metadata={"parse": parse_schedule}
+    )
+    n_steps: int = 2048  # per env, per rollout
+    batch_size: int = 64
+    n_epochs: int = 10
+    gamma: float = 0.99
+    gae_lambda: float = 0.95
+    clip_range: Schedule = field(
+        default_factory=lambda: Schedule("constant", 0.2), metadata={"parse": parse_schedule}
+    )
+    clip_range_vf: Schedule | None = field(
+        default=None, metadata={"parse": parse_optional_schedule}
+    )
+    normalize_advantage: bool = True
+    ent_coef: float = 0.0
+    vf_coef: float = 0.5
+    max_grad_norm: float = 0.5
+    use_sde: bool = False
+    sde_sample_freq: int = -1
+    target_kl: float | None = None
+
+    def sb3_kwargs(self) -> dict[str, Any]:
+        return {
+            "learning_rate": self.learning_rate,
+            "n_steps": self.n_steps,
+            "batch_size": self.batch_size,
+            "n_epochs": self.n_epochs,
+            "gamma": self.gamma,
+            "gae_lambda": self.gae_lambda,
+            "clip_range": self.clip_range,
+            "clip_range_vf": self.clip_range_vf,
+            "normalize_advantage": self.normalize_advantage,
+            "ent_coef": self.ent_coef,
+            "vf_coef": self.vf_coef,
+            "max_grad_norm": self.max_grad_norm,
+            "use_sde": self.use_sde,
+            "sde_sample_freq": self.sde_sample_freq,
+            "target_kl": self.target_kl,
+        }
+
+
+@dataclass
+class TrainingConfig:
+    total_timesteps: int = 1_000_000
+    seed: int = 0
+    device: str = "cpu"
+
+    def __post_init__(self):
+        if self.total_timesteps < 1:
+            raise ValueError(f"train.total_timesteps must be >= 1, got {self.total_timesteps}")
+
+
+@dataclass
+class EvalConfig:
+    """Periodic evaluation (SB3 EvalCallback) that keeps the best model; freq 0 disables it."""
+
+    freq: int = 20_000
+    n_episodes: int = 5
+    deterministic: bool = True
+
+
+@dataclass
+class CheckpointConfig:
+    """Periodic checkpoints (model + VecNormalize); freq 0 keeps only final/interrupt ones."""
+
+    freq: int = 50_000
+
+
+@dataclass
+class LoggingConfig:
+    tensorboard: bool = True
+    progress_bar: bool = True
+    verbose: int = 0  # 1: also print SB3's log table to stdout
+
+
+@dataclass
+class TrainConfig:
+    env: EnvConfig
+    vec_env: VecEnvConfig = field(default_factory=VecEnvConfig)
+    normalize: NormalizeConfig = field(default_factory=NormalizeConfig)
+    policy: PolicyConfig = field(default_factory=PolicyConfig)
+    ppo: PPOConfig = field(default_factory=PPOConfig)
+    train: TrainingConfig = field(default_factory=TrainingConfig)
+    eval: EvalConfig = field(default_factory=EvalConfig)
+    checkpoint: CheckpointConfig = field(default_factory=CheckpointConfig)
+    logging: LoggingConfig = field(default_factory=LoggingConfig)
+
+    def __post_init__(self):
+        rollout = self.ppo.n_steps * self.vec_env.n_envs
+        if rollout < 2:
+            raise ValueError(f"ppo.n_steps x vec_env.n_envs must be > 1, got {rollout}")
+        if self.ppo.batch_size > rollout:
+            raise ValueError(
+                f"ppo.batch_size={self.ppo.batch_size} exceeds the rollout size "
+                f"ppo.n_steps x vec_env.n_envs = {rollout}"
+            )
+
+
+def load_train_config(
+    path: str | Path | None = None,
+    overrides: list[str] | tuple[str, ...] = (),
+    data: dict[str, Any] | None = None,
+) -> TrainConfig:
+    """Read a training config from `path` (or raw `data`), apply ``key=value`` overrides, check."""
+    if (path is None) == (data is None):
+        raise ConfigError("give either a config path or config data")
+    raw = load_yaml(path) if path is not None else data
+    return from_mapping(TrainConfig, apply_overrides(raw, list(overrides)))

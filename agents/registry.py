@@ -1,0 +1,48 @@
+"""Reference (analytical) controller of each env id: ``env id -> factory (env) -> Policy``.
+
+`evaluate.py` runs the policy named ``analytical`` through this table. Add an entry when an env
+gets its controller: the value is ``"module:attribute"`` (imported only when used, so the table
+costs nothing to import) or any callable taking the env and returning a `Policy`.
+"""
+
+from __future__ import annotations
+
+import importlib
+from collections.abc import Callable
+
+import gymnasium as gym
+
+from .policy import Policy
+
+PolicyFactory = Callable[[gym.Env], Policy]
+
+ANALYTICAL_POLICIES: dict[str, str | PolicyFactory] = {
+    "HexapodCliffWalk-v0": "agents.tripod_gait:TripodGaitPolicy",
+}
+
+
+def register_analytical(env_id: str, factory: str | PolicyFactory) -> None:
+    """Add or replace the analytical controller of `env_id` (e.g. from a user's own package)."""
+    ANALYTICAL_POLICIES[env_id] = factory
+
+
+def analytical_factory(env_id: str) -> PolicyFactory:
+    """The factory of `env_id`; ValueError listing the env ids that have one."""
+    try:
+        entry = ANALYTICAL_POLICIES[env_id]
+    except KeyError:
+        raise ValueError(
+            f"no analytical controller registered for {env_id!r}; registered: "
+            f"{sorted(ANALYTICAL_POLICIES)} (add one in agents/registry.py)"
+        ) from None
+    if isinstance(entry, str):
+        module, _, attribute = entry.partition(":")
+        return getattr(importlib.import_module(module), attribute)
+    return entry
+
+
+def analytical_policy(env: gym.Env) -> Policy:
+    """The analytical controller for `env` (looked up by ``env.spec.id``)."""
+    if env.spec is None:
+        raise ValueError("env has no spec (create it with gymnasium.make) to look its id up")
+    return analytical_factory(env.spec.id)(env)
