@@ -149,7 +149,9 @@ def evaluate_main(argv: Sequence[str] | None = None) -> int:
         from .evaluation import run_suite
         from .report import write_report
 
-        overrides = list(args.overrides)
+        # Models named on the command line must exist (the suite may say skip for shipped ones).
+        overrides = ["missing_models=error"] if args.policies else []
+        overrides += args.overrides
         for key, value in (
             ("envs", args.envs),
             ("policies", args.policies),

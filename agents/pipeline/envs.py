@@ -70,7 +70,8 @@ class EnvSpec:
         try:
             return gym.make(self.id, **kwargs)
         except (TypeError, ValueError) as exc:
-            raise UserError(f"cannot create {self.id} with {self.kwargs}: {exc}") from None
+            message = str(exc).split(" was raised from the environment creator")[0]
+            raise UserError(f"cannot create {self.id} with {self.kwargs}: {message}") from None
 
 
 class EnvFactory:

@@ -1,0 +1,237 @@
+"""train.py / evaluate.py end to end with tiny budgets (DummyVecEnv, short episodes), plus the
+bad-input paths: clear one-line errors on stderr and a non-zero exit code."""
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+from agents.pipeline import callbacks
+from agents.pipeline.cli import evaluate_main, train_main
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = str(ROOT / "configs" / "cliff_walk_ppo.yaml")
+TINY = [
+    "vec_env.n_envs=1",
+    "ppo.n_steps=256",
+    "ppo.batch_size=64",
+    "ppo.n_epochs=1",
+    "policy.pi=[32, 32]",
+    "policy.vf=[32, 32]",
+    "train.total_timesteps=1024",
+    "env.max_episode_steps=100",
+    "eval.freq=512",
+    "eval.n_episodes=1",
+    "checkpoint.freq=512",
+    "logging.progress_bar=false",
+]
+
+
+def sets(overrides):
+    return [arg for o in overrides for arg in ("--set", o)]
+
+
+def train(tmp, name, *extra, overrides=TINY):
+    argv = ["--config", CONFIG, "--output-dir", str(tmp), "--run-name", name]
+    return train_main([*argv, *sets(overrides), *extra])
+
+
+def meta(path: Path) -> dict:
+    return json.loads((path / "meta.json").read_text())
+
+
+@pytest.fixture(scope="module")
+def run(tmp_path_factory):
+    """A tiny training run (1024 steps) resumed to 1536 steps."""
+    tmp = tmp_path_factory.mktemp("runs")
+    assert train(tmp, "tiny") == 0
+    run_dir = tmp / "tiny"
+    first = {
+        "final_steps": meta(run_dir / "final")["num_timesteps"],
+        "events": sorted((run_dir / "tb").glob("events.out.tfevents.*")),
+    }
+    assert train_main(["--resume", str(run_dir), "--set", "train.total_timesteps=1536"]) == 0
+    return run_dir, first
+
+
+def test_run_dir_holds_model_config_command_vecnormalize_and_tensorboard(run):
+    run_dir, first = run
+    assert first["final_steps"] == 1024 and first["events"]
+    for model_dir in (run_dir / "final", run_dir / "best", *(run_dir / "checkpoints").iterdir()):
+        for name in ("model.zip", "vecnormalize.pkl", "config.yaml", "command.txt", "meta.json"):
+            assert (model_dir / name).is_file(), model_dir / name
+    config = yaml.safe_load((run_dir / "final" / "config.yaml").read_text())
+    assert config["env"]["id"] == "HexapodCliffWalk-v0" and config["ppo"]["n_steps"] == 256
+    assert "--run-name tiny" in (run_dir / "command.txt").read_text().splitlines()[0]
+    assert "train.py" in (run_dir / "best" / "command.txt").read_text()
+
+
+def test_tensorboard_has_fasm_success_and_reward_term_scalars(run):
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    acc = EventAccumulator(str(run[0] / "tb"))
+    acc.Reload()
+    tags = set(acc.Tags()["scalars"])
+    expected = {
+        "hexapod/fasm_min_deg",
+        "hexapod/fasm_mean_deg",
+        "hexapod/time_below_xi_s",
+        "hexapod/success_rate",
+        "reward_terms/reward_forward",
+        "reward_terms/reward_stability",
+        "eval/fasm_min_deg",
+        "eval/mean_reward",
+        "rollout/ep_rew_mean",
+    }
+    assert expected <= tags, expected - tags
+    steps = [e.step for e in acc.Scalars("hexapod/fasm_min_deg")]
+    assert max(steps) == 1536  # the resumed part logs into the same directory
+
+
+def test_resume_continues_in_the_same_run_dir(run):
+    run_dir, first = run
+    assert meta(run_dir / "final")["num_timesteps"] == 1536
+    assert (run_dir / "checkpoints" / "step_000000001536").is_dir()
+    commands = (run_dir / "command.txt").read_text().splitlines()
+    assert len(commands) == 2 and "--resume" in commands[1]
+    assert yaml.safe_load((run_dir / "config.yaml").read_text())["train"]["total_timesteps"] == 1536
+    assert len(list((run_dir / "tb").glob("events.out.tfevents.*"))) >= len(first["events"])
+    assert not [p for p in run_dir.parent.iterdir() if p.name != "tiny"]
+
+
+def test_resume_refuses_a_finished_budget_and_env_changes(run, capsys):
+    run_dir = str(run[0])
+    assert train_main(["--resume", run_dir]) == 2
+    assert "already trained to 1536 steps" in capsys.readouterr().err
+    assert train_main(["--resume", run_dir, "--set", "env.id=HexapodStewartTilt-v0"]) == 2
+    assert "cannot change 'env' when resuming" in capsys.readouterr().err
+
+
+def test_ctrl_c_saves_a_checkpoint_and_exits_130(tmp_path, monkeypatch, capsys):
+    calls = {"n": 0}
+
+    def interrupt(self):
+        calls["n"] += 1
+        if calls["n"] == 300:
+            raise KeyboardInterrupt
+        return True
+
+    monkeypatch.setattr(callbacks.EpisodeStatsCallback, "_on_step", interrupt)
+    assert train(tmp_path, "stop", overrides=[*TINY, "eval.freq=0"]) == 130
+    saved = meta(tmp_path / "stop" / "checkpoints" / "step_000000000300")
+    assert saved["kind"] == "interrupt" and saved["num_timesteps"] == 300
+    assert "python train.py --resume" in capsys.readouterr().err
+
+
+def test_existing_run_dir_is_not_overwritten_without_force(run, capsys):
+    run_dir = run[0]
+    before = meta(run_dir / "final")
+    assert train(run_dir.parent, "tiny") == 2
+    assert "already exists; pass --force" in capsys.readouterr().err
+    assert meta(run_dir / "final") == before
+
+
+def test_config_typo_lists_valid_keys(tmp_path, capsys):
+    assert train(tmp_path, "x", overrides=["ppo.n_step=8"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown key 'ppo.n_step'" in err and "n_steps" in err and "batch_size" in err
+    assert not (tmp_path / "x").exists()
+
+
+def test_env_id_typo_lists_registered_hexapod_ids(tmp_path, capsys):
+    assert train(tmp_path, "x", overrides=["env.id=HexapodCliffWallk-v0"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown env id 'HexapodCliffWallk-v0'" in err
+    assert "registered Hexapod env ids: HexapodCliffWalk-v0" in err
+
+
+def test_cli_user_errors_have_no_traceback(tmp_path):
+    result = subprocess.run(
+        [sys.executable, "train.py", "--config", CONFIG, "--set", "env.id=NoSuchEnv-v0"],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+    )
+    assert result.returncode == 2
+    assert result.stderr.startswith("train.py: error: unknown env id 'NoSuchEnv-v0'")
+    assert "Traceback" not in result.stderr
+
+
+# --- evaluate.py ---------------------------------------------------------------------------------
+def evaluate(out, *policies, extra=()):
+    argv = ["--envs", "HexapodCliffWalk-v0", "--episodes", "2", "--max-episode-steps", "60"]
+    argv += ["--output-dir", str(out), "--no-progress", "--policies", *policies]
+    return evaluate_main([*argv, *extra])
+
+
+def test_evaluate_smoke_writes_json_markdown_and_html_rows(run, tmp_path, capsys):
+    ppo = f"ppo:{run[0]}"
+    assert evaluate(tmp_path / "rep", "analytical", "zero", "random", ppo) == 0
+    out = tmp_path / "rep"
+    metrics = json.loads((out / "metrics.json").read_text())
+    policies = metrics["envs"]["HexapodCliffWalk-v0"]["policies"]
+    assert list(policies) == ["analytical", "zero", "random", ppo]
+    for entry in policies.values():
+        assert [e["seed"] for e in entry["episodes"]] == [0, 1]
+        assert all(e["episode_length"] == 60 for e in entry["episodes"])
+        assert entry["aggregate"]["fasm_min_deg"]["n"] == 2
+    md, page = (out / "report.md").read_text(), (out / "report.html").read_text()
+    for name in ("analytical", "zero", "random", ppo):
+        assert f"| {name} |" in md and f"<td>{name}</td>" in page
+    assert "PPO beats the analytical controller on:" in md
+    assert "data:image/png;base64," in page and "<img" in page
+    assert metrics["envs"]["HexapodCliffWalk-v0"]["comparisons"]
+
+
+def test_identical_seeds_give_identical_episodes_across_policies(tmp_path):
+    """analytical and zero both walk the reference gait (residual mode): same seeds, same data."""
+    assert evaluate(tmp_path / "rep", "analytical", "zero") == 0
+    metrics = json.loads((tmp_path / "rep" / "metrics.json").read_text())
+    policies = metrics["envs"]["HexapodCliffWalk-v0"]["policies"]
+    assert policies["analytical"]["episodes"] == policies["zero"]["episodes"]
+
+
+def test_missing_model_path_is_a_clear_error(tmp_path, capsys):
+    assert evaluate(tmp_path / "rep", "analytical", f"ppo:{tmp_path / 'nope'}") == 2
+    assert f"no PPO model at {tmp_path / 'nope'}" in capsys.readouterr().err
+
+
+def test_model_for_another_env_is_refused(run, tmp_path, capsys):
+    fake = tmp_path / "other"
+    fake.mkdir()
+    final = run[0] / "final"
+    for name in ("model.zip", "vecnormalize.pkl"):
+        (fake / name).write_bytes((final / name).read_bytes())
+    config = yaml.safe_load((final / "config.yaml").read_text())
+    config["env"]["id"] = "HexapodStewartTilt-v0"
+    (fake / "config.yaml").write_text(yaml.safe_dump(config))
+    assert evaluate(tmp_path / "rep", f"ppo:{fake}") == 2
+    err = capsys.readouterr().err
+    assert "was trained for HexapodStewartTilt-v0, not HexapodCliffWalk-v0" in err
+
+
+def test_missing_shipped_model_is_skipped_with_a_warning_in_the_report(tmp_path):
+    models = tmp_path / "models"
+    argv = ["--envs", "HexapodCliffWalk-v0", "--episodes", "1", "--max-episode-steps", "20"]
+    argv += ["--output-dir", str(tmp_path / "rep"), "--no-progress"]
+    argv += ["--set", f"policies=[analytical, 'ppo:{models}/{{env_id}}']"]
+    argv += ["--set", "missing_models=skip"]
+    assert evaluate_main(argv) == 0
+    md = (tmp_path / "rep" / "report.md").read_text()
+    assert f"**warning:** HexapodCliffWalk-v0: skipped ppo:{models}/{{env_id}}" in md
+    assert f"no model at {models}/HexapodCliffWalk-v0" in md
+    assert "| analytical |" in md
+
+
+def test_unknown_env_id_and_existing_report_dir(tmp_path, capsys):
+    assert evaluate_main(["--envs", "HexapodClifWalk-v0", "--output-dir", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert "unknown env id 'HexapodClifWalk-v0'" in err and "HexapodCliffWalk-v0" in err
+    (tmp_path / "rep").mkdir()
+    (tmp_path / "rep" / "report.md").write_text("keep me")
+    assert evaluate(tmp_path / "rep", "zero") == 2
+    assert "already exists; pass --force" in capsys.readouterr().err
+    assert (tmp_path / "rep" / "report.md").read_text() == "keep me"

@@ -1,0 +1,273 @@
+"""Pipeline building blocks without training: typed configs, overrides, schedules, episode
+statistics, the env evaluation-metrics hook, aggregates and verdicts, the analytical registry."""
+
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import yaml
+
+import hexapod_envs  # noqa: F401
+from agents.pipeline.configtools import apply_overrides, dump_yaml, from_mapping
+from agents.pipeline.episode import EpisodeAccumulator, MetricSpec, metric_specs
+from agents.pipeline.errors import ConfigError, UserError
+from agents.pipeline.eval_config import EvaluationSuite, load_suite
+from agents.pipeline.schedules import Schedule, parse_schedule
+from agents.pipeline.summary import aggregate, compare
+from agents.pipeline.train_config import TrainConfig, load_train_config
+from agents.registry import analytical_factory, analytical_policy
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+TRAIN_CONFIGS = {
+    "cliff_walk_ppo.yaml": "HexapodCliffWalk-v0",
+    "stewart_tilt_ppo.yaml": "HexapodStewartTilt-v0",
+    "irregular_terrain_ppo.yaml": "HexapodIrregularTerrain-v0",
+    "ditch_crossing_ppo.yaml": "HexapodDitchCrossing-v0",
+}
+
+
+@pytest.mark.parametrize(("name", "env_id"), TRAIN_CONFIGS.items())
+def test_shipped_training_configs_load_with_their_env_ids(name, env_id):
+    config = load_train_config(CONFIGS / name)
+    assert config.env.id == env_id
+    assert config.vec_env.use_subprocess == (config.vec_env.n_envs > 1)
+
+
+def test_default_suite_names_all_four_envs_and_shipped_models():
+    suite = load_suite(CONFIGS / "evaluate_default.yaml")
+    assert [e.id for e in suite.envs] == list(TRAIN_CONFIGS.values())
+    assert suite.policies == ["analytical", "ppo:models/{env_id}"]
+    assert suite.output_dir == "reports/default" and suite.missing_models == "skip"
+
+
+@pytest.mark.parametrize(
+    ("override", "path", "valid"),
+    [
+        ("ppo.lerning_rate=1e-4", "ppo.lerning_rate", "learning_rate"),
+        ("trian.seed=1", "trian", "train"),
+        ("env.idd=x", "env.idd", "kwargs"),
+        ("policy.activaton=relu", "policy.activaton", "activation"),
+        ("eval.frequency=10", "eval.frequency", "n_episodes"),
+    ],
+)
+def test_unknown_keys_at_every_level_list_the_valid_keys(override, path, valid):
+    with pytest.raises(ConfigError, match=rf"unknown key '{path}'.*valid keys.*{valid}"):
+        load_train_config(CONFIGS / "cliff_walk_ppo.yaml", [override])
+
+
+def test_unknown_key_suggests_the_closest_one():
+    with pytest.raises(ConfigError, match="did you mean 'learning_rate'"):
+        load_train_config(CONFIGS / "cliff_walk_ppo.yaml", ["ppo.lerning_rate=1e-4"])
+
+
+def test_overrides_are_typed_and_reach_nested_dicts():
+    config = load_train_config(
+        CONFIGS / "cliff_walk_ppo.yaml",
+        [
+            "ppo.learning_rate=1e-4",  # PyYAML reads this as a string; float fields accept it
+            "vec_env.n_envs=2",
+            "policy.pi=[64, 64]",
+            "env.kwargs.terrain=flat",
+            "logging.progress_bar=false",
+        ],
+    )
+    assert config.ppo.learning_rate == Schedule("constant", 1e-4)
+    assert config.vec_env.n_envs == 2 and config.policy.pi == [64, 64]
+    assert config.env.kwargs["terrain"] == "flat"
+    assert config.env.kwargs["action_mode"] == "residual"  # the file's keys are kept
+    assert config.logging.progress_bar is False
+
+
+@pytest.mark.parametrize(
+    ("override", "match"),
+    [
+        ("vec_env.n_envs=two", r"vec_env.n_envs: expected an integer"),
+        ("vec_env.type=threads", r"'threads' is not a valid choice.*subprocess"),
+        ("logging.progress_bar=3", r"expected true or false"),
+        ("ppo.batch_size=100000", r"batch_size=100000 exceeds the rollout size"),
+        ("ppo", r"must look like key.subkey=value"),
+        ("policy.pi=5", r"policy.pi: expected a list"),
+    ],
+)
+def test_bad_values_are_named(override, match):
+    with pytest.raises(ConfigError, match=match):
+        load_train_config(CONFIGS / "cliff_walk_ppo.yaml", [override])
+
+
+def test_missing_required_key_is_named():
+    with pytest.raises(ConfigError, match="missing required key 'env.id'"):
+        from_mapping(TrainConfig, {"env": {}})
+
+
+def test_resolved_config_round_trips_through_yaml():
+    config = load_train_config(
+        CONFIGS / "cliff_walk_ppo.yaml",
+        ["ppo.clip_range={type: linear, initial: 0.3, final: 0.1}"],
+    )
+    again = from_mapping(TrainConfig, yaml.safe_load(dump_yaml(config)))
+    assert again == config
+
+
+@pytest.mark.parametrize(
+    ("value", "at_start", "at_half", "at_end"),
+    [
+        (3e-4, 3e-4, 3e-4, 3e-4),
+        ("3e-4", 3e-4, 3e-4, 3e-4),
+        ("lin_3e-4", 3e-4, 1.5e-4, 0.0),
+        ({"type": "linear", "initial": 1.0, "final": 0.5}, 1.0, 0.75, 0.5),
+        ({"type": "constant", "initial": 0.2}, 0.2, 0.2, 0.2),
+    ],
+)
+def test_schedules(value, at_start, at_half, at_end):
+    s = parse_schedule(value, "ppo.learning_rate")
+    assert (s(1.0), s(0.5), s(0.0)) == pytest.approx((at_start, at_half, at_end))
+
+
+@pytest.mark.parametrize(
+    "value", ["lin_x", "exp_3e-4", {"type": "cosine", "initial": 1.0}, {"initial": 1, "end": 0}]
+)
+def test_bad_schedules_are_errors(value):
+    with pytest.raises(ConfigError, match="ppo.learning_rate"):
+        parse_schedule(value, "ppo.learning_rate")
+
+
+def test_override_into_a_value_is_an_error():
+    with pytest.raises(ConfigError, match="'seed' is a value"):
+        apply_overrides({"seed": 1}, ["seed.x=2"])
+
+
+def test_suite_policy_names_are_checked():
+    with pytest.raises(ConfigError, match=r"unknown policy 'ppo'.*ppo:<path>"):
+        from_mapping(EvaluationSuite, {"envs": ["HexapodCliffWalk-v0"], "policies": ["ppo"]})
+
+
+# --- episode statistics -------------------------------------------------------------------------
+def test_episode_fasm_statistics_and_reward_terms():
+    acc = EpisodeAccumulator(dt=0.5, keep_trace=True)
+    margins = [30.0, 10.0, 25.0, -5.0]
+    for k, m in enumerate(margins):
+        acc.add(1.0, {"fasm_margin_deg": m, "reward_a": 1.0, "reward_b": -0.5, "distance": k})
+    rec = acc.finish(terminated=True, truncated=False)
+    assert rec.fasm_min_deg == -5.0 and rec.fasm_mean_deg == pytest.approx(15.0)
+    assert rec.time_below_xi_s == pytest.approx(1.0) and rec.fraction_below_xi == 0.5
+    assert rec.reward_terms == {"a": 4.0, "b": -2.0} and rec.episode_return == 4.0
+    assert rec.distance_m == 3.0 and rec.length == 4 and rec.duration_s == 2.0
+    assert rec.fasm_trace_deg == margins and rec.energy_j is None and rec.success is None
+
+
+def test_energy_integrates_actuator_power():
+    acc = EpisodeAccumulator(dt=0.02)
+    for p in (100.0, -50.0, 25.0):
+        acc.add(0.0, {"actuator_power_w": p})
+    assert acc.finish(False, True).energy_j == pytest.approx((100 + 50 + 25) * 0.02)
+
+
+class _HookEnv(gym.Env):
+    evaluation_metrics = {
+        "height_m": {"reduce": "min", "better": "higher", "description": "torso height"},
+        "speed": "rms",
+        "flag": "any",
+        "recovery_time_s": {"reduce": "episode", "better": "lower"},
+    }
+
+
+def test_evaluation_metrics_hook_reduces_declared_keys_and_keeps_episode_metrics():
+    specs = metric_specs(_HookEnv())
+    acc = EpisodeAccumulator(dt=0.1, specs=specs)
+    steps = [
+        {"height_m": 0.3, "speed": 3.0, "flag": False, "episode_metrics": {"leg": "RR"}},
+        {"height_m": 0.2, "speed": -4.0, "flag": True},
+        {
+            "height_m": 0.25,
+            "speed": 0.0,
+            "flag": False,
+            "episode_metrics": {"leg": "LM", "recovery_time_s": 1.5, "cycle_rms": [0.1, 0.2]},
+        },
+    ]
+    for info in steps:
+        acc.add(0.0, info)
+    rec = acc.finish(True, False)
+    assert rec.specifics["height_m"] == 0.2
+    assert rec.specifics["speed"] == pytest.approx(np.sqrt((9 + 16 + 0) / 3))
+    assert rec.specifics["flag"] is True
+    assert rec.specifics["leg"] == "LM" and rec.specifics["recovery_time_s"] == 1.5
+    assert rec.specifics["cycle_rms"] == [0.1, 0.2]
+
+
+@pytest.mark.parametrize(
+    ("declared", "match"),
+    [
+        ({"x": "median"}, r"reduce='median' is not valid.*'rms'"),
+        ({"x": {"reduce": "min", "better": "up"}}, r"better='up' is not valid"),
+        ({"x": {"reduce": "min", "unit": "m"}}, r"unknown keys \['unit'\]"),
+    ],
+)
+def test_bad_evaluation_metrics_declarations_are_named(declared, match):
+    env = type("E", (gym.Env,), {"evaluation_metrics": declared})()
+    with pytest.raises(ValueError, match=match):
+        metric_specs(env)
+
+
+def _records(values: list[float], success: list[bool], cycles=None):
+    recs = []
+    for k, (v, s) in enumerate(zip(values, success, strict=True)):
+        acc = EpisodeAccumulator(dt=1.0)
+        acc.add(
+            v,
+            {
+                "fasm_margin_deg": v,
+                "is_success": s,
+                "is_tipped_over": not s,
+                "episode_metrics": {"leg": "RR" if k else "LF", "rms": cycles or [v]},
+            },
+        )
+        recs.append(acc.finish(not s, s))
+    return recs
+
+
+def test_aggregate_gives_mean_std_median_range_counts_and_pooled_lists():
+    agg = aggregate(_records([10.0, 20.0, 60.0], [True, False, True], cycles=[1.0, 3.0]))
+    assert agg["fasm_min_deg"] == pytest.approx(
+        {
+            "n": 3,
+            "mean": 30.0,
+            "std": np.std([10, 20, 60]),
+            "median": 20.0,
+            "min": 10.0,
+            "max": 60.0,
+        }
+    )
+    assert agg["success"]["mean"] == pytest.approx(2 / 3) and agg["tip_overs"] == 1
+    assert agg["specifics"]["leg"]["counts"] == {"RR": 2, "LF": 1}
+    assert agg["specifics"]["rms"]["n"] == 6 and agg["specifics"]["rms"]["median"] == 2.0
+
+
+def test_verdicts_use_each_metrics_direction():
+    aggs = {
+        "ppo:x": aggregate(_records([30.0, 32.0], [True, True])),
+        "analytical": aggregate(_records([20.0, 20.1], [True, False])),
+    }
+    specs = [MetricSpec("rms", reduce="episode", better="lower")]
+    verdicts = {v.metric: v.outcome for v in compare("ppo:x", "analytical", aggs, specs)}
+    assert verdicts["fasm_min_deg"] == "better" and verdicts["success"] == "better"
+    assert verdicts["tipped_over"] == "better" and verdicts["rms"] == "worse"
+    assert verdicts["episode_return"] == "better"
+
+
+# --- registry ------------------------------------------------------------------------------
+def test_registry_gives_the_cliff_walk_tripod_gait():
+    env = gym.make("HexapodCliffWalk-v0")
+    policy = analytical_policy(env)
+    assert type(policy).__name__ == "TripodGaitPolicy"
+    obs, _ = env.reset(seed=0)
+    assert env.action_space.contains(policy(obs))
+
+
+def test_registry_names_env_ids_without_a_controller():
+    with pytest.raises(ValueError, match=r"no analytical controller.*HexapodCliffWalk-v0"):
+        analytical_factory("HexapodNoSuch-v0")
+
+
+def test_user_errors_are_value_errors():
+    assert issubclass(ConfigError, UserError) and issubclass(UserError, ValueError)
