@@ -271,3 +271,25 @@ def test_registry_names_env_ids_without_a_controller():
 
 def test_user_errors_are_value_errors():
     assert issubclass(ConfigError, UserError) and issubclass(UserError, ValueError)
+
+
+# --- rl-baselines3-zoo -------------------------------------------------------------------------
+def test_zoo_hyperparameter_file_is_generated_from_the_configs():
+    from agents.pipeline.zoo import zoo_file
+
+    expected = zoo_file(sorted(CONFIGS.glob("*_ppo.yaml")))
+    assert (CONFIGS / "rl_zoo_hyperparams.yaml").read_text() == expected
+    entries = yaml.safe_load(expected)
+    assert set(entries) == set(TRAIN_CONFIGS.values())
+    assert entries["HexapodCliffWalk-v0"]["learning_rate"] == "lin_0.0003"
+
+
+def test_zoo_cannot_express_a_linear_schedule_to_a_nonzero_value():
+    from agents.pipeline.zoo import zoo_hyperparams
+
+    config = load_train_config(
+        CONFIGS / "cliff_walk_ppo.yaml",
+        ["ppo.learning_rate={type: linear, initial: 1, final: 0.5}"],
+    )
+    with pytest.raises(ValueError, match="non-zero final value"):
+        zoo_hyperparams(config)

@@ -1,0 +1,105 @@
+"""rl-baselines3-zoo hyperparameters generated from our training configs.
+
+rl_zoo3 trains the envs unmodified (``python -m rl_zoo3.train --algo ppo --env
+HexapodCliffWalk-v0 --gym-packages hexapod_envs``; it falls back to its ``default`` PPO entry).
+To train with the same hyperparameters as ``train.py``, pass the generated file with
+``-conf configs/rl_zoo_hyperparams.yaml``. Regenerate it after changing a config::
+
+    python -m agents.pipeline.zoo configs/*_ppo.yaml > configs/rl_zoo_hyperparams.yaml
+
+The zoo evaluates its ``policy_kwargs`` string itself (``activation_fn=nn.Tanh``); nothing here
+evaluates strings.
+"""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from .schedules import Schedule
+from .train_config import TrainConfig, load_train_config
+
+ACTIVATION_NAMES = {
+    "tanh": "nn.Tanh",
+    "relu": "nn.ReLU",
+    "elu": "nn.ELU",
+    "leaky_relu": "nn.LeakyReLU",
+    "gelu": "nn.GELU",
+    "silu": "nn.SiLU",
+}
+
+
+def _schedule(s: Schedule, key: str) -> float | str:
+    if s.is_constant:
+        return s.initial
+    if s.final == 0.0:
+        return f"lin_{s.initial!r}"
+    raise ValueError(f"rl_zoo3 has no linear schedule to a non-zero final value ({key}: {s})")
+
+
+def zoo_hyperparams(config: TrainConfig) -> dict[str, Any]:
+    """One env's entry of a zoo hyperparameter file (PPO)."""
+    ppo, pol, norm = config.ppo, config.policy, config.normalize
+    entry: dict[str, Any] = {
+        "n_envs": config.vec_env.n_envs,
+        "n_timesteps": float(config.train.total_timesteps),
+        "policy": "MlpPolicy",
+    }
+    env_kwargs = dict(config.env.kwargs)
+    if config.env.max_episode_steps is not None:
+        env_kwargs["max_episode_steps"] = config.env.max_episode_steps  # a gym.make keyword
+    if env_kwargs:
+        entry["env_kwargs"] = env_kwargs
+    if norm.observation or norm.reward:
+        entry["normalize"] = {
+            "norm_obs": norm.observation,
+            "norm_reward": norm.reward,
+            "clip_obs": norm.clip_observation,
+            "clip_reward": norm.clip_reward,
+        }
+    entry.update(
+        learning_rate=_schedule(ppo.learning_rate, "learning_rate"),
+        n_steps=ppo.n_steps,
+        batch_size=ppo.batch_size,
+        n_epochs=ppo.n_epochs,
+        gamma=ppo.gamma,
+        gae_lambda=ppo.gae_lambda,
+        clip_range=_schedule(ppo.clip_range, "clip_range"),
+        normalize_advantage=ppo.normalize_advantage,
+        ent_coef=ppo.ent_coef,
+        vf_coef=ppo.vf_coef,
+        max_grad_norm=ppo.max_grad_norm,
+        use_sde=ppo.use_sde,
+        sde_sample_freq=ppo.sde_sample_freq,
+    )
+    if ppo.clip_range_vf is not None:
+        entry["clip_range_vf"] = _schedule(ppo.clip_range_vf, "clip_range_vf")
+    if ppo.target_kl is not None:
+        entry["target_kl"] = ppo.target_kl
+    entry["policy_kwargs"] = (
+        f"dict(log_std_init={pol.log_std_init}, ortho_init={pol.ortho_init}, "
+        f"activation_fn={ACTIVATION_NAMES[pol.activation]}, "
+        f"net_arch=dict(pi={list(pol.pi)}, vf={list(pol.vf)}))"
+    )
+    return entry
+
+
+def zoo_file(config_paths: list[str | Path]) -> str:
+    header = (
+        "# rl-baselines3-zoo hyperparameters (PPO) generated from configs/*_ppo.yaml by\n"
+        "#   python -m agents.pipeline.zoo configs/*_ppo.yaml > configs/rl_zoo_hyperparams.yaml\n"
+        "# Use: python -m rl_zoo3.train --algo ppo --env HexapodCliffWalk-v0 \\\n"
+        "#        --gym-packages hexapod_envs -conf configs/rl_zoo_hyperparams.yaml\n"
+    )
+    entries = {}
+    for path in sorted(config_paths):
+        config = load_train_config(path)
+        entries[config.env.id] = zoo_hyperparams(config)
+    return header + yaml.safe_dump(entries, sort_keys=True, width=1000)
+
+
+if __name__ == "__main__":
+    sys.stdout.write(zoo_file(sys.argv[1:]))
