@@ -68,7 +68,8 @@ class EvaluationSuite:
     max_episode_steps: int | None = None  # set: overrides every env's time limit (smoke runs)
     output_dir: str = "reports/evaluation"
     missing_models: Literal["error", "skip"] = "error"
-    # skip: a ppo:<path> that does not exist is left out with a warning line in the report
+    # skip: a ppo:<path> that does not exist, or an env without an analytical controller in
+    # agents/registry.py, is left out with a warning line in the report (error: exit with it)
     deterministic: bool = True  # PPO actions: the mean (true) or sampled
     frames: bool = False  # frame strip per policy (rendered with MUJOCO_GL=egl)
     frame_count: int = 6

@@ -132,6 +132,20 @@ def _check_env_ids(suite: EvaluationSuite) -> None:
         )
 
 
+def _missing_reason(name: str, env_id: str) -> str | None:
+    """Why a shipped policy does not exist yet (no model file, no registry entry), or None."""
+    if name.startswith(PPO_PREFIX):
+        path = _ppo_path(name, env_id)
+        if not path.exists():
+            return f"no model at {path} (train one and copy its model directory there)"
+    if name == "analytical":
+        from ..registry import ANALYTICAL_POLICIES
+
+        if env_id not in ANALYTICAL_POLICIES:
+            return "no analytical controller registered in agents/registry.py"
+    return None
+
+
 def _constructor_defaults(env: gym.Env) -> dict[str, Any]:
     """Keyword defaults of the env class's constructors along its MRO, plus registered kwargs."""
     defaults: dict[str, Any] = {}
@@ -188,14 +202,10 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, gym.Env, dict
         )
         policies = {}
         for name in suite.policies:
-            if name.startswith(PPO_PREFIX) and suite.missing_models == "skip":
-                path = _ppo_path(name, suite_env.id)
-                if not path.exists():
-                    warnings.append(
-                        f"{suite_env.id}: skipped {name} - no model at {path} "
-                        "(train one and copy its model directory there)"
-                    )
-                    continue
+            missing = _missing_reason(name, suite_env.id)
+            if missing and suite.missing_models == "skip":
+                warnings.append(f"{suite_env.id}: skipped {name} - {missing}")
+                continue
             policy, source = build_policy(name, env, suite_env.id, suite)
             run = PolicyRun(name=name, source=source)
             note = _kwargs_note(env, suite_env, name, getattr(policy, "train_env_kwargs", None))

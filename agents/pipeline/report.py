@@ -321,15 +321,13 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
         slug = r.env_id.replace("/", "_")
         heading(r.env_id, 2)
         limit = r.max_episode_steps
+        sources = "; ".join(f"`{n}`: {run.source}" for n, run in r.runs.items())
         para(
             f"Env kwargs: `{r.kwargs or {}}`; time limit {limit} steps"
             + (f" × {r.dt:g} s" if r.dt else "")
-            + ". Sources: "
-            + "; ".join(f"`{n}`: {run.source}" for n, run in r.runs.items())
-            + "."
+            + (f". Sources: {sources}." if sources else ". No policy ran on this env.")
         )
         if not r.runs:
-            para("No policy ran on this env.")
             continue
         aggs = {n: aggregate(run.episodes) for n, run in r.runs.items()}
         table(main_table(aggs))
