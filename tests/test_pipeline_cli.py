@@ -6,6 +6,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import gymnasium as gym
+import numpy as np
 import pytest
 import yaml
 
@@ -235,3 +237,62 @@ def test_unknown_env_id_and_existing_report_dir(tmp_path, capsys):
     assert evaluate(tmp_path / "rep", "zero") == 2
     assert "already exists; pass --force" in capsys.readouterr().err
     assert (tmp_path / "rep" / "report.md").read_text() == "keep me"
+
+
+class ToyEnv(gym.Env):
+    """A 1-D env that fills every evaluation hook: declared per-step metrics and episode_metrics."""
+
+    evaluation_metrics = {
+        "height_m": {"reduce": "min", "better": "higher", "description": "lowest torso height"},
+        "recovery_time_s": {"reduce": "episode", "better": "lower"},
+    }
+    control_dt = 0.1
+
+    def __init__(self):
+        self.observation_space = gym.spaces.Box(-10.0, 10.0, (1,))
+        self.action_space = gym.spaces.Box(-1.0, 1.0, (1,))
+
+    def reset(self, *, seed=None, options=None):
+        super().reset(seed=seed)
+        self.x, self.k = 0.0, 0
+        return np.array([self.x], dtype=np.float32), {}
+
+    def step(self, action):
+        self.x += float(action[0]) * 0.1
+        self.k += 1
+        info = {
+            "fasm_margin_deg": 30.0 - 20.0 * abs(self.x),
+            "reward_move": float(action[0]),
+            "height_m": 0.5 - 0.01 * self.k,
+            "is_success": True,
+            "distance": self.x,
+            "episode_metrics": {
+                "recovery_time_s": 0.1 * self.k,
+                "adjustment_leg": "RR" if self.x >= 0 else "LM",
+                "cycle_rms": [abs(self.x), 2 * abs(self.x)],
+            },
+        }
+        obs = np.array([self.x], dtype=np.float32)
+        return obs, float(action[0]), False, False, info
+
+
+def test_env_specific_metrics_reach_metrics_json_and_report(tmp_path):
+    gym.register("PipelineToy-v0", entry_point=ToyEnv, max_episode_steps=10)
+    argv = ["--envs", "PipelineToy-v0", "--episodes", "2", "--no-progress"]
+    argv += ["--output-dir", str(tmp_path / "rep"), "--set", "missing_models=skip"]
+    argv += ["--set", "policies=[analytical, zero, random]"]
+    assert evaluate_main(argv) == 0
+    metrics = json.loads((tmp_path / "rep" / "metrics.json").read_text())
+    env = metrics["envs"]["PipelineToy-v0"]
+    assert list(env["policies"]) == ["zero", "random"]
+    zero = env["policies"]["zero"]
+    assert zero["episodes"][0]["specifics"]["height_m"] == pytest.approx(0.4)
+    assert zero["episodes"][0]["duration_s"] == pytest.approx(1.0)
+    specifics = zero["aggregate"]["specifics"]
+    assert specifics["recovery_time_s"]["mean"] == pytest.approx(1.0)
+    assert specifics["adjustment_leg"]["counts"] == {"RR": 2}
+    assert specifics["cycle_rms"]["pooled"] and specifics["cycle_rms"]["n"] == 4
+    md = (tmp_path / "rep" / "report.md").read_text()
+    assert "skipped analytical - no analytical controller registered" in md
+    assert "### Env-specific metrics" in md and "height_m (lowest torso height)" in md
+    assert "figures/PipelineToy-v0_specific.png" in md
