@@ -116,6 +116,11 @@ class HexapodEnv(gym.Env):
         # loaded foot creep down a slope at several cm/s, far below its friction limit.
         spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
         spec.option.impratio = 10.0
+        spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
+        spec.visual.headlight.diffuse = [0.65, 0.65, 0.65]
+        spec.worldbody.add_light(
+            name="sun", pos=[0, 0, 30], dir=[0.3, 0.2, -1.0], diffuse=[0.5, 0.5, 0.5]
+        )
         spec.visual.global_.offwidth = max(self._render_size[0], 640)
         spec.visual.global_.offheight = max(self._render_size[1], 480)
         self.model = spec.compile()

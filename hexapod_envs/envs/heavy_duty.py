@@ -4,7 +4,11 @@ Action modes:
 - ``"joint"``: 18 joint position targets, each normalised to [-1, 1] over its range
   (J_x, J_z, J_theta per leg, legs in LEG_NAMES order).
 - ``"residual"``: 18 offsets in [-1, 1] added to the reference tripod gait's targets, scaled by
-  ``residual_scale`` times each joint's half range; a zero action walks the paper's gait.
+  ``residual_scale`` times each joint's half range and low-pass filtered with time constant
+  ``residual_filter_tau`` [s]; a zero action walks the paper's gait.
+
+``is_success``: not tipped over and, in walking scenarios, at least ``min_progress`` of the
+distance the reference gait covers in the elapsed walking time.
 """
 
 from __future__ import annotations
@@ -84,6 +88,8 @@ class HeavyDutyEnv(HexapodEnv):
         *,
         action_mode: str = "residual",
         residual_scale: float = 0.25,
+        residual_filter_tau: float = 0.1,
+        min_progress: float = 0.5,
         control_dt: float = 0.02,
         physics_dt: float = 0.001,
         gait: TripodGaitParams | None = None,
@@ -129,6 +135,12 @@ class HeavyDutyEnv(HexapodEnv):
         self.action_map = JointActionMap(np.tile(self.robot.joint_ranges, (6, 1)))
         self.action_space = spaces.Box(-1.0, 1.0, shape=(18,), dtype=np.float32)
         self._residual_gain = residual_scale * self.action_map.half
+        if residual_filter_tau < 0:
+            raise ValueError(f"residual_filter_tau must be >= 0 s, got {residual_filter_tau}")
+        # First-order low-pass on the residual (a servo command filter): a step-to-step
+        # jittering residual would otherwise hammer 5 t through 4e6 N/m servos.
+        self._filter_alpha = control_dt / (residual_filter_tau + control_dt)
+        self.min_progress = min_progress
         steps_per_cycle = self.gait.gait.period / control_dt
         if abs(steps_per_cycle - round(steps_per_cycle)) > 1e-9:
             raise ValueError("gait period must be a whole number of control periods")
@@ -199,7 +211,8 @@ class HeavyDutyEnv(HexapodEnv):
         """Joint targets; MuJoCo clamps them to the servo ranges (ctrlrange)."""
         if self.action_mode == "joint":
             return self.action_map.to_joints(action)
-        return self.reference_joints() + self._residual_gain * action
+        self._residual += self._filter_alpha * (self._residual_gain * action - self._residual)
+        return self.reference_joints() + self._residual
 
     # --- reset / step --------------------------------------------------------------------
     def _initial_joints(self) -> np.ndarray:
@@ -209,6 +222,7 @@ class HeavyDutyEnv(HexapodEnv):
         super().reset(seed=seed)
         mujoco.mj_resetData(self.model, self.data)
         self._step_count = 0
+        self._residual = np.zeros(self.action_space.shape)
         self._on_reset()
         # The initial joint state is perturbed; the servo targets are not, and the settling
         # below lets the perturbation decay into a seed-dependent resting state.
@@ -223,6 +237,7 @@ class HeavyDutyEnv(HexapodEnv):
         for _ in range(int(round(self.settle_time / self.control_dt))):
             self._simulate()
         self._tipped = False
+        self._power = 0.0
         self._prev_cog = self.sensors.cog().copy()
         self._start_cog = self._prev_cog.copy()
         self._update_stability()
@@ -292,7 +307,9 @@ class HeavyDutyEnv(HexapodEnv):
         cog = self.sensors.cog()
         speed = (cog[0] - self._prev_cog[0]) / self.control_dt
         margin = min(max(self._fasm_deg, -XI_F_DEG), 45.0)
-        power = np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
+        power = self._power = float(
+            np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
+        )
         reference_power = self.weight_n * self.gait.gait.body_speed
         return {
             "forward": w["forward"] * speed,
@@ -314,7 +331,8 @@ class HeavyDutyEnv(HexapodEnv):
             stance_legs=stance,
             is_tipping=self._fasm_deg < XI_F_DEG,
             is_tipped_over=self._tipped,
-            is_success=not self._tipped and not unstable,
+            is_success=not self._tipped and not unstable and self._made_progress(cog),
+            actuator_power_w=self._power,
             sim_unstable=unstable,
             time=self.time,
             cog=cog.copy(),
@@ -325,3 +343,10 @@ class HeavyDutyEnv(HexapodEnv):
 
     def _extra_info(self) -> dict:
         return {}
+
+    def _made_progress(self, cog: np.ndarray) -> bool:
+        """Walking envs: at least `min_progress` of the reference gait's distance so far."""
+        if not self.walks:
+            return True
+        walked = max(0.0, self.time - self.gait.gait.stand_time)
+        return cog[0] - self._start_cog[0] >= self.min_progress * self.gait.gait.body_speed * walked
