@@ -1,0 +1,639 @@
+"""Closed-loop tipping recovery of seed 000 (§3-4) for the heavy-duty hexapod, from sensors only.
+
+Every control period the controller reads the joint encoders, the 3-D foot force sensors (world
+frame) and the IMU, and works in the body frame:
+
+1. **State from sensors** (:mod:`.body_model`): feet by forward kinematics, the CoG from the known
+   link masses, foot forces and gravity rotated into the body frame with the IMU quaternion.
+2. **Judgment** (§3): FASM from the measured foot forces (f_r, n_r = minus the support wrench
+   about the CoG) over the loaded feet; tipping when it falls below ξ_f = 20°. The effective
+   support legs are the two with the largest vertical foot force, the tipping edge their line
+   and the adjustment leg comes from Table II (:mod:`.judgment`). For a stance that is not a
+   tripod (e.g. five legs while walking), Table II's leg is used when its edge is in the table
+   and the leg is free, otherwise the free leg whose hip lies farthest outside the edge.
+3. **Foothold** (§4.2): least-squares terrain plane through the stance feet, reachable region of
+   the adjustment leg on it and the selection rule of eq. (14) (:mod:`.foothold`).
+4. **Time budget and trajectory** (eq. 15): the margin's rate and acceleration from a quadratic fit
+   of its last `rate_window` seconds (:mod:`.margin_rate`); t_s = ϰ times the forecast time to
+   S = 0, clamped to [t_min, t_max]; a quintic from the foot's measured position and velocity to
+   the foothold, lifted by `swing_clearance` along the plane normal (:mod:`.trajectory`).
+5. **Touch-down**: if the trajectory ends without ground contact, the foot keeps descending along
+   the plane normal at `touchdown_speed` until its force sensor reports contact (the ground may
+   lie lower than the plane fitted through the feet) or `max_search_depth` is exhausted
+   (then the attempt is declared failed and the leg is pulled back).
+6. **Force distribution** (§4.3, eqs. 16-24) once the leg has landed: the desired wrench from the
+   accelerometer (low-pass filtered specific force, F_b = m (a_b - g_b)) and the gyro
+   (T_b = I ω̇ + ω × I ω); the QP with friction, minimum normal force and stability cone solved
+   through qpsolvers (daqp by default, :mod:`.force_distribution`).
+7. **Making the planned forces act**: the servos are position servos of known stiffness at the foot
+   (x, leg length, swing), so a target offset Δq = -K⁻¹ Jᵀ ΔF adds ΔF to a foot held by the
+   ground. ΔF = planned - measured is first projected onto the null space of the wrench map A
+   (eq. 17): the part of a plan that statics contradicts (the wrench error the stability cone
+   allows, or body accelerations) cannot be imposed through foot positions without moving the
+   body, while the internal part (how the load is shared, e.g. how much the new leg carries)
+   can. The offsets integrate that error with gain `force_gain` per period (the loop converges
+   geometrically; a proportional offset would only go half-way) and are clamped.
+
+The controller then holds the new stance. It never reads simulator state; the policy wrappers
+(:class:`TippingRecoveryPolicy`, and :mod:`.gait_with_recovery` for walking) give it the
+observation only. Constants not in the paper are documented on :class:`RecoveryConfig`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from agents.policy import ObservationReader
+from agents.tipping.body_model import (
+    GRAVITY,
+    HeavyDutyBodyModel,
+    forces_to_body,
+    gravity_in_body,
+    quat_to_matrix,
+)
+from agents.tipping.foothold import (
+    AXIS_ANGLE_THRESHOLD_DEG,
+    REACH_MODELS,
+    RHO,
+    FootholdChoice,
+    select_foothold,
+    terrain_plane,
+)
+from agents.tipping.force_distribution import (
+    SOLVERS,
+    ForceDistributionConfig,
+    ForceDistributionResult,
+    ForceDistributor,
+    desired_wrench,
+)
+from agents.tipping.judgment import ADJUSTMENT_LEG, XI_F_DEG, judge
+from agents.tipping.margin_rate import MarginHistory
+from agents.tipping.trajectory import KAPPA, T_MAX, T_MIN, QuinticTrajectory, time_budget
+from hexapod_envs.robots.heavy_duty.kinematics import joints_for_foot
+from hexapod_envs.robots.heavy_duty.params import LEG_NAMES, HeavyDutyParams
+from hexapod_envs.stability import fasm
+
+PHASES: tuple[str, ...] = ("monitor", "swing", "touchdown", "supported", "failed")
+"""Controller phases: watching the margin; adjustment leg on its quintic; descending until
+contact; landed and distributing forces; no ground found or no usable adjustment leg."""
+
+_LEG_INDEX = {leg: i for i, leg in enumerate(LEG_NAMES)}
+_RETRY_NARROWER = 25  # QP solves between attempts at a narrower stability cone
+
+
+@dataclass(frozen=True)
+class RecoveryConfig:
+    """Settings of the recovery controller (paper values where it gives them).
+
+    Attributes:
+        threshold_deg: ξ_f [deg] (paper: 20).
+        reach_model: foothold reach model, "kinematic" (the leg's real reach) or "paper"
+            (eqs. 10-12 as printed); see :mod:`.foothold`.
+        rho: safety factor ρ of eqs. (11)-(13) (not given in the paper).
+        angle_threshold_deg: segment/axis angle threshold of the selection rule [deg].
+        kappa, t_min, t_max: eq. (15)'s ϰ and the clamp on t_s [s].
+        rate_window: history used for the margin's rate and acceleration [s].
+        arm_after: no judgment during the first seconds of an episode (filters start-up).
+        swing_clearance: lift of the quintic at mid-swing along the plane normal [m].
+        touchdown_speed: descent speed after the trajectory ends without contact [m/s].
+        max_search_depth: how far below the fitted plane the foot may search for ground [m].
+        contact_fraction: a foot carrying more than this fraction of the robot's weight is in
+            contact (the envs use 0.02).
+        force_gain: integral gain of the force-offset loop per control period, in (0, 1].
+        max_offset: clamp on the force offsets [J_x m, J_z m, J_θ rad] (actuator units).
+        accel_filter_time: time constant of the low-pass on accelerometer and gyro [s].
+        qp_period: solve the QP every this many control periods (1 = every period).
+        cone_ratios: λ values tried in turn when the stability cone makes the QP infeasible
+            (it does whenever the support centroid G_s lies farther from below the CoG than
+            λ d_min, as after a rear or side leg lands); the first is the configured
+            ``qp.cone_ratio`` and, if none is feasible, the QP is solved without the cone.
+        force_control: apply the offsets (False: plan and log the forces only).
+        min_normal_fraction: QP's minimum normal force per stance foot as a fraction of the
+            weight (kept above contact_fraction so that every planned foot counts as loaded).
+        qp: the remaining QP settings (solver, weights, friction, cone ratio λ).
+    """
+
+    threshold_deg: float = XI_F_DEG
+    reach_model: str = "kinematic"
+    rho: float = RHO
+    angle_threshold_deg: float = AXIS_ANGLE_THRESHOLD_DEG
+    kappa: float = KAPPA
+    t_min: float = T_MIN
+    t_max: float = T_MAX
+    rate_window: float = 0.4
+    arm_after: float = 0.2
+    swing_clearance: float = 0.1
+    touchdown_speed: float = 0.15
+    max_search_depth: float = 0.5
+    contact_fraction: float = 0.02
+    force_gain: float = 0.5
+    max_offset: tuple[float, float, float] = (0.02, 0.02, 0.02)
+    accel_filter_time: float = 0.2
+    qp_period: int = 1
+    cone_ratios: tuple[float, ...] = (0.65, 0.8, 0.95)
+    force_control: bool = True
+    min_normal_fraction: float = 0.04
+    qp: ForceDistributionConfig = field(default_factory=ForceDistributionConfig)
+
+    def __post_init__(self) -> None:
+        if self.reach_model not in REACH_MODELS:
+            raise ValueError(f"reach_model must be one of {REACH_MODELS}, got {self.reach_model!r}")
+        if self.qp.solver not in SOLVERS:
+            raise ValueError(f"solver must be one of {SOLVERS}, got {self.qp.solver!r}")
+        if not 0.0 < self.force_gain <= 1.0:
+            raise ValueError(f"force_gain must lie in (0, 1], got {self.force_gain}")
+        if self.qp_period < 1:
+            raise ValueError(f"qp_period must be >= 1, got {self.qp_period}")
+        if not 0.0 < self.contact_fraction < self.min_normal_fraction:
+            raise ValueError(
+                "need 0 < contact_fraction < min_normal_fraction, got "
+                f"{self.contact_fraction}, {self.min_normal_fraction}"
+            )
+        for name in ("touchdown_speed", "max_search_depth", "rate_window", "accel_filter_time"):
+            if not getattr(self, name) > 0.0:
+                raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
+
+
+@dataclass
+class SensorReading:
+    """One control period's measurements, in the env's units.
+
+    Attributes:
+        joints: (6, 3) encoder readings [J_x m, J_z m, J_θ rad], LEG_NAMES order.
+        joint_velocities: (6, 3) their rates.
+        foot_forces: (6, 3) ground reaction on each foot, WORLD frame [N].
+        quat: (4,) IMU orientation (w, x, y, z), body -> world.
+        gyro: (3,) body angular velocity [rad/s] (body frame).
+        accel: (3,) accelerometer specific force [m/s²] (body frame).
+    """
+
+    joints: np.ndarray
+    joint_velocities: np.ndarray
+    foot_forces: np.ndarray
+    quat: np.ndarray
+    gyro: np.ndarray
+    accel: np.ndarray
+
+    @classmethod
+    def from_observation(cls, pieces: dict[str, np.ndarray]) -> SensorReading:
+        return cls(
+            joints=pieces["joint_pos"].reshape(6, 3),
+            joint_velocities=pieces["joint_vel"].reshape(6, 3),
+            foot_forces=pieces["foot_force"].reshape(6, 3),
+            quat=pieces["imu_quat"],
+            gyro=pieces["imu_gyro"],
+            accel=pieces["imu_accel"],
+        )
+
+
+class TippingRecoveryController:
+    """The recovery method as a state machine over control periods (see the module docstring).
+
+    Call :meth:`step` once per control period with the sensor reading, the nominal joint targets
+    (what the robot would do without the controller) and the time; it returns the (6, 3) joint
+    targets. The nominal targets are latched when tipping is judged: from then on the controller
+    holds that posture (plus the adjustment leg and the force offsets).
+    """
+
+    def __init__(
+        self,
+        params: HeavyDutyParams | None = None,
+        config: RecoveryConfig | None = None,
+        control_dt: float = 0.02,
+    ):
+        self.params = params or HeavyDutyParams()
+        self.config = config or RecoveryConfig()
+        self.control_dt = float(control_dt)
+        self.body = HeavyDutyBodyModel(self.params)
+        weight = self.body.total_mass * GRAVITY
+        self._contact_sq = (self.config.contact_fraction * weight) ** 2
+        self._qp_config = replace(
+            self.config.qp, min_normal_force=self.config.min_normal_fraction * weight
+        )
+        self._distributors: dict[tuple[int, int], ForceDistributor] = {}
+        self._cone_ladder = (self.config.qp.cone_ratio, *self.config.cone_ratios)
+        ranges = self.params.joint_ranges
+        self._j_low, self._j_high = ranges[:, 0], ranges[:, 1]
+        self._max_offset = np.asarray(self.config.max_offset, dtype=float)
+        self.history = MarginHistory(self.config.rate_window)
+        self.reset()
+
+    # --- episode ---------------------------------------------------------------------------
+    def reset(self) -> None:
+        self.history.clear()
+        self.phase = "monitor"
+        self._t0: float | None = None
+        self._nominal: np.ndarray | None = None
+        self._leg: str | None = None
+        self._traj: QuinticTrajectory | None = None
+        self._choice: FootholdChoice | None = None
+        self._command: np.ndarray | None = None  # adjustment foot's commanded body position
+        self._search_start: float | None = None
+        self._support: list[int] = []
+        self._landing_joints: np.ndarray | None = None
+        self._offsets: np.ndarray | None = None
+        self._accel_f: np.ndarray | None = None
+        self._gyro_f: np.ndarray | None = None
+        self._gyro_prev: np.ndarray | None = None
+        self._steps_supported = 0
+        self._last_qp: ForceDistributionResult | None = None
+        self._previous_margin = math.nan
+        self._cone_level = 0
+        self._qp_solves = 0
+        self.diagnostics: dict[str, Any] = {
+            "phase": "monitor",
+            "fasm_deg": math.nan,
+            "fasm_edge": None,
+            "stance_legs": (),
+            "judgment_time": None,
+            "margin_at_judgment_deg": None,
+            "margin_rate_deg_s": None,
+            "margin_accel_deg_s2": None,
+            "tipping_edge": None,
+            "support_legs": None,
+            "adjustment_leg": None,
+            "t_s": None,
+            "foothold": None,
+            "foothold_point": None,
+            "foothold_status": None,
+            "foothold_reason": None,
+            "foothold_within_limits": None,
+            "landing_time": None,
+            "recovery_time": None,
+            "fasm_before_landing_deg": None,
+            "supported_legs": None,
+            "planned_forces": None,
+            "measured_forces": None,
+            "qp_status": None,
+            "qp_cone_ratio": None,
+            "qp_wrench_residual": None,
+            "failure": None,
+        }
+
+    @property
+    def active(self) -> bool:
+        """True once tipping has been judged (the controller owns the posture)."""
+        return self.phase != "monitor"
+
+    # --- sensing ---------------------------------------------------------------------------
+    def _filter(self, reading: SensorReading) -> None:
+        alpha = min(1.0, self.control_dt / self.config.accel_filter_time)
+        accel = np.asarray(reading.accel, dtype=float)
+        gyro = np.asarray(reading.gyro, dtype=float)
+        if self._accel_f is None:
+            self._accel_f, self._gyro_f = accel.copy(), gyro.copy()
+            self._gyro_prev = self._gyro_f.copy()
+        else:
+            self._gyro_prev = self._gyro_f.copy()
+            self._accel_f += alpha * (accel - self._accel_f)
+            self._gyro_f += alpha * (gyro - self._gyro_f)
+
+    def _margin(self, feet, forces, cog, loaded) -> tuple[float, tuple[int, int] | None]:
+        """FASM [deg] over the loaded feet (body frame); (0, None) without a support polygon."""
+        idx = np.flatnonzero(loaded)
+        if len(idx) < 3:
+            return 0.0, None
+        f = forces[idx]
+        rel = feet[idx] - cog
+        try:
+            result = fasm(feet[idx], cog, -f.sum(axis=0), -np.cross(rel, f).sum(axis=0))
+        except ValueError:
+            return 0.0, None
+        return float(result.margin_deg), (int(idx[result.edge[0]]), int(idx[result.edge[1]]))
+
+    # --- main step -------------------------------------------------------------------------
+    def step(self, reading: SensorReading, nominal: np.ndarray, time: float) -> np.ndarray:
+        """(6, 3) joint targets for this control period."""
+        cfg = self.config
+        self._filter(reading)
+        rot = quat_to_matrix(reading.quat)
+        joints = np.asarray(reading.joints, dtype=float).reshape(6, 3)
+        feet = self.body.feet(joints)
+        cog = self.body.cog(joints)
+        forces = forces_to_body(reading.foot_forces, rot)
+        loaded = (forces * forces).sum(axis=1) > self._contact_sq
+        margin, edge = self._margin(feet, forces, cog, loaded)
+        self.history.add(time, margin)
+        d = self.diagnostics
+        self._previous_margin = d["fasm_deg"]
+        d["fasm_deg"] = margin
+        d["fasm_edge"] = None if edge is None else (LEG_NAMES[edge[0]], LEG_NAMES[edge[1]])
+        d["stance_legs"] = tuple(leg for leg, on in zip(LEG_NAMES, loaded, strict=True) if on)
+
+        if self.phase == "monitor":
+            if margin < cfg.threshold_deg and time >= cfg.arm_after and loaded.sum() >= 3:
+                self._judge(time, margin, joints, feet, forces, loaded, nominal, reading)
+            else:
+                return np.asarray(nominal, dtype=float).reshape(6, 3).copy()
+
+        targets = self._nominal.copy()
+        if self.phase == "swing":
+            self._swing(time, targets, loaded)
+        if self.phase == "touchdown":
+            self._touchdown(time, targets, loaded)
+        if self.phase == "supported":
+            self._supported(time, targets, joints, feet, forces, cog, rot)
+        d["phase"] = self.phase
+        return np.clip(targets, self._j_low, self._j_high)
+
+    # --- judgment and planning -------------------------------------------------------------
+    def _pick_leg(self, edge: tuple[str, str], stance: tuple[str, ...], feet: np.ndarray):
+        """Adjustment leg for a stance that is not a tripod (see the module docstring)."""
+        free = [leg for leg in LEG_NAMES if leg not in stance]
+        table = ADJUSTMENT_LEG.get(frozenset(edge))
+        if table in free:
+            return table
+        if not free:
+            return None
+        p, q = feet[_LEG_INDEX[edge[0]], :2], feet[_LEG_INDEX[edge[1]], :2]
+        axis = (q - p) / np.linalg.norm(q - p)
+
+        def outside(leg):  # > 0 right of the counter-clockwise edge, i.e. outside the polygon
+            h = self.params.hip_offsets[leg][:2] - p
+            return axis[0] * h[1] - axis[1] * h[0]
+
+        best = min(free, key=outside)
+        return best if outside(best) < 0.0 else None
+
+    def _judge(self, time, margin, joints, feet, forces, loaded, nominal, reading) -> None:
+        cfg, d = self.config, self.diagnostics
+        self.phase = "failed"  # until a plan exists
+        self._t0 = time
+        self._nominal = np.asarray(nominal, dtype=float).reshape(6, 3).copy()
+        stance = tuple(leg for leg, on in zip(LEG_NAMES, loaded, strict=True) if on)
+        feet_map = {leg: feet[_LEG_INDEX[leg]] for leg in stance}
+        vertical = {leg: float(forces[_LEG_INDEX[leg], 2]) for leg in stance}
+        judgment = judge(margin, vertical, stance, feet_map, cfg.threshold_deg)
+        leg = judgment.adjustment_leg
+        if leg is None:  # not a tripod stance: Table II does not cover it
+            leg = self._pick_leg(judgment.edge, stance, feet)
+        rate, accel = self.history.rate_and_acceleration()
+        d.update(
+            judgment_time=time,
+            margin_at_judgment_deg=margin,
+            margin_rate_deg_s=rate,
+            margin_accel_deg_s2=accel,
+            tipping_edge=judgment.edge,
+            support_legs=judgment.support_legs,
+            adjustment_leg=leg,
+        )
+        if leg is None:
+            d["failure"] = "no free leg lies outside the tipping edge"
+            return
+        choice = select_foothold(
+            leg,
+            feet_map,
+            judgment.edge,
+            self.params,
+            rho=cfg.rho,
+            angle_threshold_deg=cfg.angle_threshold_deg,
+            model=cfg.reach_model,
+        )
+        self._choice = choice
+        d.update(
+            foothold=None if choice.foothold is None else choice.foothold.copy(),
+            foothold_point=choice.point,
+            foothold_status=choice.status,
+            foothold_reason=choice.reason,
+            foothold_within_limits=choice.within_joint_limits,
+        )
+        if choice.foothold is None:
+            d["failure"] = choice.reason
+            return
+        t_s = time_budget(margin, rate, accel, cfg.kappa, cfg.t_min, cfg.t_max)
+        i = _LEG_INDEX[leg]
+        velocity = self.body.foot_velocities(joints, reading.joint_velocities)[i]
+        self._traj = QuinticTrajectory.plan(
+            feet[i],
+            choice.foothold,
+            t_s,
+            start_velocity=velocity,
+            clearance=cfg.swing_clearance,
+            lift_direction=choice.plane.normal,
+        )
+        self._leg = leg
+        self._support = sorted(_LEG_INDEX[x] for x in (*stance, leg))
+        self.phase = "swing"
+        d["t_s"] = t_s
+
+    # --- adjustment leg --------------------------------------------------------------------
+    def _ik(self, leg: str, position: np.ndarray) -> np.ndarray | None:
+        try:
+            return joints_for_foot(leg, position, self.params)
+        except ValueError:
+            return None
+
+    def _command_leg(self, targets: np.ndarray, position: np.ndarray) -> bool:
+        """Put the adjustment leg's target at ``position``; False when out of reach."""
+        joints = self._ik(self._leg, position)
+        if joints is None:
+            return False
+        i = _LEG_INDEX[self._leg]
+        targets[i] = joints
+        self._command = position
+        tol = 1e-9
+        return bool(np.all(joints >= self._j_low - tol) and np.all(joints <= self._j_high + tol))
+
+    def _swing(self, time: float, targets: np.ndarray, loaded: np.ndarray) -> None:
+        tau = time - self._t0
+        self._command_leg(targets, self._traj.position(tau + self.control_dt))
+        if loaded[_LEG_INDEX[self._leg]] and tau > 0.5 * self._traj.duration:
+            self._land(time)
+        elif tau + self.control_dt >= self._traj.duration:
+            self.phase = "touchdown"
+            self._search_start = time
+
+    def _touchdown(self, time: float, targets: np.ndarray, loaded: np.ndarray) -> None:
+        if loaded[_LEG_INDEX[self._leg]]:
+            self._command_leg(targets, self._command)
+            self._land(time)
+            return
+        depth = self.config.touchdown_speed * (time - self._search_start + self.control_dt)
+        position = self._choice.foothold - depth * self._choice.plane.normal
+        reachable = self._command_leg(targets, position)
+        if depth > self.config.max_search_depth or not reachable:
+            self.phase = "failed"
+            self.diagnostics["failure"] = (
+                f"no ground under {self._leg} within {depth:.2f} m below the fitted plane"
+            )
+            i = _LEG_INDEX[self._leg]
+            targets[i] = self._nominal[i]
+
+    def _land(self, time: float) -> None:
+        d = self.diagnostics
+        i = _LEG_INDEX[self._leg]
+        self._landing_joints = self._ik(self._leg, self._command)
+        self._nominal[i] = self._landing_joints
+        self._offsets = np.zeros((len(self._support), 3))
+        self.phase = "supported"
+        d.update(
+            landing_time=time,
+            recovery_time=time - d["judgment_time"],
+            fasm_before_landing_deg=self._previous_margin,
+            supported_legs=tuple(LEG_NAMES[j] for j in self._support),
+        )
+
+    # --- force distribution ----------------------------------------------------------------
+    def _distributor(self, k: int, level: int) -> ForceDistributor:
+        """QP for k feet at cone level ``level`` (index into the λ ladder; past its end: no
+        cone)."""
+        key = (k, level)
+        if key not in self._distributors:
+            ladder = self._cone_ladder
+            if level < len(ladder):
+                config = replace(self._qp_config, cone_ratio=ladder[level])
+            else:
+                config = replace(self._qp_config, stability_cone=False)
+            self._distributors[key] = ForceDistributor(k, config)
+        return self._distributors[key]
+
+    def _solve_qp(self, feet_k, cog, wrench, normal) -> tuple[ForceDistributionResult, float]:
+        """Solve at the narrowest feasible cone, starting from the last level that worked and
+        trying one level narrower every `_RETRY_NARROWER` solves. Returns (result, λ or nan)."""
+        k = len(feet_k)
+        ladder = self._cone_ladder
+        level = self._cone_level
+        if level > 0 and self._qp_solves % _RETRY_NARROWER == 0:
+            level -= 1
+        self._qp_solves += 1
+        while True:
+            result = self._distributor(k, level).solve(feet_k, cog, wrench, normal)
+            if result.ok or level >= len(ladder):
+                break
+            level += 1
+        self._cone_level = level
+        return result, (ladder[level] if level < len(ladder) else math.nan)
+
+    def _supported(self, time, targets, joints, feet, forces, cog, rot) -> None:
+        cfg, d = self.config, self.diagnostics
+        support = self._support
+        self._steps_supported += 1
+        if (self._steps_supported - 1) % cfg.qp_period == 0:
+            feet_k = feet[support]
+            inertia = self.body.inertia(joints, cog)
+            g_body = gravity_in_body(rot)
+            omega = self._gyro_f
+            omega_dot = (self._gyro_f - self._gyro_prev) / self.control_dt
+            wrench = desired_wrench(
+                self.body.total_mass,
+                inertia,
+                g_body,
+                accel_body=self._accel_f + g_body,
+                omega=omega,
+                omega_dot=omega_dot,
+            )
+            normal = terrain_plane(feet_k).normal
+            result, cone_ratio = self._solve_qp(feet_k, cog, wrench, normal)
+            self._last_qp = result
+            d["qp_cone_ratio"] = cone_ratio
+            measured = forces[support]
+            d.update(
+                qp_status=result.status,
+                planned_forces=result.forces.copy(),
+                measured_forces=measured.copy(),
+                qp_wrench_residual=result.wrench_residual.copy(),
+            )
+            if result.ok and cfg.force_control:
+                a_mat = np.vstack(
+                    [np.tile(np.eye(3), (1, len(support))), _moment_rows(feet_k - cog)]
+                )
+                error = (result.forces - measured).reshape(-1)
+                internal = error - np.linalg.pinv(a_mat) @ (a_mat @ error)
+                change = self.body.target_change_for_force(
+                    joints, internal.reshape(-1, 3), legs=support
+                )
+                self._offsets = np.clip(
+                    self._offsets + cfg.force_gain * change, -self._max_offset, self._max_offset
+                )
+        else:
+            d["measured_forces"] = forces[support].copy()
+        targets[support] = self._nominal[support] + self._offsets
+
+
+def _moment_rows(rel: np.ndarray) -> np.ndarray:
+    """[[P_1]x ... [P_k]x] (3, 3k) for positions ``rel`` relative to the CoG."""
+    k = len(rel)
+    out = np.zeros((3, 3 * k))
+    for j, (x, y, z) in enumerate(rel):
+        out[:, 3 * j : 3 * j + 3] = [[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]]
+    return out
+
+
+class TippingRecoveryPolicy:
+    """Seed 000's tipping recovery as a policy for the heavy-duty hexapod envs.
+
+    Works in either action mode: the joint targets of :class:`TippingRecoveryController` become
+    normalised targets ("joint") or offsets from the env's reference posture ("residual"; the
+    Stewart env's default residual_scale 2 reaches every target). The nominal posture is the
+    env's reference (``env.unwrapped.reference_joints()``, the definition of the residual
+    action); everything else comes from the observation.
+
+    Args:
+        env: a heavy-duty hexapod env (e.g. HexapodStewartTilt-v0).
+        config: :class:`RecoveryConfig`; keyword overrides of its fields may be given instead,
+            e.g. ``TippingRecoveryPolicy(env, reach_model="paper", solver="quadprog")``.
+    """
+
+    def __init__(self, env: gym.Env, config: RecoveryConfig | None = None, **overrides):
+        self.env = env
+        base = env.unwrapped
+        for name in ("observation_structure", "action_map", "action_mode", "robot"):
+            if not hasattr(base, name):
+                raise ValueError(f"{type(base).__name__} is not a heavy-duty hexapod env")
+        self.config = _config_with(config, overrides)
+        self.read = ObservationReader(base.observation_structure)
+        self.action_map = base.action_map
+        self.action_mode = base.action_mode
+        self.control_dt = float(base.control_dt)
+        if self.action_mode == "residual":
+            self._gain = base.residual_scale * self.action_map.half
+        self._dtype = env.action_space.dtype
+        self.controller = TippingRecoveryController(base.robot, self.config, self.control_dt)
+        self.reset()
+
+    def reset(self) -> None:
+        self.controller.reset()
+        self._steps = 0
+
+    @property
+    def diagnostics(self) -> dict[str, Any]:
+        """The controller's state: phase, adjustment leg, foothold, t_s, forces, QP status..."""
+        return self.controller.diagnostics
+
+    def nominal(self, observation: np.ndarray) -> np.ndarray:
+        """Joint targets without recovery: the env's reference posture."""
+        return self.env.unwrapped.reference_joints().reshape(6, 3)
+
+    def to_action(self, targets: np.ndarray) -> np.ndarray:
+        joints = np.asarray(targets).reshape(-1)
+        if self.action_mode == "residual":
+            reference = self.env.unwrapped.reference_joints()
+            action = np.clip((joints - reference) / self._gain, -1.0, 1.0)
+        else:
+            action = self.action_map.to_action(joints)
+        return action.astype(self._dtype)
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        reading = SensorReading.from_observation(self.read(observation))
+        time = self._steps * self.control_dt
+        self._steps += 1
+        targets = self.controller.step(reading, self.nominal(observation), time)
+        return self.to_action(targets)
+
+
+def _config_with(config: RecoveryConfig | None, overrides: dict[str, Any]) -> RecoveryConfig:
+    """``config`` (default RecoveryConfig()) with keyword overrides; ``solver`` sets qp.solver."""
+    config = config or RecoveryConfig()
+    overrides = dict(overrides)
+    if "solver" in overrides:
+        config = replace(config, qp=replace(config.qp, solver=overrides.pop("solver")))
+    valid = set(RecoveryConfig.__dataclass_fields__)
+    unknown = sorted(set(overrides) - valid)
+    if unknown:
+        raise ValueError(f"unknown setting(s) {unknown}; valid: {sorted(valid | {'solver'})}")
+    return replace(config, **overrides)

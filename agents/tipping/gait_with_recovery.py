@@ -1,0 +1,101 @@
+"""The reference tripod gait with seed 000's tipping recovery taking over when tipping is judged.
+
+`GaitWithRecoveryPolicy` walks the paper's tripod gait
+(:class:`agents.tripod_gait.TripodGaitPolicy`) while the tipping-recovery controller
+(:mod:`.controller`) watches the FASM computed from the sensors. When the margin falls below ξ_f
+the controller takes over: it freezes the posture the gait commanded at that moment (the stance
+legs stop pushing the body forward), puts the adjustment leg down at the foothold of §4.2 (Table
+II's leg, or for a non-tripod stance the free leg on the far side of the tipping edge),
+distributes the foot forces once it has landed and then holds that stance. It does not resume
+walking: after a tipping event on unknown terrain (here a cliff) the safe continuation is to stop
+and let a planner or an operator decide.
+
+If the foothold turns out to have no ground (the adjustment leg descends `max_search_depth` below
+the plane fitted through the stance feet without touching anything, as over a cliff), the leg is
+pulled back to its frozen gait target and the robot holds the remaining stance.
+
+The controller needs full authority over the joint targets once it has taken over, because the
+env's residual reference keeps walking: use ``action_mode="joint"``, or ``"residual"`` with a
+``residual_scale`` of at least 2 (every target reachable from any reference). With a smaller
+residual scale the targets are clipped to what the action can express and the policy is told so
+through ``diagnostics["saturated"]``.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+from agents.policy import ObservationReader
+from agents.tipping.controller import (
+    RecoveryConfig,
+    SensorReading,
+    TippingRecoveryController,
+    _config_with,
+)
+from agents.tripod_gait import TripodGaitPolicy
+
+FULL_AUTHORITY_RESIDUAL_SCALE = 2.0
+"""A residual scale from which any joint target is reachable from any reference."""
+
+
+class GaitWithRecoveryPolicy:
+    """Tripod gait + tipping recovery for the walking heavy-duty envs (HexapodCliffWalk-v0).
+
+    Args:
+        env: a walking heavy-duty hexapod env (with the ``gait_phase`` observation).
+        config: :class:`RecoveryConfig` or keyword overrides of its fields.
+    """
+
+    def __init__(self, env: gym.Env, config: RecoveryConfig | None = None, **overrides):
+        base = env.unwrapped
+        if "gait_phase" not in getattr(base, "observation_structure", {}):
+            raise ValueError(
+                f"{type(base).__name__} has no gait_phase observation; GaitWithRecoveryPolicy "
+                "needs a walking heavy-duty hexapod env such as HexapodCliffWalk-v0"
+            )
+        self.env = env
+        self.gait = TripodGaitPolicy(env)
+        self.config = _config_with(config, overrides)
+        self.read = ObservationReader(base.observation_structure)
+        self.action_map = base.action_map
+        self.action_mode = base.action_mode
+        self.control_dt = float(base.control_dt)
+        self.full_authority = (
+            self.action_mode == "joint" or base.residual_scale >= FULL_AUTHORITY_RESIDUAL_SCALE
+        )
+        if self.action_mode == "residual":
+            self._gain = base.residual_scale * self.action_map.half
+        self._dtype = env.action_space.dtype
+        self.controller = TippingRecoveryController(base.robot, self.config, self.control_dt)
+        self.reset()
+
+    def reset(self) -> None:
+        self.controller.reset()
+        self.gait.reset()
+        self._steps = 0
+        self._saturated = False
+
+    @property
+    def diagnostics(self) -> dict[str, Any]:
+        """The recovery controller's diagnostics plus ``saturated`` (targets clipped by the
+        action's residual range after the take-over)."""
+        return {**self.controller.diagnostics, "saturated": self._saturated}
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        pieces = self.read(observation)
+        reading = SensorReading.from_observation(pieces)
+        time = self._steps * self.control_dt
+        self._steps += 1
+        nominal = self.gait.joint_targets(observation).reshape(6, 3)
+        targets = self.controller.step(reading, nominal, time).reshape(-1)
+        if self.action_mode == "residual":
+            reference = self.env.unwrapped.reference_joints()
+            raw = (targets - reference) / self._gain
+            self._saturated = self._saturated or bool(np.any(np.abs(raw) > 1.0 + 1e-9))
+            action = np.clip(raw, -1.0, 1.0)
+        else:
+            action = self.action_map.to_action(targets)
+        return action.astype(self._dtype)
