@@ -76,6 +76,7 @@ class HeavyDutyBodyModel:
     def __init__(self, params: HeavyDutyParams | None = None):
         self.params = p = params or HeavyDutyParams()
         self.hips = np.array([p.hip_offsets[leg] for leg in LEG_NAMES])  # (6, 3)
+        self._hip_sums = self.hips.sum(axis=0).tolist()
         self.l1 = np.array([p.signed_l1(leg) for leg in LEG_NAMES])  # (6,)
         self.total_mass = p.total_mass
         m = p.leg_mass
@@ -156,28 +157,24 @@ class HeavyDutyBodyModel:
     def cog(self, joints: np.ndarray) -> np.ndarray:
         """Whole-robot centre of gravity in the body frame [m] from the encoders."""
         q = self.leg_state(joints)
-        theta = q.theta
-        zeros = np.zeros(6)
-        hip = self._rotate(0.5 * self.l1, zeros, theta)
-        carriage = self._rotate(self.l1, np.full(6, self._carriage_z), theta)
-        shank = self._rotate(self.l1, -q.d + self._shank_up, theta)
-        foot = self._rotate(self.l1, -q.d + self._foot_up, theta)
-        yz = (
-            self._m_hip * hip
-            + self._m_carriage * carriage
-            + self._m_shank * shank
-            + self._m_foot * foot
-        ).sum(axis=0)
+        # Mass moment of each leg's links in its (unrotated) leg plane, then one rotation by the
+        # swing angle per leg (the rotation is linear, so it commutes with the weighted sum).
         m_moving = self._m_carriage + self._m_shank + self._m_foot
-        m_leg = self.params.leg_mass
-        moment = np.array(
-            [
-                m_leg * self.hips[:, 0].sum() + m_moving * q.x.sum(),
-                m_leg * self.hips[:, 1].sum() + yz[0],
-                m_leg * self.hips[:, 2].sum() + yz[1],
-            ]
+        y = (0.5 * self._m_hip + m_moving) * self.l1
+        z = (
+            self._m_carriage * self._carriage_z
+            + self._m_shank * (self._shank_up - q.d)
+            + self._m_foot * (self._foot_up - q.d)
         )
-        return moment / self.total_mass
+        c, s = np.cos(q.theta), np.sin(q.theta)
+        m_leg = self.params.leg_mass
+        hips = self._hip_sums
+        moment = (
+            m_leg * hips[0] + m_moving * float(q.x.sum()),
+            m_leg * hips[1] + float((y * c - z * s).sum()),
+            m_leg * hips[2] + float((y * s + z * c).sum()),
+        )
+        return np.array(moment) / self.total_mass
 
     def inertia(self, joints: np.ndarray, cog: np.ndarray | None = None) -> np.ndarray:
         """(3, 3) inertia about the CoG, body frame [kg m²]: body box + feet-end leg masses.

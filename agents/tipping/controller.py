@@ -245,6 +245,8 @@ class TippingRecoveryController:
         self._previous_margin = math.nan
         self._cone_level = 0
         self._qp_solves = 0
+        self._inertia: np.ndarray | None = None
+        self._last_qp_a: np.ndarray | None = None
         self.diagnostics: dict[str, Any] = {
             "phase": "monitor",
             "fasm_deg": math.nan,
@@ -294,17 +296,31 @@ class TippingRecoveryController:
             self._gyro_f += alpha * (gyro - self._gyro_f)
 
     def _margin(self, feet, forces, cog, loaded) -> tuple[float, tuple[int, int] | None]:
-        """FASM [deg] over the loaded feet (body frame); (0, None) without a support polygon."""
-        idx = np.flatnonzero(loaded)
+        """FASM [deg] over the loaded feet (body frame); (0, None) without a support polygon.
+
+        f_r and n_r are minus the measured support wrench about the CoG (seed 000 eq. 4).
+        """
+        idx = [i for i, on in enumerate(loaded.tolist()) if on]
         if len(idx) < 3:
             return 0.0, None
-        f = forces[idx]
-        rel = feet[idx] - cog
+        all_p, all_f = feet.tolist(), forces.tolist()
+        cx, cy, cz = cog.tolist()
+        fx = fy = fz = mx = my = mz = 0.0
+        for i in idx:  # plain floats: a few feet, numpy overhead would dominate
+            px, py, pz = all_p[i]
+            gx, gy, gz = all_f[i]
+            rx, ry, rz = px - cx, py - cy, pz - cz
+            fx -= gx
+            fy -= gy
+            fz -= gz
+            mx -= ry * gz - rz * gy
+            my -= rz * gx - rx * gz
+            mz -= rx * gy - ry * gx
         try:
-            result = fasm(feet[idx], cog, -f.sum(axis=0), -np.cross(rel, f).sum(axis=0))
-        except ValueError:
+            result = fasm([all_p[i] for i in idx], (cx, cy, cz), (fx, fy, fz), (mx, my, mz))
+        except ValueError:  # collinear feet, zero force: no polygon to tip about
             return 0.0, None
-        return float(result.margin_deg), (int(idx[result.edge[0]]), int(idx[result.edge[1]]))
+        return float(result.margin_deg), (idx[result.edge[0]], idx[result.edge[1]])
 
     # --- main step -------------------------------------------------------------------------
     def step(self, reading: SensorReading, nominal: np.ndarray, time: float) -> np.ndarray:
@@ -502,11 +518,18 @@ class TippingRecoveryController:
             level -= 1
         self._qp_solves += 1
         while True:
-            result = self._distributor(k, level).solve(feet_k, cog, wrench, normal)
-            if result.ok or level >= len(ladder):
+            distributor = self._distributor(k, level)
+            try:
+                qp = distributor.build(feet_k, cog, wrench, normal)
+            except ValueError:  # degenerate geometry (e.g. CoG on an edge line): no plan
+                qp, result = None, None
+            else:
+                result = distributor.solve_qp(qp)
+            if (result is not None and result.ok) or level >= len(ladder):
                 break
             level += 1
         self._cone_level = level
+        self._last_qp_a = None if qp is None else qp.A
         return result, (ladder[level] if level < len(ladder) else math.nan)
 
     def _supported(self, time, targets, joints, feet, forces, cog, rot) -> None:
@@ -515,7 +538,9 @@ class TippingRecoveryController:
         self._steps_supported += 1
         if (self._steps_supported - 1) % cfg.qp_period == 0:
             feet_k = feet[support]
-            inertia = self.body.inertia(joints, cog)
+            if self._inertia is None:  # the posture is held from here on: compute it once
+                self._inertia = self.body.inertia(joints, cog)
+            inertia = self._inertia
             g_body = gravity_in_body(rot)
             omega = self._gyro_f
             omega_dot = (self._gyro_f - self._gyro_prev) / self.control_dt
@@ -532,18 +557,20 @@ class TippingRecoveryController:
             self._last_qp = result
             d["qp_cone_ratio"] = cone_ratio
             measured = forces[support]
-            d.update(
-                qp_status=result.status,
-                planned_forces=result.forces.copy(),
-                measured_forces=measured.copy(),
-                qp_wrench_residual=result.wrench_residual.copy(),
-            )
-            if result.ok and cfg.force_control:
-                a_mat = np.vstack(
-                    [np.tile(np.eye(3), (1, len(support))), _moment_rows(feet_k - cog)]
+            if result is None:
+                d.update(qp_status="degenerate_geometry", planned_forces=None)
+            else:
+                d.update(
+                    qp_status=result.status,
+                    planned_forces=result.forces.copy(),
+                    qp_wrench_residual=result.wrench_residual.copy(),
                 )
+            d["measured_forces"] = measured.copy()
+            if result is not None and result.ok and cfg.force_control:
+                # Internal part: error - Aᵀ (A Aᵀ)⁻¹ A error (A has full row rank, k >= 3).
+                a_mat = self._last_qp_a
                 error = (result.forces - measured).reshape(-1)
-                internal = error - np.linalg.pinv(a_mat) @ (a_mat @ error)
+                internal = error - a_mat.T @ np.linalg.solve(a_mat @ a_mat.T, a_mat @ error)
                 change = self.body.target_change_for_force(
                     joints, internal.reshape(-1, 3), legs=support
                 )
@@ -553,15 +580,6 @@ class TippingRecoveryController:
         else:
             d["measured_forces"] = forces[support].copy()
         targets[support] = self._nominal[support] + self._offsets
-
-
-def _moment_rows(rel: np.ndarray) -> np.ndarray:
-    """[[P_1]x ... [P_k]x] (3, 3k) for positions ``rel`` relative to the CoG."""
-    k = len(rel)
-    out = np.zeros((3, 3 * k))
-    for j, (x, y, z) in enumerate(rel):
-        out[:, 3 * j : 3 * j + 3] = [[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]]
-    return out
 
 
 class TippingRecoveryPolicy:

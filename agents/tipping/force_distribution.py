@@ -192,6 +192,23 @@ class StabilityCone:
         return bool(np.all(self.faces @ force <= tol * np.linalg.norm(force)))
 
 
+def _v_sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def _v_dot(a, b) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def _v_cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def _v_unit(a):
+    n = math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+    return (a[0] / n, a[1] / n, a[2] / n)
+
+
 def stability_cone(
     feet: np.ndarray,
     cog: np.ndarray,
@@ -204,46 +221,96 @@ def stability_cone(
     The feet are projected onto the plane through their centroid with unit ``normal`` (up);
     ``hull`` (support-polygon vertex indices, counter-clockwise from +normal) is computed when
     not given. Raises ValueError when the CoG is not above that plane.
+
+    Computed on plain floats: at 3-6 feet numpy's per-call overhead would dominate.
     """
     feet = np.asarray(feet, dtype=float)
-    cog = np.asarray(cog, dtype=float)
-    n = _unit(np.asarray(normal, dtype=float))
-    centre = feet.mean(axis=0)
-    proj = feet - np.outer((feet - centre) @ n, n)
+    cog_arr = np.asarray(cog, dtype=float)
+    n = _v_unit(np.asarray(normal, dtype=float).tolist())
+    rows = feet.tolist()
+    k = len(rows)
+    centre = (
+        sum(r[0] for r in rows) / k,
+        sum(r[1] for r in rows) / k,
+        sum(r[2] for r in rows) / k,
+    )
+    proj = []
+    for r in rows:
+        h = _v_dot(_v_sub(r, centre), n)
+        proj.append((r[0] - h * n[0], r[1] - h * n[1], r[2] - h * n[2]))
     if hull is None:
-        hull = support_polygon(proj, up=n)
-    poly = proj[hull]
+        hull = support_polygon(np.array(proj), up=np.array(n))
+    poly = [proj[i] for i in np.asarray(hull).tolist()]
+    m = len(poly)
     # Area centroid by a triangle fan (the polygon is convex).
-    p0, p1, p2 = poly[0], poly[1:-1], poly[2:]
-    areas = 0.5 * (_cross(p1 - p0, p2 - p0) @ n)
-    g_s = (areas[:, None] * (p0 + p1 + p2)).sum(axis=0) / (3.0 * areas.sum())
+    p0 = poly[0]
+    gx = gy = gz = total = 0.0
+    for j in range(1, m - 1):
+        p1, p2 = poly[j], poly[j + 1]
+        area = 0.5 * _v_dot(_v_cross(_v_sub(p1, p0), _v_sub(p2, p0)), n)
+        total += area
+        gx += area * (p0[0] + p1[0] + p2[0])
+        gy += area * (p0[1] + p1[1] + p2[1])
+        gz += area * (p0[2] + p1[2] + p2[2])
+    g_s = (gx / (3.0 * total), gy / (3.0 * total), gz / (3.0 * total))
     # Eq. (21): distance from G_s to each edge line.
-    e_hat = np.roll(poly, -1, axis=0) - poly
-    e_hat /= np.linalg.norm(e_hat, axis=1)[:, None]
-    w = poly - g_s
-    d_min = float(np.linalg.norm(w - np.sum(w * e_hat, axis=1)[:, None] * e_hat, axis=1).min())
+    d_min = math.inf
+    for j in range(m):
+        a, b = poly[j], poly[(j + 1) % m]
+        e = _v_unit(_v_sub(b, a))
+        w = _v_sub(a, g_s)
+        t = _v_dot(w, e)
+        perp = (w[0] - t * e[0], w[1] - t * e[1], w[2] - t * e[2])
+        d_min = min(d_min, math.sqrt(_v_dot(perp, perp)))
     radius = cone_ratio * d_min
-    ex = _unit(np.array([1.0, 0.0, 0.0]) - n[0] * n)
-    ey = _cross(n, ex)
-    base = g_s + radius * np.array([ex, ey, -ex, -ey])
-    axis = g_s - cog
-    if axis @ n >= 0.0:
-        raise ValueError(f"the CoG {cog} is not above the support plane (normal {n})")
-    to_t = base - cog
-    tan_alpha = np.linalg.norm(_cross(axis, to_t), axis=1) / np.abs(to_t @ axis)
-    g_hat = _unit(axis)
-    e1 = _unit(ex - (ex @ g_hat) * g_hat)
-    e2 = _cross(e1, g_hat)
-    q = np.column_stack([e1, e2, -g_hat])
-    s_m = np.array(
+    ex = _v_unit((1.0 - n[0] * n[0], -n[0] * n[1], -n[0] * n[2]))
+    ey = _v_cross(n, ex)
+    base = [
+        tuple(g_s[i] + radius * sign * v[i] for i in range(3))
+        for sign, v in ((1.0, ex), (1.0, ey), (-1.0, ex), (-1.0, ey))
+    ]
+    c = tuple(cog_arr.tolist())
+    axis = _v_sub(g_s, c)
+    if _v_dot(axis, n) >= 0.0:
+        raise ValueError(f"the CoG {cog_arr} is not above the support plane (normal {n})")
+    tan_alpha = []
+    for t_point in base:
+        to_t = _v_sub(t_point, c)
+        cr = _v_cross(axis, to_t)
+        tan_alpha.append(math.sqrt(_v_dot(cr, cr)) / abs(_v_dot(to_t, axis)))
+    g_hat = _v_unit(axis)
+    eg = _v_dot(ex, g_hat)
+    e1 = _v_unit((ex[0] - eg * g_hat[0], ex[1] - eg * g_hat[1], ex[2] - eg * g_hat[2]))
+    e2 = _v_cross(e1, g_hat)
+    r2 = 1.0 / math.sqrt(2.0)
+    # faces = S_Mᵀ Qᵀ with Q = [e1 e2 -g_hat]: row j = s_1j e1 + s_2j e2 - (tan α_j/√2) g_hat.
+    s12 = ((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))
+    faces = np.array(
         [
-            [1.0, 0.0, -1.0, 0.0],
-            [0.0, 1.0, 0.0, -1.0],
-            tan_alpha / math.sqrt(2.0),
+            [a * e1[i] + b * e2[i] - ta * r2 * g_hat[i] for i in range(3)]
+            for (a, b), ta in zip(s12, tan_alpha, strict=True)
         ]
     )
-    faces = s_m.T @ q.T
-    return StabilityCone(cog.copy(), g_s, d_min, radius, base, tan_alpha, faces)
+    return StabilityCone(
+        cog_arr.copy(),
+        np.array(g_s),
+        d_min,
+        radius,
+        np.array(base),
+        np.array(tan_alpha),
+        faces,
+    )
+
+
+def _moment_rows(rel: np.ndarray) -> np.ndarray:
+    """[[P_1]x ... [P_k]x] (3, 3k) for positions ``rel`` (k, 3) relative to the CoG."""
+    k = len(rel)
+    out = np.zeros((3, k, 3))
+    x, y, z = rel[:, 0], rel[:, 1], rel[:, 2]
+    out[0, :, 1], out[0, :, 2] = -z, y
+    out[1, :, 0], out[1, :, 2] = z, -x
+    out[2, :, 0], out[2, :, 1] = -y, x
+    return out.reshape(3, 3 * k)
 
 
 def tipping_force_matrices(
@@ -261,19 +328,28 @@ def tipping_force_matrices(
     edges = np.asarray(edges)
     k = len(feet)
     if moment_rows is None:
-        moment_rows = _skew(feet - cog).transpose(1, 0, 2).reshape(3, 3 * k)
-    a_vec = feet[edges[:, 1]] - feet[edges[:, 0]]
-    a_hat = a_vec / np.linalg.norm(a_vec, axis=1)[:, None]
-    w = feet[edges[:, 1]] - cog
-    l_vec = w - np.sum(w * a_hat, axis=1)[:, None] * a_hat
-    l_norm = np.linalg.norm(l_vec, axis=1)
-    if l_norm.min() < 1e-9 * max(1.0, float(np.abs(w).max())):
-        bad = edges[int(np.argmin(l_norm))]
-        raise ValueError(f"the CoG lies on the line of support edge {tuple(bad.tolist())}")
-    aa = a_hat[:, :, None] * a_hat[:, None, :]
-    couple = _skew(l_vec / l_norm[:, None]) @ aa / l_norm[:, None, None]
-    force_sum = np.tile(np.eye(3), (1, k))
-    return (np.eye(3) - aa) @ force_sum + couple @ moment_rows
+        moment_rows = _moment_rows(feet - cog)
+    rows = feet.tolist()
+    c = cog.tolist()
+    m = len(edges)
+    aa = np.empty((m, 3, 3))
+    couple = np.empty((m, 3, 3))
+    for i, (e0, e1) in enumerate(edges.tolist()):
+        a = _v_unit(_v_sub(rows[e1], rows[e0]))
+        w = _v_sub(rows[e1], c)
+        t = _v_dot(w, a)
+        lv = (w[0] - t * a[0], w[1] - t * a[1], w[2] - t * a[2])
+        l_norm = math.sqrt(_v_dot(lv, lv))
+        if l_norm < 1e-9 * max(1.0, abs(w[0]), abs(w[1]), abs(w[2])):
+            raise ValueError(f"the CoG lies on the line of support edge {(e0, e1)}")
+        outer = [[a[r] * a[s] for s in range(3)] for r in range(3)]
+        aa[i] = outer
+        # [l̂]x (a aᵀ) / ‖l‖ = (l̂ × a) aᵀ / ‖l‖
+        la = _v_cross(lv, a)
+        inv = 1.0 / (l_norm * l_norm)
+        couple[i] = [[la[r] * a[s] * inv for s in range(3)] for r in range(3)]
+    force_part = np.tile(np.eye(3) - aa, (1, 1, k))
+    return force_part + couple @ moment_rows
 
 
 @dataclass(frozen=True)
@@ -353,6 +429,14 @@ class ForceDistributor:
         self._pyramid = np.array(
             [[1.0, 0.0, -mu], [-1.0, 0.0, -mu], [0.0, 1.0, -mu], [0.0, -1.0, -mu]]
         )
+        # Index patterns of the block-diagonal normal and friction rows of G.
+        feet_idx = np.arange(k)
+        self._normal_rows = feet_idx[:, None]
+        self._foot_cols = 3 * feet_idx[:, None] + np.arange(3)
+        rows = k + 4 * feet_idx[:, None] + np.arange(4)  # (k, 4)
+        self._friction_rows = rows.reshape(-1, 1)
+        self._friction_cols = np.repeat(self._foot_cols, 4, axis=0)
+        self._blocks = {"normal": slice(0, k), "friction": slice(k, 5 * k)}
 
     def build(
         self,
@@ -376,54 +460,53 @@ class ForceDistributor:
             raise ValueError(f"cog must be (3,) and wrench (6,), got {cog.shape}, {b.shape}")
         if not (np.isfinite(feet).all() and np.isfinite(cog).all() and np.isfinite(b).all()):
             raise ValueError("feet, cog and wrench must be finite")
-        n = fit_plane(feet).normal if normal is None else _unit(np.asarray(normal, dtype=float))
+        if normal is None:
+            n = fit_plane(feet).normal
+        else:
+            n = np.array(_v_unit(np.asarray(normal, dtype=float).tolist()))
 
         rel = feet - cog
-        moment_rows = _skew(rel).transpose(1, 0, 2).reshape(3, 3 * k)  # [[P_1]x ... [P_k]x]
-        a_mat = np.vstack([self._sum, moment_rows])
-        scale = max(float(np.linalg.norm(b[:3])), k * cfg.min_normal_force, 1.0)
+        moment_rows = _moment_rows(rel)  # [[P_1]x ... [P_k]x]
+        a_mat = np.empty((6, 3 * k))
+        a_mat[:3] = self._sum
+        a_mat[3:] = moment_rows
+        scale = max(math.sqrt(float(b[:3] @ b[:3])), k * cfg.min_normal_force, 1.0)
         b_scaled = b / scale
         sa = self._s[:, None] * a_mat
         u_mat = 2.0 * a_mat.T @ sa + self._reg
         f_vec = -2.0 * sa.T @ b_scaled
 
-        t1 = np.array([1.0, 0.0, 0.0]) - n[0] * n
-        if np.linalg.norm(t1) < 1e-6:
-            t1 = np.array([0.0, 1.0, 0.0]) - n[1] * n
-        t1 = _unit(t1)
-        t2 = _cross(n, t1)
-        frame = np.vstack([t1, t2, n])  # rows: tangent 1, tangent 2, normal
-        friction_rows = self._pyramid @ frame  # (4, 3)
-
-        blocks_g = []
-        blocks_h = []
-        eye = self._eye_k
-        normal_g = (eye[:, :, None] * -n).reshape(k, 3 * k)
-        friction_g = (eye[:, None, :, None] * friction_rows[None, :, None, :]).reshape(4 * k, 3 * k)
-        blocks_g += [normal_g, friction_g]
-        blocks_h += [np.full(k, -cfg.min_normal_force / scale), np.zeros(4 * k)]
+        nl = n.tolist()
+        t1 = (1.0 - nl[0] * nl[0], -nl[0] * nl[1], -nl[0] * nl[2])
+        if math.sqrt(_v_dot(t1, t1)) < 1e-6:
+            t1 = (-nl[1] * nl[0], 1.0 - nl[1] * nl[1], -nl[1] * nl[2])
+        t1 = _v_unit(t1)
+        t2 = _v_cross(nl, t1)
+        friction_rows = self._pyramid @ np.array([t1, t2, nl])  # (4, 3); frame rows t1, t2, n
 
         cone = None
         hull = support_polygon(feet, up=n)
         edges = np.column_stack([hull, np.roll(hull, -1)])
+        n_cone = 4 * len(edges) if cfg.stability_cone else 0
+        g_mat = np.zeros((5 * k + n_cone, 3 * k))
+        h_vec = np.zeros(5 * k + n_cone)
+        g_mat[self._normal_rows, self._foot_cols] = -n
+        h_vec[:k] = -cfg.min_normal_force / scale
+        g_mat[self._friction_rows, self._friction_cols] = np.tile(friction_rows, (k, 1))
         if cfg.stability_cone:
             cone = stability_cone(feet, cog, n, cfg.cone_ratio, hull=hull)
             v_all = tipping_force_matrices(feet, cog, edges, moment_rows)
             # faces · f*_i <= 0 with f*_i = -V_i x.
-            blocks_g.append(-(cone.faces @ v_all).reshape(-1, 3 * k))
-            blocks_h.append(np.zeros(4 * len(edges)))
+            g_mat[5 * k :] = -(cone.faces @ v_all).reshape(-1, 3 * k)
 
-        sizes = [len(h) for h in blocks_h]
-        starts = np.concatenate([[0], np.cumsum(sizes)])
-        blocks = {
-            name: slice(int(starts[i]), int(starts[i + 1]))
-            for i, name in enumerate(CONSTRAINT_BLOCKS[: len(sizes)])
-        }
+        blocks = dict(self._blocks)
+        if cfg.stability_cone:
+            blocks["stability"] = slice(5 * k, 5 * k + n_cone)
         return ForceQp(
             U=u_mat,
             f=f_vec,
-            G=np.vstack(blocks_g),
-            h=np.concatenate(blocks_h),
+            G=g_mat,
+            h=h_vec,
             A=a_mat,
             b=b,
             scale=scale,
