@@ -18,6 +18,8 @@ PolicyFactory = Callable[[gym.Env], Policy]
 
 ANALYTICAL_POLICIES: dict[str, str | PolicyFactory] = {
     "HexapodCliffWalk-v0": "agents.tripod_gait:TripodGaitPolicy",
+    "HexapodDitchCrossing-v0": "agents.upu_gait:UpuGaitPolicy",
+    "HexapodIrregularTerrain-v0": "agents.athena_policy:analytical_policy",
 }
 
 

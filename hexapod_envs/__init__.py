@@ -21,3 +21,9 @@ register(
     entry_point="hexapod_envs.envs.stewart_tilt:StewartTiltEnv",
     max_episode_steps=1600,
 )
+
+register(
+    id="HexapodIrregularTerrain-v0",
+    entry_point="hexapod_envs.envs.irregular_terrain:IrregularTerrainEnv",
+    max_episode_steps=1200,
+)

@@ -9,6 +9,8 @@ for privileged evaluation quantities (e.g. the torso's true clearance) in `info`
 
 from __future__ import annotations
 
+import bisect
+import functools
 import math
 from dataclasses import dataclass
 
@@ -49,6 +51,13 @@ class Ramp:
         on = (np.abs(y - self.y_center) <= self.width / 2) & (x >= self.start_x) & (x <= end)
         return np.where(on, rise, 0.0)
 
+    def height_at(self, x: float, y: float) -> float:
+        """`surface_height` at one point, on plain floats (cheap enough for every env step), m."""
+        end = self.start_x + self.length + self.top_length
+        if abs(y - self.y_center) > self.width / 2 or not self.start_x <= x <= end:
+            return 0.0
+        return min(x - self.start_x, self.length) * math.tan(self.slope)
+
 
 @dataclass(frozen=True)
 class BlockField:
@@ -68,6 +77,22 @@ class BlockField:
         inside = (i >= 0) & (i < len(self.x_edges) - 1) & (j >= 0) & (j < len(self.y_edges) - 1)
         ii, jj = np.where(inside, i, 0), np.where(inside, j, 0)
         return np.where(inside, self.heights[ii, jj], 0.0)
+
+    def height_at(self, x: float, y: float) -> float:
+        """`surface_height` at one point, on plain floats (cheap enough for every env step), m."""
+        xe, ye = self._edges
+        i, j = bisect.bisect_right(xe, x) - 1, bisect.bisect_right(ye, y) - 1
+        if 0 <= i < len(xe) - 1 and 0 <= j < len(ye) - 1:
+            return self._height_rows[i][j]
+        return 0.0
+
+    @functools.cached_property
+    def _edges(self) -> tuple[list[float], list[float]]:
+        return self.x_edges.tolist(), self.y_edges.tolist()
+
+    @functools.cached_property
+    def _height_rows(self) -> list[list[float]]:
+        return self.heights.tolist()
 
 
 def add_ramp(

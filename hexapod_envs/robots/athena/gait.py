@@ -46,16 +46,21 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from hexapod_envs.robots.athena.kinematics import (
-    forward_kinematics_all,
-    inverse_kinematics,
-)
-from hexapod_envs.robots.athena.params import ATHENA, LEG_NAMES, TRIPODS, AthenaParams
-from hexapod_envs.stability.plane_fit import fit_plane
+from ...stability.plane_fit import fit_plane
+from .kinematics import foot_position_closed_form, forward_kinematics_all, leg_ik
+from .params import ATHENA, LEG_NAMES, TRIPODS, AthenaParams
+
+START_FROM = ("measured", "commanded", "measured_height")
+"""Choices of `AthenaPostureController(start_from=...)`. With compliant servos, "measured" makes
+the stance feet, which lag behind their targets while they push the robot, start every phase a
+little further forward: on the 10° ramp with 8 N·m/rad servos the feet wander by ~4 mm per cycle
+in x until the legs reach their limits after ~15 cycles. "measured_height" keeps the paper's
+measured heights (terrain following and the sag that the height control corrects) without that
+horizontal drift."""
 
 _TRIPOD_INDICES = tuple(tuple(LEG_NAMES.index(leg) for leg in tripod) for tripod in TRIPODS)
 _MIN_TRIANGLE_AREA = 1e-4  # m², a triple of feet closer to collinear gives no usable plane
@@ -173,9 +178,13 @@ class PostureEstimate:
 
 @dataclass
 class _Plan:
-    start: np.ndarray  # (6, 3) p_{i,0}
-    swing_points: dict[int, np.ndarray] = field(default_factory=dict)  # leg -> (4, 3)
-    stance_end: dict[int, np.ndarray] = field(default_factory=dict)  # leg -> (3,)
+    """One phase's foot paths: Bezier control points of the swing legs, lines of the stance legs."""
+
+    swing: list[int]  # leg indices
+    swing_points: np.ndarray  # (3, 4, 3) control points per swing leg
+    stance: list[int]
+    stance_start: np.ndarray  # (3, 3) p_{i,0}
+    stance_delta: np.ndarray  # (3, 3) p_{i,f} - p_{i,0}
 
 
 class AthenaPostureController:
@@ -196,8 +205,11 @@ class AthenaPostureController:
     touchdown_wait: ticks to hold a landing leg that has not touched yet before extending it.
     extend_step: downward extension per tick of a landing leg that has not found the ground, m.
     max_extension: give up extending after this much, m.
-    start_from: "measured" (the paper: p_{i,0} from the encoders via eq. 12) or "commanded"
-        (the previous phase's commanded end points, immune to servo tracking errors).
+    start_from: where each phase starts, p_{i,0}: "measured" (the paper: eq. 12 on the
+        encoders), "commanded" (the previous phase's commanded end points, immune to servo
+        tracking errors) or "measured_height" (x, y commanded, z measured: the feet follow the
+        terrain and the servos' sag in height as with "measured", but the stride pattern does not
+        wander horizontally with the servos' lag; see `START_FROM`).
     rng: optional generator; if given, the plane's three legs are a random choice among the
         feet in contact, as in the paper; otherwise deterministic (see the module docstring).
     """
@@ -227,8 +239,8 @@ class AthenaPostureController:
                 f"phase_time / control_dt must be a positive whole number, got "
                 f"{phase_time} / {control_dt} = {ticks}"
             )
-        if start_from not in ("measured", "commanded"):
-            raise ValueError(f"start_from must be 'measured' or 'commanded', got {start_from!r}")
+        if start_from not in START_FROM:
+            raise ValueError(f"start_from must be one of {START_FROM}, got {start_from!r}")
         for label, value in (
             ("stride", stride),
             ("swing_height", swing_height),
@@ -256,6 +268,7 @@ class AthenaPostureController:
         self.max_extension = float(max_extension)
         self.start_from = start_from
         self.rng = rng
+        self._iks = [leg_ik(leg, params) for leg in LEG_NAMES]
         self._gains = _checked_gains(kz, k_alpha, k_beta)
         self.reset()
 
@@ -285,6 +298,25 @@ class AthenaPostureController:
     def at_phase_start(self) -> bool:
         """True if the next `step` begins a new phase (and so uses newly set gains)."""
         return self._tick == 0
+
+    @property
+    def next_phase_index(self) -> int:
+        """Index of the phase that the next `step` belongs to (a new one at a phase start)."""
+        return self._phase_index + (1 if self._tick == 0 else 0)
+
+    @property
+    def at_cycle_start(self) -> bool:
+        """True if the next `step` begins a gait cycle (a phase start with an even index).
+
+        A gait cycle is two phases (each tripod swings once); cycle k holds phases 2k, 2k+1.
+        """
+        return self._tick == 0 and self.next_phase_index % 2 == 0
+
+    @property
+    def cycle_phase(self) -> float:
+        """Position of the next `step` in its gait cycle, in [0, 1) (ticks / ticks per cycle)."""
+        in_cycle = (self.next_phase_index % 2) * self.ticks_per_phase + self._tick
+        return in_cycle / self.ticks_per_cycle
 
     @property
     def stance_legs(self) -> tuple[str, ...]:
@@ -342,11 +374,13 @@ class AthenaPostureController:
             self._waited = 0
             self._begin_phase(q, contact, forces, height)
         u = (self._tick + 1) / self.ticks_per_phase
+        v = 1.0 - u
         plan = self._plan
-        for i, points in plan.swing_points.items():
-            self._command[i] = cubic_bezier(points, u)
-        for i, end in plan.stance_end.items():
-            self._command[i] = plan.start[i] + u * (end - plan.start[i])
+        # cubic_bezier for the three swing legs at once, and eq. (31)'s straight stance lines.
+        self._command[plan.swing] = np.array([v**3, 3 * v * v * u, 3 * v * u * u, u**3]) @ (
+            plan.swing_points
+        )
+        self._command[plan.stance] = plan.stance_start + u * plan.stance_delta
         self._tick = (self._tick + 1) % self.ticks_per_phase
         return self._joint_targets()
 
@@ -357,11 +391,21 @@ class AthenaPostureController:
         stance = _TRIPOD_INDICES[(self._phase_index + 1) % 2]
         swing = _TRIPOD_INDICES[self._phase_index % 2]
         kz, ka, kb = self._gains
-        start = (
-            forward_kinematics_all(q, self.params)
-            if self.start_from == "measured"
-            else self._command.copy()
-        )
+        if self.start_from == "commanded":
+            start = self._command.copy()
+        else:
+            # Eq. (12) on the encoder angles (the closed form of the DH chain: same numbers).
+            measured = np.array(
+                [
+                    foot_position_closed_form(leg, q[i], self.params)
+                    for i, leg in enumerate(LEG_NAMES)
+                ]
+            )
+            if self.start_from == "measured":
+                start = measured
+            else:
+                start = self._command.copy()
+                start[:, 2] = measured[:, 2]
         plane_legs = self._choose_plane_legs(start, contact, stance)
         if plane_legs:
             plane = fit_plane(start[list(plane_legs)])
@@ -373,14 +417,16 @@ class AthenaPostureController:
 
         stride = self.stride / 2 if self._phase_index == 0 else self.stride
         rotation = posture_rotation(ka * d_pitch, kb * d_roll)
-        plan = _Plan(start=start)
-        for i in swing:
-            plan.swing_points[i] = swing_control_points(
-                start[i], stride, self.swing_height, kz * d_z
-            )
-        for i in stance:
-            plan.stance_end[i] = stance_end_point(start[i], stride, kz * d_z, rotation)
-        self._plan = plan
+        stance_end = [stance_end_point(start[i], stride, kz * d_z, rotation) for i in stance]
+        self._plan = _Plan(
+            swing=list(swing),
+            swing_points=np.array(
+                [swing_control_points(start[i], stride, self.swing_height, kz * d_z) for i in swing]
+            ),
+            stance=list(stance),
+            stance_start=start[list(stance)],
+            stance_delta=np.array(stance_end) - start[list(stance)],
+        )
         self._command = start.copy()
         self._estimate = PostureEstimate(
             phase_index=self._phase_index,
@@ -415,16 +461,15 @@ class AthenaPostureController:
         return max(triples, key=lambda t: triangle_area_xy(feet[list(t)]))
 
     def _joint_targets(self) -> np.ndarray:
-        targets = np.empty((6, 3))
-        clamped = []
-        for i, leg in enumerate(LEG_NAMES):
-            try:
-                targets[i] = inverse_kinematics(leg, self._command[i], self.params)
-            except ValueError:
-                targets[i] = inverse_kinematics(leg, self._command[i], self.params, clamp=True)
-                clamped.append(leg)
+        """IK of the commanded feet; unreachable points get the nearest reachable pose."""
+        rows, clamped = [], []
+        for ik, (x, y, z) in zip(self._iks, self._command.tolist(), strict=True):
+            t2, t3, t4, problem = ik.solve(x, y, z)
+            rows.append((t2, t3, t4))
+            if problem is not None:
+                clamped.append(ik.leg)
         self.clamped_legs = tuple(clamped)
-        return targets
+        return np.array(rows)
 
 
 def _checked_gains(kz: float, k_alpha: float, k_beta: float) -> tuple[float, float, float]:

@@ -14,6 +14,7 @@ arrays have shape (6, 3): rows in `LEG_NAMES` order, columns (TC, CTr, FTi) or (
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -101,55 +102,85 @@ def inverse_kinematics(
     p = np.asarray(p, dtype=float)
     if p.shape != (3,) or not np.all(np.isfinite(p)):
         raise ValueError(f"foot position must be 3 finite numbers, got {p!r}")
-    t1 = params.mounting_angle(leg)
-    d = p - params.hip_position(leg)
-    l3, l4 = params.l3, params.l4
+    *q, problem = leg_ik(leg, params).solve(*p.tolist())
+    if problem is not None and not clamp:
+        raise ValueError(f"foot position {p.tolist()} {problem}")
+    return np.array(q)
 
-    # Eq. (14): TC angle = azimuth of the foot about the hip, relative to the mounting angle.
-    t2 = _wrap(math.atan2(d[1], d[0]) - t1)
-    horizontal = math.hypot(d[0], d[1])
-    tc_lo, tc_hi = params.joint_range("TC")
-    if not tc_lo <= t2 <= tc_hi and tc_lo <= _wrap(t2 + math.pi) <= tc_hi:
-        # Foot horizontally behind the hip (femur down, tibia folded back under the body):
-        # the coxa points away from the foot and the foot's reach along it is negative.
-        t2, horizontal = _wrap(t2 + math.pi), -horizontal
-    # Planar problem in the leg's vertical plane, origin at the CTr joint (frame U, eq. 16).
-    rho = horizontal - params.l2
-    z = d[2]
-    s = math.hypot(rho, z)
-    s_min, s_max = abs(l3 - l4), l3 + l4
-    if not s_min + 1e-12 <= s <= s_max - 1e-12:
-        if not clamp:
-            raise ValueError(
-                f"foot position {p.tolist()} is out of reach of leg {leg}: distance "
-                f"{s:.4f} m from the CTr joint, reachable [{s_min:.4f}, {s_max:.4f}] m"
-            )
-        s_new = min(max(s, s_min + 1e-9), s_max - 1e-9)
-        if s > 0:
-            rho, z = rho * s_new / s, z * s_new / s
-        else:
-            rho, z = s_new, 0.0
-        s = s_new
-    # Eqs. (17)-(18), knee-up branch (theta_4 < 0).
-    c4 = (s * s - l3 * l3 - l4 * l4) / (2 * l3 * l4)
-    t4 = -math.acos(min(1.0, max(-1.0, c4)))
-    t3 = math.atan2(z, rho) - math.atan2(l4 * math.sin(t4), l3 + l4 * math.cos(t4))
-    q = np.array([t2, _wrap(t3), t4])
 
-    lo, hi = params.joint_ranges[:, 0], params.joint_ranges[:, 1]
-    outside = (q < lo - 1e-9) | (q > hi + 1e-9)
-    if np.any(outside):
-        if not clamp:
-            bad = [
-                f"{JOINT_NAMES[k]}={q[k]:.4f} not in [{lo[k]:.4f}, {hi[k]:.4f}]"
-                for k in np.flatnonzero(outside)
-            ]
-            raise ValueError(
-                f"foot position {p.tolist()} of leg {leg} needs joint angles outside the "
-                f"ranges: {', '.join(bad)}"
+class LegIK:
+    """The analytic inverse kinematics of one leg with its constants precomputed.
+
+    `solve(x, y, z)` works on plain floats (a controller calls it for six legs at every tick) and
+    is the one implementation behind `inverse_kinematics`.
+    """
+
+    def __init__(self, leg: str, params: AthenaParams = ATHENA):
+        self.leg = leg
+        self.hip = tuple(float(v) for v in params.hip_position(leg))
+        self.theta1 = params.mounting_angle(leg)
+        self.l2, self.l3, self.l4 = params.l2, params.l3, params.l4
+        self.ranges = tuple(tuple(r) for r in params.joint_ranges.tolist())
+
+    def solve(self, x: float, y: float, z: float) -> tuple[float, float, float, str | None]:
+        """(theta_2, theta_3, theta_4, problem) for the foot centre at body-frame (x, y, z), m.
+
+        `problem` is None for a reachable point; otherwise it says why the point is out of reach
+        and the angles are the nearest pose the servos can take (distance clamped to the
+        reachable annulus, angles to the joint ranges).
+        """
+        hx, hy, hz = self.hip
+        dx, dy, dz = x - hx, y - hy, z - hz
+        l2, l3, l4 = self.l2, self.l3, self.l4
+        (lo2, hi2), (lo3, hi3), (lo4, hi4) = self.ranges
+
+        # Eq. (14): TC angle = azimuth of the foot about the hip, relative to the mounting angle.
+        t2 = _wrap(math.atan2(dy, dx) - self.theta1)
+        horizontal = math.hypot(dx, dy)
+        if not lo2 <= t2 <= hi2 and lo2 <= _wrap(t2 + math.pi) <= hi2:
+            # Foot horizontally behind the hip (femur down, tibia folded back under the body):
+            # the coxa points away from the foot and the foot's reach along it is negative.
+            t2, horizontal = _wrap(t2 + math.pi), -horizontal
+        # Planar problem in the leg's vertical plane, origin at the CTr joint (frame U, eq. 16).
+        rho, zz = horizontal - l2, dz
+        s = math.hypot(rho, zz)
+        s_min, s_max = abs(l3 - l4), l3 + l4
+        problem = None
+        if not s_min + 1e-12 <= s <= s_max - 1e-12:
+            problem = (
+                f"is out of reach of leg {self.leg}: distance {s:.4f} m from the CTr joint, "
+                f"reachable [{s_min:.4f}, {s_max:.4f}] m"
             )
-        q = np.clip(q, lo, hi)
-    return q
+            s_new = min(max(s, s_min + 1e-9), s_max - 1e-9)
+            if s > 0:
+                rho, zz = rho * s_new / s, zz * s_new / s
+            else:
+                rho, zz = s_new, 0.0
+            s = s_new
+        # Eqs. (17)-(18), knee-up branch (theta_4 < 0).
+        c4 = (s * s - l3 * l3 - l4 * l4) / (2 * l3 * l4)
+        t4 = -math.acos(min(1.0, max(-1.0, c4)))
+        t3 = _wrap(math.atan2(zz, rho) - math.atan2(l4 * math.sin(t4), l3 + l4 * math.cos(t4)))
+
+        q = (t2, t3, t4)
+        bounds = ((lo2, hi2), (lo3, hi3), (lo4, hi4))
+        bad = [k for k in range(3) if not bounds[k][0] - 1e-9 <= q[k] <= bounds[k][1] + 1e-9]
+        if bad and problem is None:
+            problem = f"of leg {self.leg} needs joint angles outside the ranges: " + ", ".join(
+                f"{JOINT_NAMES[k]}={q[k]:.4f} not in [{bounds[k][0]:.4f}, {bounds[k][1]:.4f}]"
+                for k in bad
+            )
+        if problem is not None:
+            q = tuple(min(max(q[k], bounds[k][0]), bounds[k][1]) for k in range(3))
+        return (*q, problem)
+
+
+@functools.lru_cache(maxsize=64)
+def leg_ik(leg: str, params: AthenaParams = ATHENA) -> LegIK:
+    """The (cached) `LegIK` of `leg` for `params`; ValueError for an unknown leg."""
+    if leg not in LEG_NAMES:
+        raise ValueError(f"unknown leg {leg!r}; valid: {', '.join(LEG_NAMES)}")
+    return LegIK(leg, params)
 
 
 def inverse_kinematics_all(
