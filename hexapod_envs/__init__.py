@@ -27,3 +27,9 @@ register(
     entry_point="hexapod_envs.envs.irregular_terrain:IrregularTerrainEnv",
     max_episode_steps=1200,
 )
+
+register(
+    id="HexapodDitchCrossing-v0",
+    entry_point="hexapod_envs.envs.ditch_crossing:DitchCrossingEnv",
+    max_episode_steps=1500,
+)

@@ -6,8 +6,9 @@ path (eq. 19) and lands; stage II the lower platform does the same. This module 
 steps: platform paths, stride limits (eq. 17), the static stability margin of the CoG
 projection in the support triangle (eqs. 12-14), and a ditch-crossing planner that shortens
 steps so that no foot lands on a ditch edge and extends legs into the ditch (§7, Fig. 13-14).
-It knows nothing about MuJoCo or the env; a gait policy turns a `GaitPlan` into commands (limb
-lengths from `PlatformStep.limb_lengths`, leg extensions from the step's fields).
+It knows nothing about MuJoCo or the env; `gait_schedule.GaitSchedule` turns a `GaitPlan` into
+timed commands (limb lengths from the step's path, leg extensions from the step's fields) for
+the env's reference gait and for `agents.upu_gait.UpuGaitPolicy`.
 
 Conventions: SI units; world x forward along the walk, both platform centres stay on y = 0;
 "extension" of a leg is its length beyond nominal (+ = longer, foot lower; see
@@ -25,19 +26,21 @@ from __future__ import annotations
 import math
 from collections import deque
 from dataclasses import dataclass
-from functools import cache
+from functools import cache, lru_cache
 
 import numpy as np
 
-from hexapod_envs.robots.upu.kinematics import inside_limits, inverse_kinematics
-from hexapod_envs.robots.upu.params import PLATFORM_LEGS, UpuParams, check_platform
-from hexapod_envs.stability import static_stability_margin
+from ...stability import static_stability_margin
+from .kinematics import inside_limits, inverse_kinematics
+from .params import PLATFORM_LEGS, UpuParams, check_platform
 
 PLAN_STATUSES: tuple[str, ...] = ("ok", "too_deep", "too_wide", "no_plan")
-"""`GaitPlan.status` values: "too_deep": a foot must stand in the ditch (it is too wide to step
-over) but the bottom is beyond the legs' reach; "too_wide": a foot cannot stand in the ditch
-(too narrow for a foot with clearance, or too deep) and the ditch is too wide to step over;
-"no_plan": the search found no step sequence for another reason (see `GaitPlan.reason`)."""
+"""`GaitPlan.status` values: "too_deep": the bottom is beyond the legs' reach (depth >
+`UpuParams.leg_extend`), so every foot must step over the ditch, and it is too wide for that;
+"too_wide": the bottom is within reach but too narrow for a foot with its edge clearance, and
+the ditch is too wide to step over; "no_plan": the search found no step sequence for another
+reason (see `GaitPlan.reason`). A flat-bottomed ditch whose bottom is within reach is crossable
+at any width (the robot walks through it, legs extended), so width alone never fails."""
 
 
 # --- Paths and limits -----------------------------------------------------------------------
@@ -361,27 +364,44 @@ def _swing_extension(moving: str, params: UpuParams, settings: GaitSettings) -> 
     return -min(retract, params.leg_retract)
 
 
+@lru_cache(maxsize=8192)
 def _feasible_lift(params: UpuParams, settings: GaitSettings, moving: str, x0: float, x1: float):
     """Largest lift <= the target lift (1 mm steps) keeping the whole path inside the workspace;
-    None if even the straight path leaves it. Relative coordinates [m]."""
+    None if even the straight path leaves it. Relative coordinates [m]. Cached: the result
+    depends only on its (hashable, frozen) arguments, and the planner asks for the same
+    relative moves again and again."""
     h = params.initial_height if moving == "upper" else -params.initial_height
     target = params.step_lift if settings.lift is None else settings.lift
-    candidates = [0.0]
+    candidates = np.zeros(1)
     if moving == "upper" and target > 0:
         candidates = np.linspace(target, 0.0, int(round(target / 0.001)) + 1)
-    for lift in candidates:
-        pose = step_path(x0, x1, h, float(lift)).sample(21)
-        pts = np.column_stack([pose[:, 0], np.zeros(len(pose)), pose[:, 1]])
-        if np.all(inside_limits(pts, params, moving=moving)):
-            return float(lift)
-    return None
+    x = np.linspace(x0, x1, 21)
+    mid = (x0 + x1) / 2
+    half = (x1 - x0) / 2
+    bump = 1.0 - ((x - mid) / half) ** 2 if half != 0 else np.zeros_like(x)
+
+    def feasible(lifts: np.ndarray) -> np.ndarray:
+        z = h + lifts[:, None] * bump[None, :]
+        pts = np.stack([np.broadcast_to(x, z.shape), np.zeros_like(z), z], axis=-1)
+        return np.all(inside_limits(pts, params, moving=moving), axis=-1)
+
+    if feasible(candidates[:1])[0]:  # the usual case: the full lift fits
+        return float(candidates[0])
+    ok = feasible(candidates[1:])  # all smaller lifts in one workspace check
+    first = np.flatnonzero(ok)
+    return float(candidates[1 + first[0]]) if first.size else None
 
 
-def _transfer_margin(params: UpuParams, moving: str, x0: float, x1: float, n: int = 11) -> float:
-    """Min static margin while the `moving` centre goes from x0 to x1 relative to the other."""
+def _transfer_margin(params: UpuParams, moving: str, x0: float, x1: float) -> float:
+    """Min static margin while the `moving` centre goes from x0 to x1 relative to the other [m].
+
+    The CoG moves on a straight line and the margin inside a convex polygon is the minimum of
+    the distances to its sides, each linear in the CoG position: a concave function, so its
+    minimum over the segment is at an end (and a negative end is caught there too).
+    """
     support = _other(moving)
     values = []
-    for x in np.linspace(x0, x1, n):
+    for x in (x0, x1):
         xu, xl = (x, 0.0) if moving == "upper" else (0.0, x)
         values.append(stance_margin(params, xu, xl, support))
     return min(values)
@@ -551,12 +571,27 @@ def plan_ditch_crossing(
                 break
             queue.append(nxt)
     if goal is None:
-        return GaitPlan(
-            "no_plan",
-            f"no sequence of steps <= {limit:.3f} m keeps every foot {band:.3f} m from the "
-            f"ditch edges with margin >= {settings.min_margin} m",
-            ditch=ditch,
+        search_note = (
+            f"no sequence of steps <= {limit:.3f} m (eq. 17) keeps every foot {band:.3f} m "
+            f"from the ditch edges with margin >= {settings.min_margin} m"
         )
+        if not can_stand and ditch.depth > reach:
+            return GaitPlan(
+                "too_deep",
+                f"the ditch is {ditch.depth:.3f} m deep but a leg extends at most {reach:.3f} m, "
+                f"so no foot can stand on its bottom, and at {ditch.width:.3f} m it is too wide "
+                f"to step over: {search_note}",
+                ditch=ditch,
+            )
+        if not can_stand:
+            return GaitPlan(
+                "too_wide",
+                f"the ditch ({ditch.width:.3f} m) is too narrow for a foot with "
+                f"{settings.edge_clearance} m clearance on each side and too wide to step "
+                f"over: {search_note}",
+                ditch=ditch,
+            )
+        return GaitPlan("no_plan", search_note, ditch=ditch)
 
     chain = []
     state = goal
@@ -603,4 +638,29 @@ def plan_ditch_crossing(
         f"{len(steps)} steps cross the {ditch.width} m x {ditch.depth} m ditch, {how}",
         tuple(steps),
         ditch,
+    )
+
+
+def plan_flat_past(
+    params: UpuParams,
+    goal_x: float,
+    x_start: float = 0.0,
+    settings: GaitSettings | None = None,
+) -> GaitPlan:
+    """Flat-ground gait (full strides, eq. 17) until every foot, sphere included, is past the
+    line x = `goal_x` [m]: the same finish line as a ditch ending at `goal_x`, without the
+    ditch."""
+    settings = settings or GaitSettings()
+    if not (math.isfinite(goal_x) and math.isfinite(x_start)):
+        raise ValueError(f"goal_x and x_start must be finite [m], got {goal_x}, {x_start}")
+    rear = min(float(params.foot_offset(leg)[0]) for leg in PLATFORM_LEGS["lower"])
+    rear = min(rear, *(float(params.foot_offset(leg)[0]) for leg in PLATFORM_LEGS["upper"]))
+    distance = goal_x + params.foot_radius + settings.edge_clearance - rear - x_start
+    if distance <= 0:
+        raise ValueError(
+            f"goal_x = {goal_x} m is already behind the robot's rear feet (start x = {x_start} m)"
+        )
+    stride = _stride_limit(params, settings)
+    return plan_flat_walk(
+        params, int(math.ceil(distance / stride - 1e-9)), x_start=x_start, settings=settings
     )

@@ -30,6 +30,16 @@ Structure (names follow the package's model-building contract where it applies):
   -R_site @ sensor - foot_mass * g with g = (0, 0, -9.81) m/s^2 (world frame), checked by
   tests/test_upu_model.py.
 
+Command modes (`add_upu(..., command=...)`): ``"position"`` (default): each actuator's ctrl is
+its target (limb length or leg extension [m]). ``"interpolated"``: the servo target is the
+actuator's activation (act, clamped to the same ranges) and ctrl is its rate [m/s], limited to
+`UpuParams.limb_speed_limit` / `leg_speed_limit`: an executor that wants target T at the end of
+a control period of length dt sets ctrl = (T - act) / dt, and MuJoCo moves the target linearly
+within the period (a first-order hold, as servo drives interpolate set-points). A controller
+running at a few tens of Hz then drives the robot as smoothly as one that sets every physics
+step, with no per-step Python work; stepping a position target at 20 Hz instead jerks the
+5e5 N/m limb servos into their force limit and makes the feet slip.
+
 Collisions: robot geoms have contype 1 / conaffinity 0 and terrain geoms contype 0 /
 conaffinity 1, so the robot touches only the terrain, never itself (the upper legs pass beside
 the lower platform). The stiff limb servos want a timestep of at most `RECOMMENDED_TIMESTEP`.
@@ -153,6 +163,17 @@ def _add_plate(body, name: str, hub_radius: float, arm_ends, rgba) -> None:
         )
 
 
+COMMAND_MODES: tuple[str, ...] = ("position", "interpolated")
+
+
+def _interpolate_commands(act, speed_limit: float) -> None:
+    """Turn a position servo into one whose target is its activation, moved at rate ctrl."""
+    act.dyntype = mujoco.mjtDyn.mjDYN_INTEGRATOR
+    act.actlimited = mujoco.mjtLimited.mjLIMITED_TRUE
+    act.actrange = list(act.ctrlrange)
+    act.ctrlrange = [-speed_limit, speed_limit]
+
+
 def _set_limb_servo(act, p: UpuParams) -> None:
     """PD length servo, or with `limb_integral_gain` > 0 MuJoCo's PID actuator (position input,
     integral clamped at `limb_integral_limit`), which needs MuJoCo >= 4."""
@@ -173,7 +194,9 @@ def _set_limb_servo(act, p: UpuParams) -> None:
     )
 
 
-def _add_leg(spec: mujoco.MjSpec, platform_body, leg: str, p: UpuParams) -> None:
+def _add_leg(
+    spec: mujoco.MjSpec, platform_body, leg: str, p: UpuParams, interpolated: bool
+) -> None:
     x, y = p.foot_offset(leg)
     length = p.leg_length(leg)
     leg_body = platform_body.add_body(name=f"{leg}_leg", pos=[x, y, 0.0])
@@ -223,6 +246,8 @@ def _add_leg(spec: mujoco.MjSpec, platform_body, leg: str, p: UpuParams) -> None
     act.ctrlrange = list(p.extension_range)
     act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
     act.forcerange = [-p.leg_force_limit, p.leg_force_limit]
+    if interpolated:
+        _interpolate_commands(act, p.leg_speed_limit)
     site = mujoco.mjtObj.mjOBJ_SITE
     spec.add_sensor(
         name=f"{joint}_pos",
@@ -248,6 +273,7 @@ def add_upu(
     spec: mujoco.MjSpec,
     params: UpuParams | None = None,
     pos: tuple[float, float, float] | None = None,
+    command: str = "position",
 ) -> UpuHandles:
     """Add the 3-UPU hexapod to `spec`; return the names it created.
 
@@ -256,8 +282,18 @@ def add_upu(
         params: robot parameters (default: the paper's, `UpuParams()`).
         pos: world position of the torso origin (lower Hooke-joint centre) [m]. Default:
             standing with all six nominal-length legs on flat ground at z = 0, 1 mm above it.
+        command: "position" (ctrl = target) or "interpolated" (act = target, ctrl = its rate;
+            see the module docstring). The interpolated mode needs the PD limb servo.
     """
     p = params or UpuParams()
+    if command not in COMMAND_MODES:
+        raise ValueError(f"command must be one of {COMMAND_MODES}, got {command!r}")
+    interpolated = command == "interpolated"
+    if interpolated and p.limb_integral_gain > 0:
+        raise ValueError(
+            'command="interpolated" drives the servo target through the actuator activation, '
+            "which MuJoCo's PID actuator uses for its integral: set limb_integral_gain=0"
+        )
     if pos is None:
         pos = (0.0, 0.0, p.lower_leg_length + 0.001)
     pos = [float(v) for v in pos]
@@ -318,6 +354,8 @@ def add_upu(
         act.ctrlrange = [p.limb_min, p.limb_max]
         act.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
         act.forcerange = [-p.limb_force_limit, p.limb_force_limit]
+        if interpolated:
+            _interpolate_commands(act, p.limb_speed_limit)
         spec.add_sensor(
             name=f"{limb}_length",
             type=mujoco.mjtSensor.mjSENS_TENDONPOS,
@@ -326,9 +364,9 @@ def add_upu(
         )
 
     for leg in UPPER_LEGS:
-        _add_leg(spec, upper, leg, p)
+        _add_leg(spec, upper, leg, p, interpolated)
     for leg in LOWER_LEGS:
-        _add_leg(spec, torso, leg, p)
+        _add_leg(spec, torso, leg, p, interpolated)
 
     site = mujoco.mjtObj.mjOBJ_SITE
     spec.add_sensor(name="imu_gyro", type=mujoco.mjtSensor.mjSENS_GYRO, objtype=site, objname="imu")

@@ -152,15 +152,27 @@ class UpuParams:
     limb_integral_gain: float = 0.0
     """Integral gain of the limb servo [N/(m s)]. 0 (default): PD position servo. > 0: MuJoCo's
     PID actuator (needs MuJoCo >= 4), which removes the static error (2e6 brings it below
-    1 mm within 0.6 s). Off by default so that the model is the same on every supported
-    MuJoCo version; the PD servo's sag is predictable (closed-form compliance)."""
+    1 mm within 0.6 s with upper_slide_damping = 5 N s/m; with the default 300 N s/m that
+    gain winds up against the force limit on large moves and needs retuning). Off by default
+    so that the model is the same on every supported MuJoCo version; the PD servo's sag is
+    predictable (closed-form compliance)."""
     limb_integral_limit: float = 400.0
     """Anti-windup clamp of the integral term [N] (PID mode only)."""
-    upper_slide_damping: float = 5.0
-    """Viscous damping of the upper platform's x/y/z slide joints [N s/m] (joint friction of
-    the mechanism)."""
+    upper_slide_damping: float = 300.0
+    """Viscous damping of the upper platform's x/y/z slide joints [N s/m] (friction in the
+    mechanism's joints). The nearly parallel limbs give the platform a horizontal stiffness of
+    only ~7e3 N/m (see `limb_stiffness`); with the limb servos' share (~140 N s/m) this value
+    makes that sway mode of the 3.55 kg upper half about critically damped. Lightly damped
+    (5 N s/m), the platform keeps swaying by a few mm after each transfer, enough (at 7 Hz) to
+    rock the robot off a foot when the CoG is 15 mm from a support edge."""
     limb_force_limit: float = 400.0
     """Limb servo force limit [N] (the robot weighs ~75 N)."""
+    limb_speed_limit: float = 0.25
+    """Fastest limb-length change [m/s] of the interpolated command mode (`model.add_upu`
+    with ``command="interpolated"``); the reference gait needs <= ~0.1 m/s."""
+    leg_speed_limit: float = 1.0
+    """Fastest leg-extension change [m/s] of the interpolated command mode; the reference
+    gait's lift needs <= ~0.55 m/s (0.22 m out of the ditch in 0.8 s)."""
     leg_stiffness: float = 5.0e4
     """Leg-length servo stiffness [N/m]: < 1 mm sag with the robot on three legs."""
     leg_damping: float = 1.0e3

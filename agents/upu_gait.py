@@ -1,0 +1,148 @@
+"""The 3-3 gait of the 3-UPU hexapod (seed 003 §6-7) as a policy for HexapodDitchCrossing-v0.
+
+The policy plans the walk the way the paper's robot does, knowing the ditch: it reads the
+ditch geometry the env exposes (`env.unwrapped.ditch`, `terrain`, `start_x`; the robot's
+`params`) and calls the planner of `hexapod_envs.robots.upu.gait_plan` (strides <= l_max1 =
+160 mm, eq. 17; strides shortened so that no foot lands on a ditch edge; legs extended into
+the ditch, §7). `hexapod_envs.robots.upu.gait_schedule` times the steps: the moving platform's
+legs retract (lift), the platform travels along its quadratic path (eqs. 19-21), the legs
+extend until the feet are down (land), and the platforms swap roles.
+
+Closed loop through the foot contact switches (observation piece ``foot_contact``, the
+paper's per-leg pressure sensors): the transfer starts only once the moving feet are off the
+ground, and the next platform lifts only once the landed feet are down; until then the policy
+holds its command (`waiting`). It needs no simulator state.
+
+A ditch the mechanism cannot cross gets no plan: `status` is "too_deep", "too_wide" or
+"no_plan" (see `gait_plan.PLAN_STATUSES`), `reason` says why, and the policy holds the
+standing pose instead of walking into the ditch.
+
+Action modes: in ``"joint"`` mode the action is the command normalised over the actuator
+ranges; in ``"residual"`` mode it is the difference to the env's reference gait (observation
+piece ``reference_action``), which is the same schedule, so it is zero while the gates pass on
+time. A wait at a gate puts the policy behind the reference; the residual then grows and may
+saturate at residual_scale, so use ``action_mode="joint"`` for the full closed-loop behaviour.
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+
+from hexapod_envs.robots.upu.gait_plan import (
+    Ditch,
+    GaitPlan,
+    GaitSettings,
+    plan_ditch_crossing,
+    plan_flat_past,
+)
+from hexapod_envs.robots.upu.gait_schedule import Checkpoint, GaitSchedule, GaitTiming
+from hexapod_envs.robots.upu.params import LEG_NAMES
+
+from .policy import ObservationReader
+
+_LEG_INDEX = {leg: i for i, leg in enumerate(LEG_NAMES)}
+
+
+class UpuGaitPolicy:
+    """The paper's 3-3 gait planned for the env's ditch; `reset()`, `__call__(obs) -> action`.
+
+    Args:
+        env: a HexapodDitchCrossing-v0 env (wrapped or not); only public attributes are read.
+        settings: planner settings (default: the env's `gait_settings`).
+        timing: phase durations (default: the env's `gait_timing`, so that the policy plays the
+            env's reference gait exactly when no gate has to wait).
+    """
+
+    def __init__(
+        self,
+        env: gym.Env,
+        settings: GaitSettings | None = None,
+        timing: GaitTiming | None = None,
+    ):
+        base = env.unwrapped
+        for name in ("ditch", "terrain", "start_x", "params", "command_low", "command_high"):
+            if not hasattr(base, name):
+                raise ValueError(
+                    f"UpuGaitPolicy needs a HexapodDitchCrossing env; {type(base).__name__} has "
+                    f"no attribute {name!r}"
+                )
+        self.env = base
+        self.settings = settings or base.gait_settings
+        self.timing = timing or base.gait_timing
+        self.read = ObservationReader(base.observation_structure)
+        self._center = (base.command_low + base.command_high) / 2
+        self._half = (base.command_high - base.command_low) / 2
+        self._dtype = env.action_space.dtype
+        self._planned_for: tuple | None = None
+        self.plan: GaitPlan | None = None
+        self.schedule: GaitSchedule | None = None
+        self.reset()
+
+    # --- planning ----------------------------------------------------------------------
+    def _course(self) -> tuple:
+        e = self.env
+        d = e.ditch
+        return (e.terrain, d.start_x, d.width, d.depth, e.start_x, e.control_dt)
+
+    def _ensure_plan(self) -> None:
+        """(Re)plan when the env's course differs from the one planned for (ditch geometry is
+        sampled at env.reset(), which may come before or after this policy's reset())."""
+        course = self._course()
+        if course == self._planned_for:
+            return
+        e = self.env
+        terrain, start_x, width, depth, x0, control_dt = course
+        ditch = Ditch(start_x, width, depth)
+        if terrain == "flat":
+            self.plan = plan_flat_past(e.params, ditch.end_x, x0, self.settings)
+        else:
+            self.plan = plan_ditch_crossing(e.params, ditch, x0, self.settings)
+        self.schedule = GaitSchedule(self.plan, e.params, control_dt, self.timing)
+        self._planned_for = course
+        self.tick = 0
+
+    @property
+    def status(self) -> str:
+        """The planner's verdict: "ok", "too_deep", "too_wide" or "no_plan"."""
+        self._ensure_plan()
+        return self.plan.status
+
+    @property
+    def reason(self) -> str:
+        """Why the plan is what it is (number of steps, or what makes the ditch impassable)."""
+        self._ensure_plan()
+        return self.plan.reason
+
+    # --- the policy interface ----------------------------------------------------------
+    def reset(self) -> None:
+        self.tick = 0
+        """Next row of the schedule to play."""
+        self.waiting = False
+        """True while the last call held its command at an unmet gate."""
+        self.waits = 0
+        """Control steps spent waiting at gates since reset()."""
+        self._planned_for = None
+
+    def _gate_met(self, gate: Checkpoint, contact: np.ndarray) -> bool:
+        down = [bool(contact[_LEG_INDEX[leg]]) for leg in gate.legs]
+        return all(down) if gate.state == "down" else not any(down)
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        self._ensure_plan()
+        obs = self.read(observation)
+        contact = obs["foot_contact"] > 0.5
+        gate = self.schedule.gate(self.tick)
+        self.waiting = gate is not None and not self._gate_met(gate, contact)
+        if self.waiting:
+            command = self.schedule.command(self.tick - 1)  # hold (gates follow hold phases)
+            self.waits += 1
+        else:
+            command = self.schedule.command(self.tick)
+            self.tick += 1
+        if self.env.action_mode == "residual":
+            reference = self._center + self._half * obs["reference_action"]
+            action = (command - reference) / (self.env.residual_scale * self._half)
+        else:
+            action = (command - self._center) / self._half
+        return np.clip(action, -1.0, 1.0).astype(self._dtype)

@@ -1,0 +1,60 @@
+"""HexapodDitchCrossing-v0 speed: raw mj_step rate vs the env's rate with substeps counted.
+
+Target (issue 5): env/raw ratio >= 0.9, both measured over the same motion (the reference gait
+walking toward and into the ditch; see `benchmarks.common.replay_step_rate`). Also prints the
+cost of the env's per-step stability work and of planning at reset. Run:
+    python benchmarks/bench_ditch_crossing.py
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run as a script from anywhere
+
+import hexapod_envs  # noqa: F401
+from benchmarks.common import env_vs_raw, per_call_us
+from hexapod_envs.envs.ditch_crossing import DitchCrossingEnv
+from hexapod_envs.robots.upu.gait_plan import Ditch, plan_ditch_crossing
+from hexapod_envs.robots.upu.params import UpuParams
+
+ENV_ID = "HexapodDitchCrossing-v0"
+
+
+def main() -> None:
+    print(f"{'env':32s} {'raw mj_step/s':>14s} {'env physics steps/s':>20s} {'env/raw':>8s}")
+    for label, kwargs in (
+        ("HexapodDitchCrossing-v0", {}),
+        ("  terrain='flat'", {"terrain": "flat"}),
+    ):
+        raw, env_rate = env_vs_raw(ENV_ID, steps=1500, **kwargs)
+        print(f"{label:32s} {raw:14.0f} {env_rate:20.0f} {env_rate / raw:8.3f}")
+
+    env = DitchCrossingEnv()
+    env.reset(seed=0)
+    for _ in range(300):
+        env.step(np.zeros(9))
+    rows = (
+        ("stability update (forces, FASM, static margin)", env._update_stability, ()),
+        ("observation vector", env._observation, ()),
+        ("info dict", env._info, ({}, False)),
+    )
+    for label, fn, args in rows:
+        print(f"{label:48s} {per_call_us(fn, *args):6.1f} us per control step")
+
+    params = UpuParams()
+    start = time.perf_counter()
+    plan_ditch_crossing(params, Ditch(0.6, 0.33, 0.12))
+    cold = time.perf_counter() - start
+    start = time.perf_counter()
+    plan_ditch_crossing(params, Ditch(0.6, 0.31, 0.13))
+    warm = time.perf_counter() - start
+    print(f"ditch plan at reset: {cold * 1e3:.0f} ms cold, {warm * 1e3:.0f} ms warm")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,466 @@
+"""HexapodDitchCrossing-v0: the 3-UPU parallel-mechanism hexapod walks forward across a ditch.
+
+Seed 003 §6-7 (Li et al., Robotics 2018): the robot walks with the "3-3" gait, one platform
+standing on its three legs while the other lifts its legs, travels along a quadratic path
+(eqs. 19-21) and lands; strides are at most l_max1 = 160 mm (eq. 17) and are shortened near
+the ditch, and legs extend into it (Fig. 13). The default ditch is the paper's: 140 mm deep,
+350 mm wide, its near edge 0.6 m ahead of the robot's centre (front feet at x = 0.2 m).
+``terrain="flat"`` removes the ditch and keeps the same finish line.
+
+The env carries a reference gait: the plan of `hexapod_envs.robots.upu.gait_plan` for the
+episode's terrain (made at reset, after any randomisation), timed by
+`hexapod_envs.robots.upu.gait_schedule`. A ditch the mechanism cannot cross gets no plan: the
+reference stands still and ``info["planner_status"]`` says why ("too_deep", "too_wide",
+"no_plan").
+
+| Observation piece | size | unit |
+|---|---|---|
+| joint_pos | 9 | limb lengths l_1..l_3, then leg extensions U1..L3 (+ = longer) [m] |
+| joint_vel | 9 | [m/s], same order |
+| foot_force | 18 | ground reaction on each foot (U1..L3), world frame [N] |
+| foot_contact | 6 | 1 when the foot's pressure switch reads > contact_threshold x weight |
+| fasm_margin_deg | 1 | force-angle stability margin of the loaded feet [deg] (0 with < 3) |
+| static_margin_m | 1 | CoG projection to the loaded feet's support polygon [m] (0 with < 3) |
+| imu_gyro | 3 | lower-platform angular velocity [rad/s] |
+| imu_accel | 3 | accelerometer [m/s²] |
+| imu_quat | 4 | lower-platform orientation (w, x, y, z) |
+| reference_action | 9 | the reference gait's command now, normalised like a "joint" action |
+
+The CoG is that of the kinematic model with the known masses (MuJoCo's subtree centre of mass,
+which is exactly that), so static_margin_m is the paper's d of Fig. 5 (eqs. 12-14).
+
+Actions: 9 values in [-1, 1], in the order of joint_pos. ``action_mode="joint"``: each is a
+target normalised over its range (limb length over [l_min, l_max] = [0.365, 0.465] m, leg
+extension over [-leg_retract, leg_extend] = [-0.08, 0.16] m). ``"residual"`` (default): an
+offset from the reference gait's target of residual_scale x the half range; the zero action
+walks (and crosses) with the reference gait.
+
+| Reward term (info key) | meaning |
+|---|---|
+| reward_progress | progress_weight x CoG speed along x [m/s] |
+| reward_stability | stability_weight x clip(static_margin_m / 0.1 m, -1, 1) (0.1 m = rho/2) |
+| reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
+| reward_effort | -effort_weight x sum of |actuator power| / (robot weight x 0.1 m/s) |
+
+The episode ends (terminated) when the robot tips over (body tilt > tip_over_angle_deg) or
+succeeds: every foot past the far edge of the ditch (the finish line on flat ground), all six
+feet loaded, not tipped. `info`: the reward terms, fasm_margin_deg, static_margin_m,
+stance_legs, is_tipping (static_margin_m <= 0: the CoG projection is not inside the loaded
+feet's polygon), is_tipped_over, is_success, sim_unstable, distance (CoG advance [m]), tilt_deg,
+planner_status, planner_reason, ditch (start_x, width, depth [m]; None on flat ground),
+finish_x [m], gait_step and gait_phase (the reference's plan step and phase), time, cog.
+"""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+from gymnasium import spaces
+
+from ..robots.upu.gait_plan import (
+    Ditch,
+    GaitPlan,
+    GaitSettings,
+    plan_ditch_crossing,
+    plan_flat_past,
+)
+from ..robots.upu.gait_schedule import COMMAND_NAMES, GaitSchedule, GaitTiming
+from ..robots.upu.model import add_upu
+from ..robots.upu.params import LEG_NAMES, UpuParams
+from ..stability import static_stability_margin
+from ..terrain.ditch import add_ditch
+from ..terrain.flat import add_flat
+from .base import HexapodEnv
+from .heavy_duty import fasm_from_feet
+from .sensors import RobotSensors
+
+TERRAINS = ("ditch", "flat")
+ACTION_MODES = ("joint", "residual")
+GRAVITY = 9.81
+_RANGE_KWARGS = ("ditch_start_x_range", "ditch_width_range", "ditch_depth_range")
+
+
+def _check_range(name: str, value) -> tuple[float, float] | None:
+    if value is None:
+        return None
+    try:
+        lo, hi = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be None or a (low, high) pair [m], got {value!r}") from None
+    if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
+        raise ValueError(f"{name} must be a finite (low, high) pair with low <= high, got {value}")
+    return (lo, hi)
+
+
+class DitchCrossingEnv(HexapodEnv):
+    """The 3-UPU hexapod crossing a ditch (or walking on flat ground); see the module docstring.
+
+    Keyword arguments (SI units): terrain ("ditch" | "flat"); ditch_start_x, ditch_width,
+    ditch_depth [m] (defaults 0.6, 0.35, 0.14); ditch_start_x_range, ditch_width_range,
+    ditch_depth_range ((low, high) [m] or None): when given, sampled uniformly from np_random at
+    every reset; action_mode ("residual" | "joint"), residual_scale; control_dt, physics_dt [s];
+    progress_weight, stability_weight, tip_over_penalty, effort_weight; contact_threshold
+    (fraction of the weight); tip_over_angle_deg; reset_noise_scale [m]; friction;
+    gait_timing (GaitTiming), gait_settings (GaitSettings), params (UpuParams); rendering:
+    render_mode, width, height, camera_name (default the tracking camera "track").
+    """
+
+    def __init__(
+        self,
+        *,
+        terrain: str = "ditch",
+        ditch_start_x: float = 0.6,
+        ditch_width: float = 0.35,
+        ditch_depth: float = 0.14,
+        ditch_start_x_range: tuple[float, float] | None = None,
+        ditch_width_range: tuple[float, float] | None = None,
+        ditch_depth_range: tuple[float, float] | None = None,
+        action_mode: str = "residual",
+        residual_scale: float = 0.25,
+        control_dt: float = 0.1,
+        physics_dt: float = 0.002,
+        progress_weight: float = 20.0,
+        stability_weight: float = 0.25,
+        tip_over_penalty: float = 100.0,
+        effort_weight: float = 0.02,
+        contact_threshold: float = 0.005,
+        tip_over_angle_deg: float = 20.0,
+        reset_noise_scale: float = 0.002,
+        friction: float = 1.0,
+        gait_timing: GaitTiming | None = None,
+        gait_settings: GaitSettings | None = None,
+        params: UpuParams | None = None,
+        render_mode: str | None = None,
+        width: int = 640,
+        height: int = 480,
+        camera_name: str | None = "track",
+    ):
+        super().__init__(
+            control_dt=control_dt,
+            physics_dt=physics_dt,
+            render_mode=render_mode,
+            width=width,
+            height=height,
+            camera_name=camera_name,
+        )
+        if terrain not in TERRAINS:
+            raise ValueError(f"terrain must be one of {TERRAINS}, got {terrain!r}")
+        if action_mode not in ACTION_MODES:
+            raise ValueError(f"action_mode must be one of {ACTION_MODES}, got {action_mode!r}")
+        if not (math.isfinite(residual_scale) and residual_scale > 0):
+            raise ValueError(f"residual_scale must be a finite number > 0, got {residual_scale}")
+        if not 0 < contact_threshold < 1:
+            raise ValueError(f"contact_threshold must be in (0, 1), got {contact_threshold}")
+        if not 0 < tip_over_angle_deg < 90:
+            raise ValueError(f"tip_over_angle_deg must be in (0, 90), got {tip_over_angle_deg}")
+        if not (math.isfinite(reset_noise_scale) and reset_noise_scale >= 0):
+            raise ValueError(f"reset_noise_scale must be >= 0 m, got {reset_noise_scale}")
+        self.terrain = terrain
+        self.action_mode = action_mode
+        self.residual_scale = residual_scale
+        self.params = params or UpuParams()
+        self.gait_timing = gait_timing or GaitTiming()
+        self.gait_settings = gait_settings or GaitSettings()
+        self.friction = friction
+        self.reset_noise_scale = reset_noise_scale
+        self.weights = {
+            "progress": progress_weight,
+            "stability": stability_weight,
+            "tip_over": tip_over_penalty,
+            "effort": effort_weight,
+        }
+        self.ditch_ranges = {
+            name.removesuffix("_range"): _check_range(name, value)
+            for name, value in zip(
+                _RANGE_KWARGS,
+                (ditch_start_x_range, ditch_width_range, ditch_depth_range),
+                strict=True,
+            )
+        }
+        self.ditch_defaults = {
+            "ditch_start_x": ditch_start_x,
+            "ditch_width": ditch_width,
+            "ditch_depth": ditch_depth,
+        }
+        self.start_x = 0.0
+        """World x of both platform centres at the start [m]."""
+        self._check_geometry(ditch_start_x, ditch_width, ditch_depth)
+        for key, rng in self.ditch_ranges.items():
+            if rng is not None:
+                values = dict(self.ditch_defaults)
+                for v in rng:
+                    values[key] = v
+                    self._check_geometry(**values)
+        self.ditch = Ditch(ditch_start_x, ditch_width, ditch_depth)
+        """The episode's ditch geometry (public: a controller that knows the ditch, as the
+        paper's robot does, plans from it). On flat ground it marks the finish line only."""
+
+        p = self.params
+        self.weight_n = p.total_mass * GRAVITY
+        self.contact_force = contact_threshold * self.weight_n
+        """Normal force above which a foot counts as in contact [N]."""
+        self.tip_over_cos = math.cos(math.radians(tip_over_angle_deg))
+        self.inradius = p.support_inradius
+        low = np.array([p.limb_min] * 3 + [p.extension_range[0]] * 6)
+        high = np.array([p.limb_max] * 3 + [p.extension_range[1]] * 6)
+        self.command_low, self.command_high = low, high
+        self._center = (low + high) / 2
+        self._half = (high - low) / 2
+        self._residual_gain = residual_scale * self._half
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(len(COMMAND_NAMES),), dtype=np.float32)
+        self._reference_power = self.weight_n * 0.1
+        self._inv_dt = 1.0 / control_dt
+        self._plans: dict[tuple, GaitPlan] = {}
+        self._built_for: tuple | None = None
+        self._build(self.ditch)
+        self._set_observation_layout(
+            {
+                "joint_pos": 9,
+                "joint_vel": 9,
+                "foot_force": 18,
+                "foot_contact": 6,
+                "fasm_margin_deg": 1,
+                "static_margin_m": 1,
+                "imu_gyro": 3,
+                "imu_accel": 3,
+                "imu_quat": 4,
+                "reference_action": 9,
+            }
+        )
+        self._set_plan(self.ditch)
+
+    # --- geometry, model, plan -----------------------------------------------------------------
+    def _check_geometry(self, ditch_start_x: float, ditch_width: float, ditch_depth: float):
+        Ditch(ditch_start_x, ditch_width, ditch_depth)  # finite, width and depth > 0
+        band = self.params.foot_radius + 0.001
+        front = self.start_x + self.params.leg_circle_radius
+        if ditch_start_x - band < front:
+            raise ValueError(
+                f"ditch_start_x = {ditch_start_x} m puts the ditch under the robot: its front "
+                f"feet stand at x = {front} m, so the ditch must start beyond "
+                f"{front + band:.3f} m"
+            )
+
+    @property
+    def finish_x(self) -> float:
+        """x every foot (sphere included) must pass for success: the ditch's far edge [m]."""
+        return self.ditch.end_x
+
+    def _geometry_key(self, ditch: Ditch) -> tuple:
+        return (ditch.start_x, ditch.width, ditch.depth) if self.terrain == "ditch" else ()
+
+    def _build(self, ditch: Ditch) -> None:
+        key = self._geometry_key(ditch)
+        if key == self._built_for:
+            return
+        spec = mujoco.MjSpec()
+        spec.compiler.degree = False  # MjSpec defaults to degrees; the builders use radians
+        spec.modelname = type(self).__name__
+        if self.terrain == "ditch":
+            add_ditch(spec, ditch.start_x, ditch.width, ditch.depth, friction=self.friction)
+        else:
+            add_flat(spec, friction=self.friction)
+        p = self.params
+        self.handles = add_upu(
+            spec, p, pos=(self.start_x, 0.0, p.lower_leg_length + 0.001), command="interpolated"
+        )
+        self._compile(spec)
+        self._built_for = key
+        m = self.model
+        self.sensors = RobotSensors(m, self.data, LEG_NAMES, COMMAND_NAMES)
+        self._act = np.array([m.actuator(name).id for name in COMMAND_NAMES])
+        self._act_state = m.actuator_actadr[self._act]  # servo targets (interpolated commands)
+        self._foot_body = np.array([m.body(f"{leg}_foot").id for leg in LEG_NAMES])
+        self._foot_weight = np.array(
+            [0.0, 0.0, p.foot_mass * GRAVITY]
+        )  # added to -sensor (see model.py)
+        self._leg_qpos = np.array(
+            [m.jnt_qposadr[m.joint(self.handles.leg_joint(leg)).id] for leg in LEG_NAMES]
+        )
+        self._upper_qpos = np.array(
+            [m.jnt_qposadr[m.joint(j).id] for j in self.handles.upper_joints]
+        )
+        self._torso = m.body("torso").id
+        self._touch = np.array(
+            [m.sensor_adr[m.sensor(name).id] for name in self.handles.foot_touch_sensors]
+        )
+
+    def _plan_for(self, ditch: Ditch) -> GaitPlan:
+        key = self._geometry_key(ditch) or ("flat", ditch.end_x)
+        if key not in self._plans:
+            p, s = self.params, self.gait_settings
+            if self.terrain == "ditch":
+                plan = plan_ditch_crossing(p, ditch, self.start_x, s)
+            else:
+                plan = plan_flat_past(p, ditch.end_x, self.start_x, s)
+            if len(self._plans) > 256:  # randomised geometry: keep the cache bounded
+                self._plans.clear()
+            self._plans[key] = plan
+        return self._plans[key]
+
+    def _set_plan(self, ditch: Ditch) -> None:
+        self.plan = self._plan_for(ditch)
+        """The reference gait's plan for the current episode (`GaitPlan`)."""
+        self.schedule = GaitSchedule(self.plan, self.params, self.control_dt, self.gait_timing)
+        """The reference gait's timed commands (`GaitSchedule`)."""
+        self._reference_actions = np.clip(
+            (self.schedule.commands - self._center) / self._half, -1.0, 1.0
+        )
+
+    def _sample_ditch(self) -> Ditch:
+        values = dict(self.ditch_defaults)
+        for key in ("ditch_start_x", "ditch_width", "ditch_depth"):
+            rng = self.ditch_ranges[key]
+            if rng is not None:
+                values[key] = float(self.np_random.uniform(rng[0], rng[1]))
+        return Ditch(values["ditch_start_x"], values["ditch_width"], values["ditch_depth"])
+
+    # --- reset / step ------------------------------------------------------------------------
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        super().reset(seed=seed)
+        if any(r is not None for r in self.ditch_ranges.values()):
+            self.ditch = self._sample_ditch()
+            self._build(self.ditch)
+            self._set_plan(self.ditch)
+        m, d = self.model, self.data
+        mujoco.mj_resetData(m, d)
+        noise = self.reset_noise_scale
+        if noise > 0:
+            d.qpos[self._leg_qpos] += self.np_random.uniform(-noise, noise, 6)
+            d.qpos[self._upper_qpos] += self.np_random.uniform(-noise, noise, 3)
+        d.act[self._act_state] = self.schedule.command(0)
+        d.ctrl[self._act] = 0.0
+        mujoco.mj_forward(m, d)
+        # Settle onto the feet under the standing command (not part of the episode).
+        for _ in range(int(round(0.5 / self.control_dt))):
+            self._simulate()
+        self._tick = 0
+        self._tipped = False
+        self._success = False
+        self._prev_cog_x = float(self.sensors.cog()[0])
+        self._start_cog_x = self._prev_cog_x
+        self._update_stability()
+        self._last_obs = self._observation()
+        return self._last_obs, self._info({}, unstable=False)
+
+    def reference_command(self, tick: int | None = None) -> np.ndarray:
+        """The reference gait's command (`COMMAND_NAMES`, [m]) at control step `tick` (default:
+        the current one)."""
+        return self.schedule.command(self._tick if tick is None else tick)
+
+    def step(self, action):
+        action = self._validate_action(action, self.action_space)
+        if self.action_mode == "joint":
+            target = self._center + self._half * action
+        else:
+            target = self.schedule.command(self._tick) + self._residual_gain * action
+        # Interpolated commands: the servo targets (act) move linearly to `target` during the
+        # control period; MuJoCo clamps the rate to the speed limits, the target to the ranges.
+        d = self.data
+        d.ctrl[self._act] = (target - d.act[self._act_state]) * self._inv_dt
+        stable = self._simulate()
+        self._tick += 1
+        if not stable:
+            return self._last_obs, 0.0, False, True, self._info({}, unstable=True)
+        self._update_stability()
+        tipped = self.data.xmat[self._torso, 8] < self.tip_over_cos
+        self._tipped = self._tipped or bool(tipped)
+        self._success = not self._tipped and self._all_feet_past_finish()
+        cog_x = float(self.sensors.cog()[0])
+        terms = self._reward_terms(cog_x, bool(tipped))
+        self._prev_cog_x = cog_x
+        self._last_obs = self._observation()
+        reward = terms["progress"] + terms["stability"] + terms["tip_over"] + terms["effort"]
+        terminated = bool(tipped) or self._success
+        return self._last_obs, reward, terminated, False, self._info(terms, unstable=False)
+
+    # --- measurements ------------------------------------------------------------------------
+    def _update_stability(self) -> None:
+        forces = self.sensors.foot_forces() + self._foot_weight
+        self._forces = forces
+        # The per-leg pressure switch (paper §2): the touch sensor's normal contact force, free
+        # of the foot's own inertia that the 3-D force sensor also measures.
+        self._loaded = self.data.sensordata[self._touch] > self.contact_force
+        soles = self.data.xpos[self._foot_body]
+        cog = self.sensors.cog()
+        self._fasm_deg, _ = fasm_from_feet(soles, forces, cog, self._loaded)
+        self._static_margin = 0.0
+        if self._loaded.sum() >= 3:
+            try:
+                self._static_margin = static_stability_margin(soles[self._loaded], cog)
+            except ValueError:  # loaded feet on a line: no polygon
+                self._static_margin = 0.0
+
+    def _all_feet_past_finish(self) -> bool:
+        if not self._loaded.all():
+            return False
+        rear = self.data.xpos[self._foot_body, 0].min() - self.params.foot_radius
+        return bool(rear > self.finish_x)
+
+    def _observation_pieces(self) -> dict[str, np.ndarray]:
+        s = self.sensors
+        return {
+            "joint_pos": s.joint_positions(),
+            "joint_vel": s.joint_velocities(),
+            "foot_force": self._forces.reshape(-1),
+            "foot_contact": self._loaded,
+            "fasm_margin_deg": self._fasm_deg,
+            "static_margin_m": self._static_margin,
+            "imu_gyro": s.gyro(),
+            "imu_accel": s.accelerometer(),
+            "imu_quat": s.orientation(),
+            "reference_action": self._reference_actions[
+                min(self._tick, len(self._reference_actions) - 1)
+            ],
+        }
+
+    def _reward_terms(self, cog_x: float, tipped: bool) -> dict[str, float]:
+        w = self.weights
+        speed = (cog_x - self._prev_cog_x) / self.control_dt
+        r = self.inradius
+        margin = min(max(self._static_margin, -r), r) / r
+        power = float(
+            np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
+        )
+        return {
+            "progress": w["progress"] * speed,
+            "stability": w["stability"] * margin,
+            "tip_over": -w["tip_over"] if tipped else 0.0,
+            "effort": -w["effort"] * power / self._reference_power,
+        }
+
+    def _info(self, terms: dict[str, float], unstable: bool) -> dict:
+        step, phase = self.schedule.phase(self._tick)
+        cog = self.sensors.cog()
+        up_z = min(1.0, max(-1.0, float(self.data.xmat[self._torso, 8])))
+        info = {f"reward_{name}": value for name, value in terms.items()}
+        info.update(
+            fasm_margin_deg=self._fasm_deg,
+            static_margin_m=self._static_margin,
+            stance_legs=tuple(leg for leg, on in zip(LEG_NAMES, self._loaded, strict=True) if on),
+            is_tipping=self._static_margin <= 0.0,
+            is_tipped_over=self._tipped,
+            is_success=self._success and not unstable,
+            sim_unstable=unstable,
+            distance=float(cog[0]) - self._start_cog_x,
+            tilt_deg=math.degrees(math.acos(up_z)),
+            planner_status=self.plan.status,
+            planner_reason=self.plan.reason,
+            ditch=(
+                {
+                    "start_x": self.ditch.start_x,
+                    "width": self.ditch.width,
+                    "depth": self.ditch.depth,
+                }
+                if self.terrain == "ditch"
+                else None
+            ),
+            finish_x=self.finish_x,
+            gait_step=step,
+            gait_phase=phase,
+            time=self._tick * self.control_dt,
+            cog=cog.copy(),
+        )
+        return info

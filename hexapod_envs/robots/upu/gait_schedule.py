@@ -1,0 +1,235 @@
+"""Timed actuator commands of a 3-UPU gait plan (seed 003 §6, Fig. 7), pure numpy.
+
+`GaitSchedule` samples a `GaitPlan` at the control period: each platform step runs six phases,
+
+| phase | what moves | ends when |
+|---|---|---|
+| unload | the moving legs retract by `GaitTiming.unload_retract`, slowly (1) | time |
+| lift | the moving legs retract on to `swing_extension` (feet leave the ground) | time |
+| unloaded | nothing (the robot settles on the supporting tripod) | gate: moving feet off |
+| transfer | the limbs carry the moving platform along the quadratic path (eqs. 19-21) | time |
+| settle | nothing | time |
+| land | the moving legs extend to their landing extensions (the ditch depth in the ditch) | time |
+| loaded | nothing (six-leg support) | gate: moving feet down |
+
+(1) so that the robot's weight passes to the supporting tripod without rocking it.
+
+Ramps use the quintic (minimum-jerk) profile 10a^3 - 15a^4 + 6a^5: zero velocity and
+acceleration at both ends. The transfer's ends are where the CoG sits nearest a side of the
+support triangle, so ending without acceleration keeps the inertial shift of the zero-moment
+point away from the margin's minimum.
+
+The command vector is `COMMAND_NAMES`: the three limb lengths [m] then the six leg extensions
+[m] (``U1 U2 U3 L1 L2 L3``), the order of `UpuHandles.actuators`. The schedule itself is open
+loop; the gates are checkpoints (`Checkpoint`) that a closed-loop executor (the gait policy)
+waits at until the foot contacts confirm them. Used by the env's reference gait and by
+`agents.upu_gait.UpuGaitPolicy`, so both play exactly the same commands.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from .gait_plan import GaitPlan
+from .kinematics import inverse_kinematics
+from .params import LEG_NAMES, LIMB_NAMES, PLATFORM_LEGS, UpuParams
+
+COMMAND_NAMES: tuple[str, ...] = LIMB_NAMES + tuple(f"{leg}_extend" for leg in LEG_NAMES)
+"""Order of a command vector: limb lengths l_1..l_3 [m], then leg extensions U1..L3 [m]."""
+
+PHASES: tuple[str, ...] = ("unload", "lift", "unloaded", "transfer", "settle", "land", "loaded")
+"""Phases of one platform step, in order (see the module docstring)."""
+
+GATES: dict[str, str] = {"unloaded": "off", "loaded": "down"}
+"""Phase -> the moving feet's required contact state before the next phase may start."""
+
+_LEG_INDEX = {leg: 3 + i for i, leg in enumerate(LEG_NAMES)}
+
+
+def quintic(a):
+    """Minimum-jerk profile 10a^3 - 15a^4 + 6a^5 on [0, 1] (clipped outside)."""
+    a = np.clip(a, 0.0, 1.0)
+    return a * a * a * (10.0 - 15.0 * a + 6.0 * a * a)
+
+
+@dataclass(frozen=True)
+class GaitTiming:
+    """Duration of each phase of a platform step [s] (see `PHASES`), and the unload stroke."""
+
+    unload: float = 0.4
+    lift: float = 0.8
+    unloaded: float = 0.2
+    transfer: float = 2.5
+    settle: float = 0.3
+    land: float = 0.6
+    loaded: float = 0.3
+    unload_retract: float = 0.005
+    """How far the moving legs retract during 'unload' [m]: a few mm take the load off the
+    feet (leg servo and contact compliance are < 2 mm); retracting them at the lift's pace
+    drops the load within ~0.1 s and rocks the robot on its supporting tripod."""
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = getattr(self, f.name)
+            if not (math.isfinite(value) and value > 0):
+                unit = "m" if f.name == "unload_retract" else "s"
+                raise ValueError(
+                    f"GaitTiming.{f.name} must be a finite number > 0 {unit}, got {value}"
+                )
+
+    @property
+    def durations(self) -> tuple[float, ...]:
+        """Phase durations in `PHASES` order [s]."""
+        return tuple(getattr(self, name) for name in PHASES)
+
+    @property
+    def step_duration(self) -> float:
+        """One platform step [s] (half a gait cycle)."""
+        return sum(self.durations)
+
+
+@dataclass(frozen=True)
+class Checkpoint:
+    """A gate of the schedule: the command row `tick` may only be played once the `legs` are
+    `state` ('off' the ground or 'down' on it)."""
+
+    tick: int
+    step: int
+    state: str
+    legs: tuple[str, ...]
+
+
+def raise_to_limb_min(poses, params: UpuParams, moving: str) -> np.ndarray:
+    """`poses` (..., 3) with |z| raised just enough that no limb is shorter than l_min [m].
+
+    The paper's gait height (363 mm, eqs. 20-21) leaves limbs 2 and 3 up to 0.7 mm short of
+    l_min near x = Delta/2 (see `UpuParams.initial_height`). Clipping those lengths instead
+    would move the platform along x, by ~10x the clipped amount because the limbs are nearly
+    vertical: ~5 mm per step, which adds up over a ditch crossing. Raising the pose keeps x.
+    """
+    q = np.array(poses, dtype=float)
+    sign = 1.0 if moving == "upper" else -1.0
+    v = q[..., None, :] * sign + params.upper_hooke_points - params.lower_hooke_points
+    horizontal_sq = v[..., 0] ** 2 + v[..., 1] ** 2
+    z_min = np.sqrt(np.maximum(params.limb_min**2 - horizontal_sq, 0.0).max(axis=-1))
+    q[..., 2] = np.sign(q[..., 2]) * np.maximum(np.abs(q[..., 2]), z_min)
+    return q
+
+
+def standing_command(params: UpuParams) -> np.ndarray:
+    """Command vector of the initial stance: upper platform at (0, 0, initial_height), legs at
+    nominal length (limb lengths clipped to their range, as the MuJoCo servos clip them)."""
+    limbs = inverse_kinematics(params.initial_position, params)
+    return np.concatenate([np.clip(limbs, params.limb_min, params.limb_max), np.zeros(6)])
+
+
+class GaitSchedule:
+    """The commands of `plan` at every control step (row k is played during control step k).
+
+    A plan that is not ``ok`` (or has no steps) gives a one-row schedule that stands still.
+    After the last row the robot holds the last command (`command` clamps the tick).
+    """
+
+    def __init__(
+        self,
+        plan: GaitPlan,
+        params: UpuParams,
+        control_dt: float,
+        timing: GaitTiming | None = None,
+    ):
+        if not (math.isfinite(control_dt) and control_dt > 0):
+            raise ValueError(f"control_dt must be a finite number > 0 s, got {control_dt}")
+        self.plan, self.params, self.control_dt = plan, params, control_dt
+        self.timing = timing or GaitTiming()
+        ticks = [max(1, int(round(d / control_dt))) for d in self.timing.durations]
+        self.phase_ticks: tuple[int, ...] = tuple(ticks)
+        rows, steps, phases, checkpoints = [], [], [], []
+        current = standing_command(params)
+        if plan.ok:
+            for k, step in enumerate(plan.steps):
+                legs = PLATFORM_LEGS[step.moving]
+                cols = [_LEG_INDEX[leg] for leg in legs]
+                start_ext = current[cols].copy()
+                swing = np.full(3, step.swing_extension)
+                unloaded = np.maximum(start_ext - self.timing.unload_retract, swing)
+                landing = np.array([step.landing_extension[leg] for leg in legs])
+                poses = _transfer_poses(step, params, ticks[PHASES.index("transfer")])
+                limbs = np.clip(
+                    inverse_kinematics(
+                        raise_to_limb_min(poses, params, step.moving), params, moving=step.moving
+                    ),
+                    params.limb_min,
+                    params.limb_max,
+                )
+                for p, (name, n) in enumerate(zip(PHASES, ticks, strict=True)):
+                    block = np.repeat(current[None, :], n, axis=0)
+                    a = quintic(np.arange(1, n + 1) / n)[:, None]
+                    if name == "unload":
+                        block[:, cols] = start_ext + (unloaded - start_ext) * a
+                    elif name == "lift":
+                        block[:, cols] = unloaded + (swing - unloaded) * a
+                    elif name == "transfer":
+                        block[:, :3] = limbs
+                    elif name == "land":
+                        block[:, cols] = swing + (landing - swing) * a
+                    current = block[-1].copy()
+                    if name in GATES and not (name == "loaded" and k == len(plan.steps) - 1):
+                        checkpoints.append(Checkpoint(len(rows) + n, k, GATES[name], legs))
+                    rows.extend(block)
+                    steps.extend([k] * n)
+                    phases.extend([p] * n)
+        if not rows:
+            rows, steps, phases = [current], [-1], [-1]
+        self.commands = np.array(rows)
+        """(n_ticks, 9) command rows [m], columns `COMMAND_NAMES`."""
+        self.step_index = np.array(steps, dtype=int)
+        """(n_ticks,) plan step of each row (-1: standing without a plan)."""
+        self.phase_index = np.array(phases, dtype=int)
+        """(n_ticks,) index into `PHASES` of each row (-1: standing without a plan)."""
+        self.checkpoints: tuple[Checkpoint, ...] = tuple(checkpoints)
+        self._gate_at = {c.tick: c for c in checkpoints}
+
+    @property
+    def n_ticks(self) -> int:
+        return len(self.commands)
+
+    @property
+    def duration(self) -> float:
+        """Length of the schedule [s] (without gate waits)."""
+        return self.n_ticks * self.control_dt
+
+    def command(self, tick: int) -> np.ndarray:
+        """Command row of control step `tick` (the last row after the end; read-only view)."""
+        return self.commands[min(max(tick, 0), self.n_ticks - 1)]
+
+    def gate(self, tick: int) -> Checkpoint | None:
+        """The checkpoint that must hold before row `tick` is played, if any."""
+        return self._gate_at.get(tick)
+
+    def phase(self, tick: int) -> tuple[int, str]:
+        """(plan step, phase name) of control step `tick`; (-1, 'stand') without a plan and
+        (last step, 'done') after the end."""
+        if tick >= self.n_ticks:
+            return (int(self.step_index[-1]), "done")
+        i = int(self.phase_index[max(tick, 0)])
+        return (int(self.step_index[max(tick, 0)]), PHASES[i] if i >= 0 else "stand")
+
+    def support(self, tick: int) -> str:
+        """Legs carrying the robot at control step `tick` by the plan: 'upper' or 'lower' (the
+        supporting tripod, from the moving legs' lift-off until they touch down at the end of
+        'land') or 'all' (six legs: 'loaded', standing, done)."""
+        step, phase = self.phase(tick)
+        if step < 0 or phase in ("done", "stand", "loaded"):
+            return "all"
+        return self.plan.steps[step].support
+
+
+def _transfer_poses(step, params: UpuParams, n: int) -> np.ndarray:
+    """(n, 3) relative poses of the moving platform along its path, quintic in x [m]."""
+    path = step.path(params)
+    a = quintic(np.arange(1, n + 1) / n)
+    x = path.x_start + (path.x_end - path.x_start) * a
+    return np.column_stack([x, np.zeros(n), path.z(x)])
