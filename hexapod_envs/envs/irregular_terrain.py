@@ -5,7 +5,7 @@ gait of eqs. (19)-(23) (t_g = 1 s per phase, control at 20 Hz) over
 
 | terrain | what | robot starts |
 |---|---|---|
-| ``"ramp"`` | 10° slope along +x (`ramp_slope_deg`), 3 m run, flat top | on the slope (1) |
+| ``"ramp"`` | 10° slope along +x (`ramp_slope_deg`), 4.5 m run, flat top | on the slope (1) |
 | ``"blocks"`` | test bed: grid of `block_size` blocks 0.04-0.13 m high | on the bed (2) |
 | ``"flat"`` | plain ground | on the ground |
 
@@ -129,7 +129,7 @@ class IrregularTerrainEnv(HexapodEnv):
         friction: float = PAPER_FRICTION,
         ramp_slope_deg: float = 10.0,
         ramp_start_x: float = -0.4,
-        ramp_length: float = 3.0,
+        ramp_length: float = 4.5,
         block_height_range: tuple[float, float] = (0.04, 0.13),
         block_size: tuple[float, float] = (0.1, 0.1),
         block_region: tuple[tuple[float, float], tuple[float, float]] = (

@@ -1,0 +1,267 @@
+"""HexapodIrregularTerrain-v0: env contract for every terrain and action mode, the gains mode's
+cycle-start rule, per-cycle statistics, torso contact, start poses and bad input."""
+
+import math
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.utils.env_checker import check_env as gym_check_env
+from stable_baselines3.common.env_checker import check_env as sb3_check_env
+
+import hexapod_envs  # noqa: F401  (registers the env ids)
+from agents.athena_policy import AthenaPosturePolicy, analytical_policy
+from agents.registry import analytical_factory
+from hexapod_envs.robots.athena.kinematics import standing_foot_positions
+from hexapod_envs.robots.athena.params import ATHENA
+from hexapod_envs.stability import zmp_margin
+
+ENV_ID = "HexapodIrregularTerrain-v0"
+TERRAINS = ("ramp", "blocks", "flat")
+
+
+@pytest.mark.parametrize("terrain", TERRAINS)
+def test_gymnasium_and_sb3_checkers_pass(terrain):
+    env = gym.make(ENV_ID, terrain=terrain)
+    gym_check_env(env.unwrapped, skip_render_check=True)
+    sb3_check_env(env.unwrapped, warn=True)
+    env.close()
+
+
+@pytest.mark.parametrize("mode", ["joint", "gains"])
+def test_checkers_pass_in_the_other_action_modes(mode):
+    env = gym.make(ENV_ID, terrain="blocks", action_mode=mode)
+    gym_check_env(env.unwrapped, skip_render_check=True)
+    sb3_check_env(env.unwrapped, warn=True)
+    env.close()
+
+
+def _rollout(terrain, seed, steps=60, mode="residual"):
+    env = gym.make(ENV_ID, terrain=terrain, action_mode=mode)
+    obs, _ = env.reset(seed=seed)
+    env.action_space.seed(5)
+    trace = [obs]
+    for _ in range(steps):
+        obs, reward, *_ = env.step(env.action_space.sample())
+        trace.append(np.append(obs, reward))
+    heights = env.unwrapped.terrain_info.heights.copy() if terrain == "blocks" else None
+    env.close()
+    return np.concatenate(trace), heights
+
+
+@pytest.mark.parametrize("terrain", TERRAINS)
+def test_same_seed_same_trajectory(terrain):
+    a, heights_a = _rollout(terrain, seed=11)
+    b, heights_b = _rollout(terrain, seed=11)
+    np.testing.assert_array_equal(a, b)
+    if terrain == "blocks":
+        np.testing.assert_array_equal(heights_a, heights_b)
+
+
+def test_each_seed_draws_its_own_block_bed_unless_the_layout_is_fixed():
+    env = gym.make(ENV_ID, terrain="blocks")
+    env.reset(seed=1)
+    first = env.unwrapped.terrain_info.heights.copy()
+    env.reset(seed=2)
+    second = env.unwrapped.terrain_info.heights
+    assert not np.array_equal(first, second)
+    assert first.min() >= 0.04 and first.max() <= 0.13
+    fixed = gym.make(ENV_ID, terrain="blocks", block_layout_seed=7)
+    fixed.reset(seed=1)
+    bed = fixed.unwrapped.terrain_info.heights.copy()
+    fixed.reset(seed=2)
+    np.testing.assert_array_equal(bed, fixed.unwrapped.terrain_info.heights)
+
+
+@pytest.mark.parametrize("terrain", TERRAINS)
+def test_observation_info_and_reward_terms(terrain):
+    env = gym.make(ENV_ID, terrain=terrain, action_mode="gains")
+    base = env.unwrapped
+    obs, info = env.reset(seed=0)
+    structure = base.observation_structure
+    expected = {"joint_pos", "joint_vel", "foot_force", "foot_contact", "fasm_margin_deg"}
+    expected |= {"imu_gyro", "imu_accel", "imu_quat", "torso_height", "gait_phase"}
+    assert expected | {"posture_gains"} == set(structure)
+    policy = AthenaPosturePolicy(env, kz=0.6, ka=0.4, kb=0.4)
+    policy.reset()
+    cycles = []
+    for _ in range(200):
+        obs, reward, terminated, truncated, info = env.step(policy(obs))
+        assert env.observation_space.contains(obs) and np.all(np.isfinite(obs))
+        terms = {k: v for k, v in info.items() if k.startswith("reward_")}
+        assert set(terms) == {f"reward_{n}" for n in base.weights}
+        assert reward == pytest.approx(sum(terms.values()))
+        assert info["zmp_margin"] >= 0.0 and info["pitch_rate"] == obs[structure["imu_gyro"]][1]
+        if info["cycle_stats"] is not None:
+            cycles.append(info["cycle_stats"])
+        assert not terminated and not truncated
+    # Cycles of 2 t_g = 40 steps (more when a landing leg has to be extended to the ground).
+    assert len(cycles) >= 2 and [c["index"] for c in cycles] == list(range(len(cycles)))
+    assert all(c["steps"] >= base.ticks_per_cycle for c in cycles)
+    first = cycles[0]
+    assert first["gains"] == pytest.approx((0.6, 0.4, 0.4))
+    assert 0.03 < first["height_rms"] < 0.25 and first["pitch_rate_rms"] >= 0.0
+    assert info["distance"] > 0.05  # it walks forward
+    assert obs[structure["posture_gains"]] == pytest.approx([0.6, 0.4, 0.4])
+
+
+def test_gains_are_applied_only_at_gait_cycle_starts():
+    env = gym.make(ENV_ID, terrain="flat", action_mode="gains")
+    base = env.unwrapped
+    phase = base.observation_structure["gait_phase"]
+    obs, _ = env.reset(seed=0)
+    rng = np.random.default_rng(0)
+    applied = []
+    for _ in range(3 * base.ticks_per_cycle):
+        starts_cycle = obs[phase][2] == 1.0
+        action = rng.uniform(0, 1, 3).astype(np.float32)
+        obs, *_, info = env.step(action)
+        if starts_cycle:
+            applied.append(action.astype(float))
+            assert info["posture_gains"] == pytest.approx(tuple(action))
+        else:
+            assert info["posture_gains"] == pytest.approx(tuple(applied[-1]))
+    assert len(applied) == 3
+
+
+def test_policy_gives_the_same_walk_in_every_action_mode():
+    """The env's internal controller (gains, residual) and the policy's own (joint) agree."""
+
+    def walk(mode):
+        env = gym.make(ENV_ID, terrain="ramp", action_mode=mode)
+        policy = AthenaPosturePolicy(env, kz=0.8, ka=0.6, kb=0.0)
+        obs, _ = env.reset(seed=3)
+        policy.reset()
+        cog = []
+        for _ in range(100):
+            obs, *_, info = env.step(policy(obs))
+            cog.append(info["cog"])
+        return np.array(cog)
+
+    gains = walk("gains")
+    assert gains[-1, 0] - gains[0, 0] > 0.2
+    np.testing.assert_allclose(walk("joint"), gains, atol=1e-6)  # float32 joint actions
+    np.testing.assert_allclose(walk("residual"), gains, atol=1e-6)
+
+
+def test_zero_residual_walks_the_reference_gait_with_the_reference_gains():
+    def walk(**kwargs):
+        env = gym.make(ENV_ID, terrain="flat", **kwargs)
+        obs, _ = env.reset(seed=0)
+        for _ in range(60):
+            obs, *_, info = env.step(np.zeros(env.action_space.shape, np.float32))
+        return info["cog"]
+
+    simple = walk(action_mode="residual")
+    np.testing.assert_array_equal(simple, walk(action_mode="gains"))  # gains (0, 0, 0)
+    assert not np.array_equal(simple, walk(action_mode="residual", reference_gains=(1, 0, 0)))
+
+
+def test_analytical_policy_is_registered_with_the_papers_gains():
+    env = gym.make(ENV_ID, terrain="blocks", action_mode="gains")
+    assert analytical_factory(ENV_ID) is analytical_policy
+    policy = analytical_factory(ENV_ID)(env)
+    obs, _ = env.reset(seed=0)
+    assert policy(obs) == pytest.approx([0.6, 0.4, 0.4])
+
+
+def test_flat_start_standing_height_clearance_and_zmp():
+    env = gym.make(ENV_ID, terrain="flat")
+    _, info = env.reset(seed=0)
+    base = env.unwrapped
+    assert info["torso_height"] == pytest.approx(ATHENA.standing_torso_height, abs=0.006)
+    assert info["torso_clearance"] == pytest.approx(0.104 - 0.028, abs=0.006)
+    assert len(info["stance_legs"]) == 6 and not info["torso_contact"]
+    # Six feet equally loaded around the torso: the ZMP sits near the centre and its margin is
+    # that of the standing hexagon (eq. 33), within the settling asymmetry.
+    feet = standing_foot_positions()
+    assert np.linalg.norm(info["zmp"]) < 0.01
+    assert info["zmp_margin"] == pytest.approx(zmp_margin(feet, np.ones(6)), abs=0.01)
+    assert info["fasm_margin_deg"] > 30.0
+    assert (
+        base.observation_structure["torso_height"].stop
+        - base.observation_structure["torso_height"].start
+        == 1
+    )
+
+
+def test_ramp_start_on_the_slope_and_on_the_approach():
+    env = gym.make(ENV_ID, terrain="ramp")
+    _, info = env.reset(seed=0)
+    rot = env.unwrapped.data.xmat[env.unwrapped.sensors.torso_id].reshape(3, 3)
+    nose_up = math.degrees(math.asin(rot[2, 0]))
+    assert nose_up == pytest.approx(10.0, abs=1.0)  # parallel to the slope
+    assert len(info["stance_legs"]) == 6
+    assert info["torso_height"] == pytest.approx(ATHENA.standing_torso_height, abs=0.006)
+    env = gym.make(ENV_ID, terrain="ramp", ramp_start_x=0.5)
+    env.reset(seed=0)
+    rot = env.unwrapped.data.xmat[env.unwrapped.sensors.torso_id].reshape(3, 3)
+    assert abs(math.degrees(math.asin(rot[2, 0]))) < 1.0
+
+
+def test_blocks_start_resting_on_the_bed():
+    env = gym.make(ENV_ID, terrain="blocks")
+    _, info = env.reset(seed=4)
+    assert len(info["stance_legs"]) >= 3 and not info["torso_contact"]
+    assert info["cog"][2] > 0.04 + 0.08  # above the lowest blocks, not on the floor
+
+
+def test_torso_contact_is_detected_and_penalised():
+    """Legs folded up in joint mode: the torso drops onto the ground."""
+    env = gym.make(ENV_ID, terrain="flat", action_mode="joint", collision_penalty=2.0)
+    env.reset(seed=0)
+    base = env.unwrapped
+    up = base.action_map.to_action(np.tile([0.0, 1.4, -1.5 * math.pi / 2], 6))
+    infos = [env.step(up.astype(np.float32))[-1] for _ in range(30)]
+    touched = [i for i in infos if i["torso_contact"]]
+    assert touched and touched[-1]["reward_torso_collision"] == -2.0
+    assert infos[-1]["torso_collisions"] == len(touched)
+    assert not infos[-1]["is_success"]
+    assert infos[-1]["torso_clearance"] < 0.005
+
+
+def test_unstable_simulation_truncates_with_a_flag():
+    env = gym.make(ENV_ID, terrain="flat")
+    env.reset(seed=0)
+    env.unwrapped.data.qvel[:] = 1e12
+    _, reward, terminated, truncated, info = env.step(np.zeros(18, np.float32))
+    assert truncated and not terminated and info["sim_unstable"] and reward == 0.0
+    assert not info["is_success"]
+
+
+def test_nan_action_is_a_clear_error():
+    env = gym.make(ENV_ID, action_mode="gains")
+    env.reset(seed=0)
+    with pytest.raises(ValueError, match=r"NaN.*\[1\]"):
+        env.step(np.array([0.5, np.nan, 0.0]))
+
+
+def test_unknown_keyword_is_named_with_valid_choices():
+    with pytest.raises(TypeError, match=r"swing_hieght.*valid.*swing_height"):
+        gym.make(ENV_ID, swing_hieght=0.1)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"terrain": "ice"}, "blocks"),
+        ({"action_mode": "torque"}, "gains"),
+        ({"ramp_start_x": 0.0}, "under the robot"),
+        ({"reference_gains": (0.5, 1.5, 0.0)}, "k_alpha"),
+        ({"reference_gains": (0.5,)}, "k_z, k_alpha, k_beta"),
+        ({"physics_dt": 0.003}, "whole multiple"),
+        ({"physics_dt": 0.05 / 12}, "multiple of 5"),
+        ({"servo_kp": 0.0}, "servo_kp"),
+        ({"gait_start_from": "guess"}, "measured_height"),
+        ({"phase_time": 0.33}, "whole number"),
+    ],
+)
+def test_bad_choices_list_the_valid_ones(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        gym.make(ENV_ID, **kwargs)
+
+
+def test_policy_rejects_gains_outside_the_unit_interval():
+    env = gym.make(ENV_ID, action_mode="gains")
+    with pytest.raises(ValueError, match="kz"):
+        AthenaPosturePolicy(env, kz=1.2)
