@@ -20,7 +20,7 @@ frame) and the IMU, and works in the body frame:
 5. **Touch-down**: if the trajectory ends without ground contact, the foot keeps descending along
    the plane normal at `touchdown_speed` until its force sensor reports contact (the ground may
    lie lower than the plane fitted through the feet) or `max_search_depth` is exhausted
-   (then the attempt is declared failed and the leg is pulled back).
+   (then the attempt has failed, the leg is pulled back and the posture held).
 6. **Force distribution** (§4.3, eqs. 16-24) once the leg has landed: the desired wrench from the
    accelerometer (low-pass filtered specific force, F_b = m (a_b - g_b)) and the gyro
    (T_b = I ω̇ + ω × I ω); the QP with friction, minimum normal force and stability cone solved
@@ -78,9 +78,10 @@ from hexapod_envs.robots.heavy_duty.kinematics import joints_for_foot
 from hexapod_envs.robots.heavy_duty.params import LEG_NAMES, HeavyDutyParams
 from hexapod_envs.stability import fasm
 
-PHASES: tuple[str, ...] = ("monitor", "swing", "touchdown", "supported", "failed")
+PHASES: tuple[str, ...] = ("monitor", "swing", "touchdown", "supported", "holding")
 """Controller phases: watching the margin; adjustment leg on its quintic; descending until
-contact; landed and distributing forces; no ground found or no usable adjustment leg."""
+contact; landed and distributing forces; holding the posture without a landed adjustment leg
+(no usable leg, no reachable ground, or no ground found: ``diagnostics["failure"]`` says which)."""
 
 _LEG_INDEX = {leg: i for i, leg in enumerate(LEG_NAMES)}
 _RETRY_NARROWER = 25  # QP solves between attempts at a narrower stability cone
@@ -105,7 +106,8 @@ class RecoveryConfig:
         contact_fraction: a foot carrying more than this fraction of the robot's weight is in
             contact (the envs use 0.02).
         force_gain: integral gain of the force-offset loop per control period, in (0, 1].
-        max_offset: clamp on the force offsets [J_x m, J_z m, J_θ rad] (actuator units).
+        max_offset: clamp on the force offsets [J_x m, J_z m, J_θ rad] (actuator units; the
+            default allows 40 kN along x, 64 kN along the leg, 2e5 N·m about the swing axis).
         accel_filter_time: time constant of the low-pass on accelerometer and gyro [s].
         qp_period: solve the QP every this many control periods (1 = every period).
         cone_ratios: λ values tried in turn when the stability cone makes the QP infeasible
@@ -132,7 +134,7 @@ class RecoveryConfig:
     max_search_depth: float = 0.5
     contact_fraction: float = 0.02
     force_gain: float = 0.5
-    max_offset: tuple[float, float, float] = (0.02, 0.02, 0.02)
+    max_offset: tuple[float, float, float] = (0.004, 0.004, 0.004)
     accel_filter_time: float = 0.2
     qp_period: int = 1
     cone_ratios: tuple[float, ...] = (0.65, 0.8, 0.95)
@@ -272,6 +274,7 @@ class TippingRecoveryController:
             "planned_forces": None,
             "measured_forces": None,
             "qp_status": None,
+            "qp_legs": None,
             "qp_cone_ratio": None,
             "qp_wrench_residual": None,
             "failure": None,
@@ -353,7 +356,7 @@ class TippingRecoveryController:
         if self.phase == "touchdown":
             self._touchdown(time, targets, loaded)
         if self.phase == "supported":
-            self._supported(time, targets, joints, feet, forces, cog, rot)
+            self._supported(targets, joints, feet, forces, cog, rot, loaded)
         d["phase"] = self.phase
         return np.clip(targets, self._j_low, self._j_high)
 
@@ -378,7 +381,7 @@ class TippingRecoveryController:
 
     def _judge(self, time, margin, joints, feet, forces, loaded, nominal, reading) -> None:
         cfg, d = self.config, self.diagnostics
-        self.phase = "failed"  # until a plan exists
+        self.phase = "holding"  # until a plan exists
         self._t0 = time
         self._nominal = np.asarray(nominal, dtype=float).reshape(6, 3).copy()
         stance = tuple(leg for leg, on in zip(LEG_NAMES, loaded, strict=True) if on)
@@ -473,7 +476,7 @@ class TippingRecoveryController:
         position = self._choice.foothold - depth * self._choice.plane.normal
         reachable = self._command_leg(targets, position)
         if depth > self.config.max_search_depth or not reachable:
-            self.phase = "failed"
+            self.phase = "holding"
             self.diagnostics["failure"] = (
                 f"no ground under {self._leg} within {depth:.2f} m below the fitted plane"
             )
@@ -485,7 +488,7 @@ class TippingRecoveryController:
         i = _LEG_INDEX[self._leg]
         self._landing_joints = self._ik(self._leg, self._command)
         self._nominal[i] = self._landing_joints
-        self._offsets = np.zeros((len(self._support), 3))
+        self._offsets = np.zeros((6, 3))
         self.phase = "supported"
         d.update(
             landing_time=time,
@@ -532,31 +535,38 @@ class TippingRecoveryController:
         self._last_qp_a = None if qp is None else qp.A
         return result, (ladder[level] if level < len(ladder) else math.nan)
 
-    def _supported(self, time, targets, joints, feet, forces, cog, rot) -> None:
+    def _supported(self, targets, joints, feet, forces, cog, rot, loaded) -> None:
+        """Distribute the forces over the supporting feet that are in contact and make the
+        plan's internal part act through the servo stiffness (see the module docstring)."""
         cfg, d = self.config, self.diagnostics
-        support = self._support
+        # Contact is unilateral: a support foot that has lifted off cannot be loaded by pushing
+        # it (that would only tilt the body), so the plan covers the feet in contact, and the
+        # offsets are only adjusted while every support foot is loaded (the stiffness model
+        # assumes feet held by the ground).
+        support = [i for i in self._support if loaded[i]]
+        complete = len(support) == len(self._support)
         self._steps_supported += 1
-        if (self._steps_supported - 1) % cfg.qp_period == 0:
+        d["qp_legs"] = tuple(LEG_NAMES[i] for i in support)
+        d["measured_forces"] = forces[support].copy()
+        if len(support) < 3:
+            d.update(qp_status="too_few_feet", planned_forces=None)
+        elif (self._steps_supported - 1) % cfg.qp_period == 0:
             feet_k = feet[support]
             if self._inertia is None:  # the posture is held from here on: compute it once
                 self._inertia = self.body.inertia(joints, cog)
-            inertia = self._inertia
             g_body = gravity_in_body(rot)
-            omega = self._gyro_f
-            omega_dot = (self._gyro_f - self._gyro_prev) / self.control_dt
             wrench = desired_wrench(
                 self.body.total_mass,
-                inertia,
+                self._inertia,
                 g_body,
                 accel_body=self._accel_f + g_body,
-                omega=omega,
-                omega_dot=omega_dot,
+                omega=self._gyro_f,
+                omega_dot=(self._gyro_f - self._gyro_prev) / self.control_dt,
             )
             normal = terrain_plane(feet_k).normal
             result, cone_ratio = self._solve_qp(feet_k, cog, wrench, normal)
             self._last_qp = result
             d["qp_cone_ratio"] = cone_ratio
-            measured = forces[support]
             if result is None:
                 d.update(qp_status="degenerate_geometry", planned_forces=None)
             else:
@@ -565,21 +575,21 @@ class TippingRecoveryController:
                     planned_forces=result.forces.copy(),
                     qp_wrench_residual=result.wrench_residual.copy(),
                 )
-            d["measured_forces"] = measured.copy()
-            if result is not None and result.ok and cfg.force_control:
+            if result is not None and result.ok and cfg.force_control and complete:
                 # Internal part: error - Aᵀ (A Aᵀ)⁻¹ A error (A has full row rank, k >= 3).
                 a_mat = self._last_qp_a
-                error = (result.forces - measured).reshape(-1)
+                error = (result.forces - forces[support]).reshape(-1)
                 internal = error - a_mat.T @ np.linalg.solve(a_mat @ a_mat.T, a_mat @ error)
                 change = self.body.target_change_for_force(
                     joints, internal.reshape(-1, 3), legs=support
                 )
-                self._offsets = np.clip(
-                    self._offsets + cfg.force_gain * change, -self._max_offset, self._max_offset
+                self._offsets[support] = np.clip(
+                    self._offsets[support] + cfg.force_gain * change,
+                    -self._max_offset,
+                    self._max_offset,
                 )
-        else:
-            d["measured_forces"] = forces[support].copy()
-        targets[support] = self._nominal[support] + self._offsets
+        held = self._support
+        targets[held] = self._nominal[held] + self._offsets[held]
 
 
 class TippingRecoveryPolicy:

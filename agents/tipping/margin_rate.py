@@ -31,6 +31,11 @@ class MarginHistory:
     def __len__(self) -> int:
         return len(self._t)
 
+    @property
+    def margins(self) -> np.ndarray:
+        """The margins [deg] in the window, oldest first."""
+        return np.asarray(self._s)
+
     def add(self, time: float, margin_deg: float) -> None:
         """Append a sample; samples older than the window are dropped."""
         if self._t and time <= self._t[-1]:
