@@ -18,7 +18,7 @@ recovery controller, the robot tips over.
 
 | Reward term (info key) | meaning |
 |---|---|
-| reward_forward | forward_weight x CoG speed along x [m/s] |
+| reward_forward | forward_weight x min(CoG speed along x, gait speed) / gait speed |
 | reward_stability | stability_weight x clip(FASM, -20, 45) / 45 |
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
 | reward_effort | -effort_weight x sum of |joint power| / (weight x gait speed) |
