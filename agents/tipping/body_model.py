@@ -102,15 +102,15 @@ class HeavyDutyBodyModel:
         p = self.params
         return LegState(p.k_x * j[:, 0], p.k_z * j[:, 1] + p.l2, j[:, 2].copy())
 
-    def _rotate(self, y: np.ndarray, z: np.ndarray, theta: np.ndarray) -> np.ndarray:
-        c, s = np.cos(theta), np.sin(theta)
-        return np.stack([y * c - z * s, y * s + z * c], axis=-1)
-
     def feet(self, joints: np.ndarray) -> np.ndarray:
         """(6, 3) sole points in the body frame [m] (eq. 1 plus the hip offsets)."""
         q = self.leg_state(joints)
-        yz = self._rotate(self.l1, -q.d, q.theta)
-        return self.hips + np.column_stack([q.x, yz])
+        c, s = np.cos(q.theta), np.sin(q.theta)
+        out = self.hips.copy()
+        out[:, 0] += q.x
+        out[:, 1] += self.l1 * c + q.d * s
+        out[:, 2] += self.l1 * s - q.d * c
+        return out
 
     def foot_velocities(self, joints: np.ndarray, joint_velocities: np.ndarray) -> np.ndarray:
         """(6, 3) sole velocities relative to the body [m/s] from encoder rates."""

@@ -358,7 +358,7 @@ class TippingRecoveryController:
         if self.phase == "supported":
             self._supported(targets, joints, feet, forces, cog, rot, loaded)
         d["phase"] = self.phase
-        return np.clip(targets, self._j_low, self._j_high)
+        return np.minimum(np.maximum(targets, self._j_low), self._j_high)
 
     # --- judgment and planning -------------------------------------------------------------
     def _pick_leg(self, edge: tuple[str, str], stance: tuple[str, ...], feet: np.ndarray):
@@ -583,10 +583,9 @@ class TippingRecoveryController:
                 change = self.body.target_change_for_force(
                     joints, internal.reshape(-1, 3), legs=support
                 )
-                self._offsets[support] = np.clip(
-                    self._offsets[support] + cfg.force_gain * change,
-                    -self._max_offset,
-                    self._max_offset,
+                updated = self._offsets[support] + cfg.force_gain * change
+                self._offsets[support] = np.minimum(
+                    np.maximum(updated, -self._max_offset), self._max_offset
                 )
         held = self._support
         targets[held] = self._nominal[held] + self._offsets[held]
