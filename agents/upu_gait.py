@@ -75,8 +75,9 @@ class UpuGaitPolicy:
         self._half = (base.command_high - base.command_low) / 2
         self._dtype = env.action_space.dtype
         self._planned_for: tuple | None = None
-        self.plan: GaitPlan | None = None
-        self.schedule: GaitSchedule | None = None
+        self._cache: dict[tuple, tuple[GaitPlan, GaitSchedule]] = {}
+        self._plan: GaitPlan | None = None
+        self._schedule: GaitSchedule | None = None
         self.reset()
 
     # --- planning ----------------------------------------------------------------------
@@ -94,24 +95,38 @@ class UpuGaitPolicy:
         e = self.env
         terrain, start_x, width, depth, x0, control_dt = course
         ditch = Ditch(start_x, width, depth)
-        if terrain == "flat":
-            self.plan = plan_flat_past(e.params, ditch.end_x, x0, self.settings)
-        else:
-            self.plan = plan_ditch_crossing(e.params, ditch, x0, self.settings)
-        self.schedule = GaitSchedule(self.plan, e.params, control_dt, self.timing)
+        if course not in self._cache:
+            if terrain == "flat":
+                plan = plan_flat_past(e.params, ditch.end_x, x0, self.settings)
+            else:
+                plan = plan_ditch_crossing(e.params, ditch, x0, self.settings)
+            if len(self._cache) >= 64:  # randomised ditches: keep the cache bounded
+                self._cache.clear()
+            self._cache[course] = (plan, GaitSchedule(plan, e.params, control_dt, self.timing))
+        self._plan, self._schedule = self._cache[course]
         self._planned_for = course
         self.tick = 0
 
     @property
+    def plan(self) -> GaitPlan:
+        """The plan for the env's current course (made on first use after a change)."""
+        self._ensure_plan()
+        return self._plan
+
+    @property
+    def schedule(self) -> GaitSchedule:
+        """The timed commands of `plan`."""
+        self._ensure_plan()
+        return self._schedule
+
+    @property
     def status(self) -> str:
         """The planner's verdict: "ok", "too_deep", "too_wide" or "no_plan"."""
-        self._ensure_plan()
         return self.plan.status
 
     @property
     def reason(self) -> str:
         """Why the plan is what it is (number of steps, or what makes the ditch impassable)."""
-        self._ensure_plan()
         return self.plan.reason
 
     # --- the policy interface ----------------------------------------------------------
@@ -129,16 +144,16 @@ class UpuGaitPolicy:
         return all(down) if gate.state == "down" else not any(down)
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:
-        self._ensure_plan()
+        sched = self.schedule
         obs = self.read(observation)
         contact = obs["foot_contact"] > 0.5
-        gate = self.schedule.gate(self.tick)
+        gate = sched.gate(self.tick)
         self.waiting = gate is not None and not self._gate_met(gate, contact)
         if self.waiting:
-            command = self.schedule.command(self.tick - 1)  # hold (gates follow hold phases)
+            command = sched.command(self.tick - 1)  # hold (gates follow hold phases)
             self.waits += 1
         else:
-            command = self.schedule.command(self.tick)
+            command = sched.command(self.tick)
             self.tick += 1
         if self.env.action_mode == "residual":
             reference = self._center + self._half * obs["reference_action"]

@@ -232,3 +232,47 @@ def test_lift_setting_overrides_paper_apex():
     assert plan.steps[1].swing_extension == pytest.approx(-0.08)
     with pytest.raises(ValueError, match="lift"):
         GaitSettings(lift=-0.01)
+
+
+def test_statuses_when_the_step_over_search_fails():
+    """Deep ditches wider than the 3-3 gait can step over (~75 mm with the hexagonal foot
+    pattern) are "too_deep"; shallow ones too narrow for a foot and too wide to step over are
+    "too_wide"; a reachable flat bottom is crossable at any width."""
+    deep = plan_ditch_crossing(P, Ditch(0.6, 0.08, 0.3))
+    assert deep.status == "too_deep" and "too wide to step over" in deep.reason
+    narrow = plan_ditch_crossing(P, Ditch(0.6, 0.08, 0.05))
+    assert narrow.status == "too_wide" and "too narrow" in narrow.reason
+    assert plan_ditch_crossing(P, Ditch(0.6, 0.07, 0.3)).ok  # stepped over
+    wide = plan_ditch_crossing(P, Ditch(0.6, 1.0, 0.14))
+    assert wide.ok and "standing in the ditch" in wide.reason
+
+
+def test_transfer_margin_minimum_is_at_an_end():
+    """The planner evaluates the margin at the ends of a transfer only: the CoG moves on a line
+    and the margin is concave along it. Dense sampling agrees."""
+    from hexapod_envs.robots.upu.gait_plan import _transfer_margin
+
+    for moving, x0, x1 in (("upper", 0.0, 0.16), ("upper", 0.04, 0.12), ("lower", -0.16, 0.0)):
+        dense = min(
+            stance_margin(P, *((x, 0.0) if moving == "upper" else (0.0, x)), support=support)
+            for x in np.linspace(x0, x1, 201)
+            for support in ["lower" if moving == "upper" else "upper"]
+        )
+        assert _transfer_margin(P, moving, x0, x1) == pytest.approx(dense, abs=1e-12)
+
+
+def test_feasible_lift_matches_brute_force():
+    from hexapod_envs.robots.upu.gait_plan import _feasible_lift
+    from hexapod_envs.robots.upu.kinematics import inside_limits
+
+    settings = GaitSettings()
+    for x0, x1 in ((0.0, 0.16), (0.1, 0.16), (0.0, 0.05)):
+        lift = _feasible_lift(P, settings, "upper", x0, x1)
+        brute = None
+        for candidate in np.linspace(0.08, 0.0, 81):
+            pts = step_path(x0, x1, P.initial_height, float(candidate)).sample(21)
+            poses = np.column_stack([pts[:, 0], np.zeros(21), pts[:, 1]])
+            if np.all(inside_limits(poses, P)):
+                brute = float(candidate)
+                break
+        assert lift == pytest.approx(brute)

@@ -66,10 +66,16 @@ from ..robots.upu.gait_plan import (
     plan_ditch_crossing,
     plan_flat_past,
 )
-from ..robots.upu.gait_schedule import COMMAND_NAMES, GaitSchedule, GaitTiming
+from ..robots.upu.gait_schedule import (
+    COMMAND_NAMES,
+    GaitSchedule,
+    GaitTiming,
+    standing_command,
+    walking_height,
+)
 from ..robots.upu.model import add_upu
 from ..robots.upu.params import LEG_NAMES, UpuParams
-from ..stability import static_stability_margin
+from ..stability._geometry import hull_2d, signed_distance_2d
 from ..terrain.ditch import add_ditch
 from ..terrain.flat import add_flat
 from .base import HexapodEnv
@@ -94,6 +100,14 @@ def _check_range(name: str, value) -> tuple[float, float] | None:
     return (lo, hi)
 
 
+def _as_slice(index: np.ndarray):
+    """A contiguous ascending index array as a slice (a view instead of a copy), else as is."""
+    index = np.asarray(index)
+    if index.size and np.array_equal(index, np.arange(index[0], index[0] + index.size)):
+        return slice(int(index[0]), int(index[0]) + index.size)
+    return index
+
+
 class DitchCrossingEnv(HexapodEnv):
     """The 3-UPU hexapod crossing a ditch (or walking on flat ground); see the module docstring.
 
@@ -102,7 +116,9 @@ class DitchCrossingEnv(HexapodEnv):
     ditch_depth_range ((low, high) [m] or None): when given, sampled uniformly from np_random at
     every reset; action_mode ("residual" | "joint"), residual_scale; control_dt, physics_dt [s];
     progress_weight, stability_weight, tip_over_penalty, effort_weight; contact_threshold
-    (fraction of the weight); tip_over_angle_deg; reset_noise_scale [m]; friction;
+    (fraction of the weight); tip_over_angle_deg; reset_noise_scale [m] (the robot starts
+    shifted by up to this along x and y, and turned so that its feet move up to this much);
+    friction;
     gait_timing (GaitTiming), gait_settings (GaitSettings), params (UpuParams); rendering:
     render_mode, width, height, camera_name (default the tracking camera "track").
     """
@@ -127,7 +143,7 @@ class DitchCrossingEnv(HexapodEnv):
         effort_weight: float = 0.02,
         contact_threshold: float = 0.005,
         tip_over_angle_deg: float = 20.0,
-        reset_noise_scale: float = 0.002,
+        reset_noise_scale: float = 0.005,
         friction: float = 1.0,
         gait_timing: GaitTiming | None = None,
         gait_settings: GaitSettings | None = None,
@@ -270,9 +286,13 @@ class DitchCrossingEnv(HexapodEnv):
         self._built_for = key
         m = self.model
         self.sensors = RobotSensors(m, self.data, LEG_NAMES, COMMAND_NAMES)
-        self._act = np.array([m.actuator(name).id for name in COMMAND_NAMES])
-        self._act_state = m.actuator_actadr[self._act]  # servo targets (interpolated commands)
+        self._act = _as_slice(np.array([m.actuator(name).id for name in COMMAND_NAMES]))
+        # Servo targets of the interpolated commands (MuJoCo activations).
+        self._act_state = _as_slice(m.actuator_actadr[self._act])
         self._foot_body = np.array([m.body(f"{leg}_foot").id for leg in LEG_NAMES])
+        self._force_idx = np.array(
+            [m.sensor_adr[m.sensor(f"{leg}_foot_force").id] + np.arange(3) for leg in LEG_NAMES]
+        )
         self._foot_weight = np.array(
             [0.0, 0.0, p.foot_mass * GRAVITY]
         )  # added to -sensor (see model.py)
@@ -283,6 +303,7 @@ class DitchCrossingEnv(HexapodEnv):
             [m.jnt_qposadr[m.joint(j).id] for j in self.handles.upper_joints]
         )
         self._torso = m.body("torso").id
+        self._root_qpos = int(m.jnt_qposadr[m.joint(self.handles.root_joint).id])
         self._touch = np.array(
             [m.sensor_adr[m.sensor(name).id] for name in self.handles.foot_touch_sensors]
         )
@@ -309,6 +330,12 @@ class DitchCrossingEnv(HexapodEnv):
             (self.schedule.commands - self._center) / self._half, -1.0, 1.0
         )
 
+    @property
+    def _ditch_info(self) -> dict | None:
+        if self.terrain != "ditch":
+            return None
+        return {"start_x": self.ditch.start_x, "width": self.ditch.width, "depth": self.ditch.depth}
+
     def _sample_ditch(self) -> Ditch:
         values = dict(self.ditch_defaults)
         for key in ("ditch_start_x", "ditch_width", "ditch_depth"):
@@ -326,12 +353,24 @@ class DitchCrossingEnv(HexapodEnv):
             self._set_plan(self.ditch)
         m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
-        noise = self.reset_noise_scale
-        if noise > 0:
-            d.qpos[self._leg_qpos] += self.np_random.uniform(-noise, noise, 6)
-            d.qpos[self._upper_qpos] += self.np_random.uniform(-noise, noise, 3)
-        d.act[self._act_state] = self.schedule.command(0)
+        # Start in the standing pose with the servo targets at it, so nothing jumps: a limb
+        # started a few mm off its target would hit the 400 N force limit and throw the robot.
+        stand = standing_command(self.params)
+        d.act[self._act_state] = stand
         d.ctrl[self._act] = 0.0
+        d.qpos[self._leg_qpos] = stand[3:]
+        d.qpos[self._upper_qpos[2]] = walking_height(self.params) - self.params.initial_height
+        noise = self.reset_noise_scale
+        if noise > 0:  # seed-dependent start: the robot stands a little shifted and turned
+            dx, dy = self.np_random.uniform(-noise, noise, 2)
+            yaw = self.np_random.uniform(-noise, noise) / self.params.leg_circle_radius
+            d.qpos[self._root_qpos : self._root_qpos + 2] += (dx, dy)
+            d.qpos[self._root_qpos + 3 : self._root_qpos + 7] = (
+                np.cos(yaw / 2),
+                0.0,
+                0.0,
+                np.sin(yaw / 2),
+            )
         mujoco.mj_forward(m, d)
         # Settle onto the feet under the standing command (not part of the episode).
         for _ in range(int(round(0.5 / self.control_dt))):
@@ -378,20 +417,31 @@ class DitchCrossingEnv(HexapodEnv):
 
     # --- measurements ------------------------------------------------------------------------
     def _update_stability(self) -> None:
-        forces = self.sensors.foot_forces() + self._foot_weight
+        d = self.data
+        sd = d.sensordata
+        # Every foot site is parallel to its platform and the platforms stay parallel (the
+        # mechanism only translates), so one rotation takes all six force readings to the world
+        # frame. Ground reaction = -R s + m_foot g (see model.py).
+        rot = d.xmat[self._torso].reshape(3, 3)
+        forces = self._foot_weight - sd[self._force_idx] @ rot.T
         self._forces = forces
         # The per-leg pressure switch (paper §2): the touch sensor's normal contact force, free
         # of the foot's own inertia that the 3-D force sensor also measures.
-        self._loaded = self.data.sensordata[self._touch] > self.contact_force
-        soles = self.data.xpos[self._foot_body]
-        cog = self.sensors.cog()
-        self._fasm_deg, _ = fasm_from_feet(soles, forces, cog, self._loaded)
+        loaded = sd[self._touch] > self.contact_force
+        self._loaded = loaded
+        soles = d.xpos[self._foot_body]
+        cog = d.subtree_com[self._torso]
+        self._fasm_deg, _ = fasm_from_feet(soles, forces, cog, loaded)
         self._static_margin = 0.0
-        if self._loaded.sum() >= 3:
-            try:
-                self._static_margin = static_stability_margin(soles[self._loaded], cog)
+        if loaded.sum() >= 3:
+            pts = soles[loaded].tolist()
+            xs = [q[0] for q in pts]
+            ys = [q[1] for q in pts]
+            try:  # same computation as stability.static_stability_margin, gravity along -z
+                hull = hull_2d(xs, ys)
             except ValueError:  # loaded feet on a line: no polygon
-                self._static_margin = 0.0
+                return
+            self._static_margin = signed_distance_2d(xs, ys, hull, float(cog[0]), float(cog[1]))
 
     def _all_feet_past_finish(self) -> bool:
         if not self._loaded.all():
@@ -401,9 +451,10 @@ class DitchCrossingEnv(HexapodEnv):
 
     def _observation_pieces(self) -> dict[str, np.ndarray]:
         s = self.sensors
+        d = self.data
         return {
-            "joint_pos": s.joint_positions(),
-            "joint_vel": s.joint_velocities(),
+            "joint_pos": d.actuator_length[self._act],
+            "joint_vel": d.actuator_velocity[self._act],
             "foot_force": self._forces.reshape(-1),
             "foot_contact": self._loaded,
             "fasm_margin_deg": self._fasm_deg,
@@ -421,9 +472,8 @@ class DitchCrossingEnv(HexapodEnv):
         speed = (cog_x - self._prev_cog_x) / self.control_dt
         r = self.inradius
         margin = min(max(self._static_margin, -r), r) / r
-        power = float(
-            np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
-        )
+        d = self.data
+        power = float(np.abs(d.actuator_force[self._act] * d.actuator_velocity[self._act]).sum())
         return {
             "progress": w["progress"] * speed,
             "stability": w["stability"] * margin,
@@ -448,15 +498,7 @@ class DitchCrossingEnv(HexapodEnv):
             tilt_deg=math.degrees(math.acos(up_z)),
             planner_status=self.plan.status,
             planner_reason=self.plan.reason,
-            ditch=(
-                {
-                    "start_x": self.ditch.start_x,
-                    "width": self.ditch.width,
-                    "depth": self.ditch.depth,
-                }
-                if self.terrain == "ditch"
-                else None
-            ),
+            ditch=self._ditch_info,
             finish_x=self.finish_x,
             gait_step=step,
             gait_phase=phase,

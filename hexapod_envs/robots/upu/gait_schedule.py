@@ -119,11 +119,29 @@ def raise_to_limb_min(poses, params: UpuParams, moving: str) -> np.ndarray:
     return q
 
 
+def walking_height(params: UpuParams) -> float:
+    """Relative platform height the schedule walks at [m]: the paper's 363 mm raised to the
+    lowest height at which no limb is shorter than l_min anywhere on the gait's level path
+    (relative x in [0, l_max1] for the upper platform). Limbs 2 and 3 are shortest at
+    x = Delta/2, where they are sqrt(3)/2 Delta off vertical, so the height is
+    sqrt(l_min^2 - 3/4 Delta^2) = 363.74 mm for the paper's numbers (0.74 mm above its 363 mm,
+    which the paper rounds; see `UpuParams.initial_height`). Walking at one fixed height
+    keeps every step's start and end at the same relative height, so the legs' level offsets
+    do not drift from step to step."""
+    shortest = math.sqrt(max(params.limb_min**2 - 0.75 * params.delta**2, 0.0))
+    return max(params.initial_height, shortest)
+
+
 def standing_command(params: UpuParams) -> np.ndarray:
-    """Command vector of the initial stance: upper platform at (0, 0, initial_height), legs at
-    nominal length (limb lengths clipped to their range, as the MuJoCo servos clip them)."""
-    limbs = inverse_kinematics(params.initial_position, params)
-    return np.concatenate([np.clip(limbs, params.limb_min, params.limb_max), np.zeros(6)])
+    """Command vector of the initial stance: the upper platform straight above the lower one at
+    `walking_height`, the lower legs at nominal length and the upper legs longer by the
+    height's excess over the paper's 363 mm, so that all six feet stand on level ground (a
+    six-leg stance on stiff legs shares its load by sub-mm differences: 0.3 mm is ~15 N at
+    the legs' 5e4 N/m)."""
+    pose = raise_to_limb_min([0.0, 0.0, walking_height(params)], params, "upper")
+    limbs = np.clip(inverse_kinematics(pose, params), params.limb_min, params.limb_max)
+    rise = float(pose[2]) - params.initial_height
+    return np.concatenate([limbs, np.full(3, rise), np.zeros(3)])
 
 
 class GaitSchedule:
@@ -148,6 +166,11 @@ class GaitSchedule:
         self.phase_ticks: tuple[int, ...] = tuple(ticks)
         rows, steps, phases, checkpoints = [], [], [], []
         current = standing_command(params)
+        # Level offsets: extension each platform's legs need on level ground, beyond nominal,
+        # because the executed relative height differs from the paper's 363 mm (see
+        # `raise_to_limb_min`): upper - lower = relative height - initial_height.
+        level = {"upper": float(current[3]), "lower": 0.0}
+        lo, hi = params.extension_range
         if plan.ok:
             for k, step in enumerate(plan.steps):
                 legs = PLATFORM_LEGS[step.moving]
@@ -155,14 +178,21 @@ class GaitSchedule:
                 start_ext = current[cols].copy()
                 swing = np.full(3, step.swing_extension)
                 unloaded = np.maximum(start_ext - self.timing.unload_retract, swing)
-                landing = np.array([step.landing_extension[leg] for leg in legs])
-                poses = _transfer_poses(step, params, ticks[PHASES.index("transfer")])
+                poses = raise_to_limb_min(
+                    _transfer_poses(step, params, ticks[PHASES.index("transfer")]),
+                    params,
+                    step.moving,
+                )
                 limbs = np.clip(
-                    inverse_kinematics(
-                        raise_to_limb_min(poses, params, step.moving), params, moving=step.moving
-                    ),
+                    inverse_kinematics(poses, params, moving=step.moving),
                     params.limb_min,
                     params.limb_max,
+                )
+                rise = abs(float(poses[-1, 2])) - params.initial_height
+                other = "lower" if step.moving == "upper" else "upper"
+                level[step.moving] = level[other] + (rise if step.moving == "upper" else -rise)
+                landing = np.clip(
+                    [step.landing_extension[leg] + level[step.moving] for leg in legs], lo, hi
                 )
                 for p, (name, n) in enumerate(zip(PHASES, ticks, strict=True)):
                     block = np.repeat(current[None, :], n, axis=0)
@@ -213,7 +243,8 @@ class GaitSchedule:
         """(plan step, phase name) of control step `tick`; (-1, 'stand') without a plan and
         (last step, 'done') after the end."""
         if tick >= self.n_ticks:
-            return (int(self.step_index[-1]), "done")
+            last = int(self.step_index[-1])
+            return (last, "done" if last >= 0 else "stand")
         i = int(self.phase_index[max(tick, 0)])
         return (int(self.step_index[max(tick, 0)]), PHASES[i] if i >= 0 else "stand")
 
@@ -228,8 +259,11 @@ class GaitSchedule:
 
 
 def _transfer_poses(step, params: UpuParams, n: int) -> np.ndarray:
-    """(n, 3) relative poses of the moving platform along its path, quintic in x [m]."""
+    """(n, 3) relative poses of the moving platform along its path (eqs. 19-21), quintic in x,
+    shifted from the paper's height to `walking_height` [m]."""
     path = step.path(params)
     a = quintic(np.arange(1, n + 1) / n)
     x = path.x_start + (path.x_end - path.x_start) * a
-    return np.column_stack([x, np.zeros(n), path.z(x)])
+    shift = walking_height(params) - params.initial_height
+    z = path.z(x) + (shift if step.moving == "upper" else -shift)
+    return np.column_stack([x, np.zeros(n), z])

@@ -1,0 +1,186 @@
+"""HexapodDitchCrossing-v0: keyword arguments, observation layout, measurements, randomisation."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import hexapod_envs  # noqa: F401
+from hexapod_envs.envs.ditch_crossing import DitchCrossingEnv
+from hexapod_envs.robots.upu.gait_schedule import standing_command
+from hexapod_envs.robots.upu.params import LEG_NAMES, UpuParams
+from hexapod_envs.stability import static_stability_margin
+
+P = UpuParams()
+ZERO = np.zeros(9)
+
+
+def test_bad_keyword_arguments_are_named():
+    with pytest.raises(ValueError, match="terrain"):
+        DitchCrossingEnv(terrain="lava")
+    with pytest.raises(ValueError, match="action_mode"):
+        DitchCrossingEnv(action_mode="torque")
+    with pytest.raises(ValueError, match="under the robot"):
+        DitchCrossingEnv(ditch_start_x=0.15)
+    with pytest.raises(ValueError, match="ditch_width_range"):
+        DitchCrossingEnv(ditch_width_range=(0.4, 0.3))
+    with pytest.raises(ValueError, match="ditch_depth_range"):
+        DitchCrossingEnv(ditch_depth_range=0.1)
+    with pytest.raises(ValueError, match="under the robot"):
+        DitchCrossingEnv(ditch_start_x_range=(0.1, 0.6))
+    with pytest.raises(ValueError, match="width"):
+        DitchCrossingEnv(ditch_width=0.0)
+    with pytest.raises(TypeError, match="valid"):
+        DitchCrossingEnv(ditch_wdth=0.3)
+    with pytest.raises(ValueError, match="not a whole multiple"):
+        DitchCrossingEnv(control_dt=0.1, physics_dt=0.003)
+
+
+def test_observation_layout_and_reset_state():
+    env = DitchCrossingEnv()
+    obs, info = env.reset(seed=0)
+    sizes = {k: s.stop - s.start for k, s in env.observation_structure.items()}
+    assert sizes == {
+        "joint_pos": 9,
+        "joint_vel": 9,
+        "foot_force": 18,
+        "foot_contact": 6,
+        "fasm_margin_deg": 1,
+        "static_margin_m": 1,
+        "imu_gyro": 3,
+        "imu_accel": 3,
+        "imu_quat": 4,
+        "reference_action": 9,
+    }
+    o = {k: obs[s] for k, s in env.observation_structure.items()}
+    # Standing on six feet: all in contact, they carry the weight, margin = hexagon inradius-ish.
+    assert o["foot_contact"].tolist() == [1.0] * 6
+    forces = o["foot_force"].reshape(6, 3)
+    assert forces[:, 2].sum() == pytest.approx(P.total_mass * 9.81, rel=0.02)
+    assert np.abs(forces[:, :2].sum(axis=0)).max() < 0.5  # at rest: no net horizontal force
+    assert info["static_margin_m"] == o["static_margin_m"][0] > 0.15
+    assert info["fasm_margin_deg"] > 0
+    assert info["stance_legs"] == LEG_NAMES
+    np.testing.assert_allclose(o["joint_pos"][3:], 0.0, atol=2e-3)  # legs at nominal length
+    q = o["imu_quat"]  # level; turned by the seeded start yaw only
+    np.testing.assert_allclose(q[1:3], 0.0, atol=1e-4)
+    assert abs(q[3]) <= np.sin(0.5 * env.reset_noise_scale / P.leg_circle_radius) + 1e-4
+    # The reference's first row: the upper legs begin to unload from the standing pose.
+    center = (env.command_low + env.command_high) / 2
+    half = (env.command_high - env.command_low) / 2
+    first = env.reference_command()
+    np.testing.assert_allclose(o["reference_action"], (first - center) / half)
+    stand = standing_command(P)
+    np.testing.assert_allclose(first[:3], stand[:3])
+    assert np.all(first[3:6] < stand[3:6]) and np.all(stand[3:6] - first[3:6] < 0.005)
+    np.testing.assert_allclose(first[6:], stand[6:])
+    assert info["planner_status"] == "ok" and info["gait_phase"] == "unload"
+    assert info["ditch"] == {"start_x": 0.6, "width": 0.35, "depth": 0.14}
+    assert info["finish_x"] == pytest.approx(0.95)
+
+
+def test_static_margin_is_the_support_polygon_margin_of_the_loaded_feet():
+    env = DitchCrossingEnv()
+    env.reset(seed=3)
+    seen = set()
+    for _ in range(60):  # through the first lift-off: six, then three loaded feet
+        _, _, _, _, info = env.step(ZERO)
+        loaded = env._loaded
+        seen.add(int(loaded.sum()))
+        if loaded.sum() >= 3:
+            soles = env.data.xpos[env._foot_body][loaded]
+            cog = env.data.subtree_com[env._torso]
+            expected = static_stability_margin(soles, cog)
+            assert info["static_margin_m"] == pytest.approx(expected, abs=1e-12)
+        assert info["is_tipping"] == (info["static_margin_m"] <= 0)
+        assert info["stance_legs"] == tuple(
+            leg for leg, on in zip(LEG_NAMES, loaded, strict=True) if on
+        )
+    assert {3, 6} <= seen
+
+
+def test_nan_action_is_rejected():
+    env = DitchCrossingEnv()
+    env.reset(seed=0)
+    bad = ZERO.copy()
+    bad[4] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        env.step(bad)
+    with pytest.raises(ValueError, match="shape"):
+        env.step(np.zeros(6))
+
+
+def test_joint_mode_standing_action_stands_still():
+    env = DitchCrossingEnv(action_mode="joint")
+    obs, _ = env.reset(seed=0)
+    center = (env.command_low + env.command_high) / 2
+    half = (env.command_high - env.command_low) / 2
+    action = (standing_command(P) - center) / half
+    for _ in range(20):
+        obs, reward, terminated, truncated, info = env.step(action)
+    assert not (terminated or truncated)
+    assert abs(info["distance"]) < 1e-3 and info["tilt_deg"] < 0.2
+    assert len(info["stance_legs"]) == 6
+
+
+def test_ditch_randomisation_is_seeded_and_rebuilds_the_terrain():
+    kwargs = {
+        "ditch_width_range": (0.25, 0.45),
+        "ditch_depth_range": (0.08, 0.15),
+        "ditch_start_x_range": (0.5, 0.7),
+    }
+    env = DitchCrossingEnv(**kwargs)
+    seen = []
+    for seed in (1, 2, 1):
+        _, info = env.reset(seed=seed)
+        d = info["ditch"]
+        assert 0.25 <= d["width"] <= 0.45 and 0.08 <= d["depth"] <= 0.15
+        assert 0.5 <= d["start_x"] <= 0.7
+        assert info["planner_status"] == "ok"
+        floor = env.model.geom("ditch_floor")
+        assert floor.size[0] == pytest.approx(d["width"] / 2)
+        assert floor.pos[0] == pytest.approx(d["start_x"] + d["width"] / 2)
+        assert floor.pos[2] + floor.size[2] == pytest.approx(-d["depth"])
+        assert env.plan.ditch.width == d["width"]
+        seen.append(d)
+    assert seen[0] == seen[2] and seen[0] != seen[1]
+    fixed = DitchCrossingEnv()
+    _, info = fixed.reset(seed=5)
+    assert info["ditch"] == {"start_x": 0.6, "width": 0.35, "depth": 0.14}
+
+
+def test_flat_terrain_keeps_the_finish_line():
+    env = gym.make("HexapodDitchCrossing-v0", terrain="flat")
+    _, info = env.reset(seed=0)
+    base = env.unwrapped
+    assert info["ditch"] is None and info["finish_x"] == pytest.approx(0.95)
+    assert "ditch_floor" not in [base.model.geom(i).name for i in range(base.model.ngeom)]
+    assert info["planner_status"] == "ok" and "flat ground" in info["planner_reason"]
+    env.close()
+
+
+def test_impassable_ditch_reference_stands_still():
+    env = DitchCrossingEnv(ditch_depth=0.2)
+    _, info = env.reset(seed=0)
+    assert info["planner_status"] == "too_deep"
+    assert "0.160" in info["planner_reason"]
+    for _ in range(30):
+        _, _, terminated, _, info = env.step(ZERO)  # residual mode: the reference itself
+    assert not terminated and abs(info["distance"]) < 1e-3
+    assert len(info["stance_legs"]) == 6 and info["gait_phase"] == "stand"
+
+
+def test_reward_is_the_sum_of_named_terms_and_progress_follows_the_cog():
+    env = DitchCrossingEnv()
+    env.reset(seed=0)
+    x0 = env.data.subtree_com[env._torso][0]
+    total_progress = 0.0
+    for _ in range(120):  # the first upper step carries the CoG forward
+        _, reward, _, _, info = env.step(ZERO)
+        terms = {k[len("reward_") :]: v for k, v in info.items() if k.startswith("reward_")}
+        assert set(terms) == {"progress", "stability", "tip_over", "effort"}
+        assert reward == pytest.approx(sum(terms.values()))
+        assert terms["tip_over"] == 0.0 and terms["effort"] <= 0.0
+        total_progress += terms["progress"]
+    moved = env.data.subtree_com[env._torso][0] - x0
+    assert moved > 0.05
+    assert total_progress == pytest.approx(env.weights["progress"] * moved / env.control_dt)
