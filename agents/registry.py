@@ -17,9 +17,10 @@ from .policy import Policy
 PolicyFactory = Callable[[gym.Env], Policy]
 
 ANALYTICAL_POLICIES: dict[str, str | PolicyFactory] = {
-    "HexapodCliffWalk-v0": "agents.tripod_gait:TripodGaitPolicy",
+    "HexapodCliffWalk-v0": "agents.tipping.gait_with_recovery:GaitWithRecoveryPolicy",
     "HexapodDitchCrossing-v0": "agents.upu_gait:UpuGaitPolicy",
     "HexapodIrregularTerrain-v0": "agents.athena_policy:analytical_policy",
+    "HexapodStewartTilt-v0": "agents.tipping.controller:TippingRecoveryPolicy",
 }
 
 
