@@ -73,7 +73,14 @@ from agents.tipping.force_distribution import (
 )
 from agents.tipping.judgment import ADJUSTMENT_LEG, XI_F_DEG, judge
 from agents.tipping.margin_rate import MarginHistory
-from agents.tipping.trajectory import KAPPA, T_MAX, T_MIN, QuinticTrajectory, time_budget
+from agents.tipping.trajectory import (
+    KAPPA,
+    T_MAX,
+    T_MIN,
+    QuinticTrajectory,
+    time_budget,
+    zero_crossing_time,
+)
 from hexapod_envs.robots.heavy_duty.kinematics import joints_for_foot
 from hexapod_envs.robots.heavy_duty.params import LEG_NAMES, HeavyDutyParams
 from hexapod_envs.stability import fasm
@@ -200,6 +207,16 @@ class TippingRecoveryController:
     (what the robot would do without the controller) and the time; it returns the (6, 3) joint
     targets. The nominal targets are latched when tipping is judged: from then on the controller
     holds that posture (plus the adjustment leg and the force offsets).
+
+    ``diagnostics`` (a dict updated every period; body frame, SI units, margins in degrees):
+    phase; fasm_deg, fasm_edge, stance_legs (this period's FASM from the sensors); at judgment:
+    judgment_time, margin_at_judgment_deg, margin_rate_deg_s, margin_accel_deg_s2,
+    tipping_edge, support_legs, adjustment_leg, t_s, time_to_zero_s (eq. 15's forecast before
+    ϰ and the clamp), foothold, foothold_point, foothold_status, foothold_reason,
+    foothold_within_limits; at landing: landing_time, recovery_time (landing - judgment),
+    fasm_before_landing_deg, supported_legs; in support: qp_status, qp_legs, qp_cone_ratio
+    (λ used; nan = cone dropped), planned_forces and measured_forces ((k, 3) ground reactions
+    on qp_legs), qp_wrench_residual; failure (why the posture is only held).
     """
 
     def __init__(
@@ -262,6 +279,7 @@ class TippingRecoveryController:
             "support_legs": None,
             "adjustment_leg": None,
             "t_s": None,
+            "time_to_zero_s": None,
             "foothold": None,
             "foothold_point": None,
             "foothold_status": None,
@@ -439,6 +457,7 @@ class TippingRecoveryController:
         self._support = sorted(_LEG_INDEX[x] for x in (*stance, leg))
         self.phase = "swing"
         d["t_s"] = t_s
+        d["time_to_zero_s"] = zero_crossing_time(margin, rate, accel)
 
     # --- adjustment leg --------------------------------------------------------------------
     def _ik(self, leg: str, position: np.ndarray) -> np.ndarray | None:
