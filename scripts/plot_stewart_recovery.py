@@ -157,11 +157,15 @@ def main() -> None:
     parser.add_argument("--seed", type=int, default=0)
     args = parser.parse_args()
     header = (
-        f"{'case':22s} {'leg':>9s} {'t_s [s]':>11s} {'recovery':>8s} {'FASM before':>11s} "
+        f"{'case':22s} {'leg':>9s} {'t_s [s] [forecast]':>18s} {'recovery':>8s} "
+        f"{'FASM before':>11s} "
         f"{'FASM after':>13s} {'min after':>9s} {'held':>7s} {'ctrl':>7s}  "
         "foothold [mm] ours | paper"
     )
-    print(f"reach model: {args.reach_model}; FASM after = 0.5 s after landing; paper value in ()")
+    print(
+        f"reach model: {args.reach_model}; FASM after = 0.5 s after landing; paper value in (); "
+        "[forecast] = eq. 15's time to S = 0 before ϰ and the clamp"
+    )
     print(header)
     for scenario, stance in CASES:
         ctrl = run(scenario, stance, True, args.seed, reach_model=args.reach_model)
@@ -181,6 +185,7 @@ def main() -> None:
         print(
             f"{scenario + ' ' + stance:22s} {d['adjustment_leg'] or '-':>3s} ({p_leg}) "
             f"{d['t_s'] or float('nan'):4.2f} ({p_ts:4.2f}) "
+            f"[{d['time_to_zero_s'] or float('nan'):4.1f}] "
             f"{d['recovery_time'] or float('nan'):8.2f} "
             f"{d['fasm_before_landing_deg'] or float('nan'):11.1f} "
             f"{after:6.1f} ({p_after:>5s}) {min_after:9.1f} "
