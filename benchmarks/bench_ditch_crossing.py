@@ -31,8 +31,15 @@ def main() -> None:
         ("HexapodDitchCrossing-v0", {}),
         ("  terrain='flat'", {"terrain": "flat"}),
     ):
-        raw, env_rate = env_vs_raw(ENV_ID, steps=1500, **kwargs)
+        raw, env_rate = env_vs_raw(ENV_ID, steps=1000, repeats=5, **kwargs)
         print(f"{label:32s} {raw:14.0f} {env_rate:20.0f} {env_rate / raw:8.3f}")
+        substeps = round(0.1 / 0.002)
+        physics_us = substeps / raw * 1e6
+        overhead_us = substeps / env_rate * 1e6 - physics_us
+        print(
+            f"{'':32s} per control step: physics {physics_us:6.0f} us "
+            f"({substeps} x mj_step), env overhead {overhead_us:5.0f} us"
+        )
 
     env = DitchCrossingEnv()
     env.reset(seed=0)

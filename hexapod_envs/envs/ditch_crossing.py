@@ -33,7 +33,15 @@ Actions: 9 values in [-1, 1], in the order of joint_pos. ``action_mode="joint"``
 target normalised over its range (limb length over [l_min, l_max] = [0.365, 0.465] m, leg
 extension over [-leg_retract, leg_extend] = [-0.08, 0.16] m). ``"residual"`` (default): an
 offset from the reference gait's target of residual_scale x the half range; the zero action
-walks (and crosses) with the reference gait.
+walks (and crosses) with the reference gait. Control runs at 10 Hz (control_dt = 0.1 s,
+physics 2 ms); the servo drives interpolate: each target is approached linearly over the
+control period, at most 0.25 m/s for a limb and 1 m/s for a leg (`model.add_upu`,
+``command="interpolated"``), as the stiff limb servos would otherwise jerk the feet into
+slipping on every step of the command.
+
+The reference gait (`hexapod_envs.robots.upu.gait_schedule.GaitTiming`) takes 5.1 s per
+platform step: unload 0.4, lift 0.8, hold 0.2, transfer 2.5, hold 0.3, land 0.6, hold 0.3.
+Crossing the default ditch takes 20 steps, 102 s (1017 control steps); the time limit is 1500.
 
 | Reward term (info key) | meaning |
 |---|---|
@@ -54,6 +62,7 @@ finish_x [m], gait_step and gait_phase (the reference's plan step and phase), ti
 from __future__ import annotations
 
 import math
+from itertools import compress
 
 import mujoco
 import numpy as np
@@ -118,9 +127,13 @@ class DitchCrossingEnv(HexapodEnv):
     progress_weight, stability_weight, tip_over_penalty, effort_weight; contact_threshold
     (fraction of the weight); tip_over_angle_deg; reset_noise_scale [m] (the robot starts
     shifted by up to this along x and y, and turned so that its feet move up to this much);
-    friction;
-    gait_timing (GaitTiming), gait_settings (GaitSettings), params (UpuParams); rendering:
-    render_mode, width, height, camera_name (default the tracking camera "track").
+    friction; gait_timing (GaitTiming), gait_settings (GaitSettings), params (UpuParams);
+    rendering: render_mode, width, height, camera_name (default the tracking camera "track").
+
+    Public attributes for controllers that know the course (as the paper's robot knows the
+    ditch): ``ditch`` (the episode's `Ditch`), ``terrain``, ``start_x``, ``params``,
+    ``finish_x``, ``command_low`` / ``command_high`` (actuator ranges), ``plan`` and
+    ``schedule`` (the reference gait), ``gait_settings``, ``gait_timing``.
     """
 
     def __init__(
@@ -404,10 +417,10 @@ class DitchCrossingEnv(HexapodEnv):
         if not stable:
             return self._last_obs, 0.0, False, True, self._info({}, unstable=True)
         self._update_stability()
-        tipped = self.data.xmat[self._torso, 8] < self.tip_over_cos
+        tipped = d.xmat[self._torso, 8] < self.tip_over_cos
         self._tipped = self._tipped or bool(tipped)
         self._success = not self._tipped and self._all_feet_past_finish()
-        cog_x = float(self.sensors.cog()[0])
+        cog_x = float(d.subtree_com[self._torso, 0])
         terms = self._reward_terms(cog_x, bool(tipped))
         self._prev_cog_x = cog_x
         self._last_obs = self._observation()
@@ -467,6 +480,23 @@ class DitchCrossingEnv(HexapodEnv):
             ],
         }
 
+    def _observation(self) -> np.ndarray:
+        """`_observation_pieces` written straight into the flat vector (the per-step path)."""
+        b, o, d = self._obs_buffer, self.observation_layout.slices, self.data
+        b[o["joint_pos"]] = d.actuator_length[self._act]
+        b[o["joint_vel"]] = d.actuator_velocity[self._act]
+        b[o["foot_force"]] = self._forces.reshape(-1)
+        b[o["foot_contact"]] = self._loaded
+        b[o["fasm_margin_deg"]] = self._fasm_deg
+        b[o["static_margin_m"]] = self._static_margin
+        b[o["imu_gyro"]] = d.sensordata[self.sensors._gyro]
+        b[o["imu_accel"]] = d.sensordata[self.sensors._accel]
+        b[o["imu_quat"]] = d.sensordata[self.sensors._quat]
+        b[o["reference_action"]] = self._reference_actions[
+            min(self._tick, len(self._reference_actions) - 1)
+        ]
+        return b.copy()
+
     def _reward_terms(self, cog_x: float, tipped: bool) -> dict[str, float]:
         w = self.weights
         speed = (cog_x - self._prev_cog_x) / self.control_dt
@@ -489,7 +519,7 @@ class DitchCrossingEnv(HexapodEnv):
         info.update(
             fasm_margin_deg=self._fasm_deg,
             static_margin_m=self._static_margin,
-            stance_legs=tuple(leg for leg, on in zip(LEG_NAMES, self._loaded, strict=True) if on),
+            stance_legs=tuple(compress(LEG_NAMES, self._loaded.tolist())),
             is_tipping=self._static_margin <= 0.0,
             is_tipped_over=self._tipped,
             is_success=self._success and not unstable,
