@@ -455,6 +455,7 @@ class TippingRecoveryController:
         )
         self._leg = leg
         self._support = sorted(_LEG_INDEX[x] for x in (*stance, leg))
+        self._support_idx = np.array(self._support, dtype=np.intp)
         self.phase = "swing"
         d["t_s"] = t_s
         d["time_to_zero_s"] = zero_crossing_time(margin, rate, accel)
@@ -562,11 +563,13 @@ class TippingRecoveryController:
         # it (that would only tilt the body), so the plan covers the feet in contact, and the
         # offsets are only adjusted while every support foot is loaded (the stiffness model
         # assumes feet held by the ground).
-        support = [i for i in self._support if loaded[i]]
-        complete = len(support) == len(self._support)
+        held = self._support_idx
+        in_contact = loaded[held]
+        support = held[in_contact]
+        complete = bool(in_contact.all())
         self._steps_supported += 1
-        d["qp_legs"] = tuple(LEG_NAMES[i] for i in support)
-        d["measured_forces"] = forces[support].copy()
+        d["qp_legs"] = tuple(LEG_NAMES[i] for i in support.tolist())
+        measured = d["measured_forces"] = forces[support]
         if len(support) < 3:
             d.update(qp_status="too_few_feet", planned_forces=None)
         elif (self._steps_supported - 1) % cfg.qp_period == 0:
@@ -589,15 +592,15 @@ class TippingRecoveryController:
             if result is None:
                 d.update(qp_status="degenerate_geometry", planned_forces=None)
             else:
-                d.update(
+                d.update(  # fresh arrays of this solve: no copies needed
                     qp_status=result.status,
-                    planned_forces=result.forces.copy(),
-                    qp_wrench_residual=result.wrench_residual.copy(),
+                    planned_forces=result.forces,
+                    qp_wrench_residual=result.wrench_residual,
                 )
             if result is not None and result.ok and cfg.force_control and complete:
                 # Internal part: error - Aᵀ (A Aᵀ)⁻¹ A error (A has full row rank, k >= 3).
                 a_mat = self._last_qp_a
-                error = (result.forces - forces[support]).reshape(-1)
+                error = (result.forces - measured).reshape(-1)
                 internal = error - a_mat.T @ np.linalg.solve(a_mat @ a_mat.T, a_mat @ error)
                 change = self.body.target_change_for_force(
                     joints, internal.reshape(-1, 3), legs=support
@@ -606,7 +609,6 @@ class TippingRecoveryController:
                 self._offsets[support] = np.minimum(
                     np.maximum(updated, -self._max_offset), self._max_offset
                 )
-        held = self._support
         targets[held] = self._nominal[held] + self._offsets[held]
 
 
