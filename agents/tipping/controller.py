@@ -24,7 +24,11 @@ frame) and the IMU, and works in the body frame:
 6. **Force distribution** (§4.3, eqs. 16-24) once the leg has landed: the desired wrench from the
    accelerometer (low-pass filtered specific force, F_b = m (a_b - g_b)) and the gyro
    (T_b = I ω̇ + ω × I ω); the QP with friction, minimum normal force and stability cone solved
-   through qpsolvers (daqp by default, :mod:`.force_distribution`).
+   through qpsolvers (daqp by default, :mod:`.force_distribution`) every control period, over
+   the support feet in contact. The cone (base radius λ d_min round the support centroid) makes
+   the QP infeasible when the centroid lies far from below the CoG, as after a rear or side leg
+   lands; λ is then widened step by step (`cone_ratios`) and, if nothing is feasible, the cone
+   dropped; a narrower λ is retried every 25 solves.
 7. **Making the planned forces act**: the servos are position servos of known stiffness at the foot
    (x, leg length, swing), so a target offset Δq = -K⁻¹ Jᵀ ΔF adds ΔF to a foot held by the
    ground. ΔF = planned - measured is first projected onto the null space of the wrench map A
@@ -32,7 +36,9 @@ frame) and the IMU, and works in the body frame:
    allows, or body accelerations) cannot be imposed through foot positions without moving the
    body, while the internal part (how the load is shared, e.g. how much the new leg carries)
    can. The offsets integrate that error with gain `force_gain` per period (the loop converges
-   geometrically; a proportional offset would only go half-way) and are clamped.
+   geometrically; a proportional offset would only go half-way) and are clamped. They are only
+   adjusted while every support foot is loaded: near lift-off the feet are no longer held and
+   pushing a foot down would roll the body instead.
 
 The controller then holds the new stance. It never reads simulator state; the policy wrappers
 (:class:`TippingRecoveryPolicy`, and :mod:`.gait_with_recovery` for walking) give it the
