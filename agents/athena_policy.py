@@ -12,7 +12,10 @@ any of its action modes, reading the observation by name (``joint_pos``, ``foot_
   env's ``reference_gains``). The policy runs two controllers on the same observations, one with
   its gains and one with the env's reference gains, and returns the difference of their targets
   in residual units. Both are deterministic functions of the observations, so the reference
-  copy reproduces the env's exactly; with equal gains the action is zero.
+  copy reproduces the env's exactly; with equal gains the action is zero. This is exact only
+  while the two targets differ by less than the residual range (``residual_scale`` x half
+  range); on the blocks the posture gains move the feet further and the env clips the action,
+  so use the "gains" or "joint" mode to run the paper's controller there.
 
 k_z = k_α = k_β = 0 is the paper's "simple control".
 """

@@ -73,15 +73,15 @@ def run_episode(
 ) -> EpisodeRecord:
     """Walk `terrain` with the posture controller at `gains` from ``reset(seed=seed)``.
 
-    Runs `steps` 20 Hz steps (default `DEFAULT_STEPS`), or until `cycles` gait cycles are
-    complete; stops early on tip-over. On the ramp, cycles that end with the front feet past the
-    top of the slope are dropped.
+    Runs `steps` 20 Hz steps (default `DEFAULT_STEPS`), or fewer if `cycles` gait cycles are
+    complete first; stops early on tip-over. On the ramp, cycles that end with the front feet
+    past the top of the slope are dropped.
     """
-    env = gym.make(ENV_ID, terrain=terrain, action_mode="gains", **env_kwargs)
-    base = env.unwrapped
     steps = DEFAULT_STEPS if steps is None else steps
-    if cycles is not None:
-        steps = max(steps, (cycles + 1) * base.ticks_per_cycle * 3)  # room for slow cycles
+    env = gym.make(
+        ENV_ID, terrain=terrain, action_mode="gains", max_episode_steps=steps, **env_kwargs
+    )
+    base = env.unwrapped
     policy = AthenaPosturePolicy(env, *gains)
     record = EpisodeRecord(terrain=terrain, gains=tuple(gains), seed=seed)
     obs, info = env.reset(seed=seed)

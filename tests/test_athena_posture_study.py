@@ -83,3 +83,25 @@ def test_blocks_posture_control_raises_the_zmp_margin(blocks):
 def test_blocks_runs_walk_and_stay_upright(blocks):
     for name in ("simple", "posture"):
         assert all(r.distance > 0.5 and not r.tipped_over for r in blocks[name])
+
+
+def _script(name):
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "scripts" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(name, path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_study_and_sweep_scripts_write_their_outputs(tmp_path):
+    _script("athena_posture_study").main(["--seeds", "1", "--steps", "100", "--out", str(tmp_path)])
+    for name in ("athena_ramp_posture.png", "athena_blocks_posture.png"):
+        assert (tmp_path / name).stat().st_size > 10_000
+    assert "change_pct" in (tmp_path / "athena_posture_study.json").read_text()
+    out = tmp_path / "sweep.md"
+    _script("athena_gain_sweep").main(["--cycles", "1", "--out", str(out)])
+    text = out.read_text()
+    assert text.count("| k_z = ") == 10 and "paper's tuned (0.6, 0.4, 0.4)" in text

@@ -15,14 +15,18 @@ gait of eqs. (19)-(23) (t_g = 1 s per phase, control at 20 Hz) over
 The block heights are drawn from the episode's ``np_random`` at every reset (one bed per seed);
 ``block_layout_seed=<int>`` fixes one bed for all episodes.
 
-Servos. The paper's joints are servos with a 1.89 N·m stall torque. Ours are proportional
-position servos with that torque limit, a stiffness ``servo_kp`` and viscous damping
+Servos and gait. The paper's joints are servos with a 1.89 N·m stall torque. Ours are
+proportional position servos with that torque limit, a stiffness ``servo_kp`` and viscous damping
 ``servo_damping``. The default stiffness, 8 N·m/rad, reaches the stall torque at 0.24 rad (13.5°)
-of position error, the compliance of a hobby servo's proportional band; a stance leg carrying a
-third to a half of the robot's weight sags a few millimetres, as the paper's Gazebo servos did.
-Because the gait starts every phase from the *measured* feet (eq. 12 on the encoders) this sag
-accumulates under the "simple control": the torso slowly sinks, and only the height correction
-k_z δz brings it back (see `reports/athena_gain_sweep.md`).
+of position error, a hobby servo's proportional band; a stance leg carrying a third to a half of
+the robot's weight sags by a few millimetres. The paper's own simple-control results (median torso
+height 0.068 m on the ramp against 0.104 m standing) show that its simulated servos sagged too:
+because every phase starts from the *measured* feet (eq. 12 on the encoders) the sag accumulates
+and the torso slowly sinks unless the height correction k_z δz brings it back. The phase start
+uses the measured heights but the commanded horizontal positions (``gait_start_from=
+"measured_height"``, see `hexapod_envs.robots.athena.gait.START_FROM`): with measured x, y too
+the stance legs' lag makes the footholds wander ~4 mm per cycle until the legs reach their limits.
+`reports/athena_gain_sweep.md` shows how the ramp results depend on ``servo_kp`` and this rule.
 
 | Observation piece | size | unit |
 |---|---|---|
@@ -49,8 +53,9 @@ Action modes (``action_mode=``):
 - ``"gains"``: 3 values (k_z, k_α, k_β) in [0, 1], the posture-control gains of eqs. (27)-(31),
   which the paper names as its future work for learning. The env runs the posture controller
   internally at every 20 Hz step; **the action is applied only at the start of a gait cycle**
-  (the step after which ``gait_phase[2]`` was 1) and held for the cycle's two phases; the actions
-  of the other steps are ignored. Gains start at ``reference_gains``.
+  (the action passed to `step` when the current observation's ``gait_phase[2]`` is 1) and held
+  for the cycle's two phases; the actions of the other steps are ignored. Gains start at
+  ``reference_gains``.
 
 | Reward term (info key) | meaning |
 |---|---|

@@ -1,0 +1,102 @@
+"""HexapodIrregularTerrain-v0 speed: env vs raw mj_step over the same motion, and the posture
+controller's step time.
+
+Targets (issue 4): env/raw ratio >= 0.9; controller step time reported in µs. The env/raw figure
+is measured per terrain in each action mode (zero actions: in "residual" and "gains" mode the env
+runs the seed-002 gait with its internal controller, in "joint" mode it holds zero targets), and
+the per-step costs of the pieces that the env adds to the physics are timed on their own, so that
+a shortfall can be attributed. Run: python benchmarks/bench_irregular_terrain.py
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run as a script from anywhere
+
+import hexapod_envs  # noqa: F401
+from benchmarks.common import env_vs_raw, per_call_us
+from hexapod_envs.envs.heavy_duty import fasm_from_feet
+from hexapod_envs.robots.athena.gait import AthenaPostureController
+from hexapod_envs.robots.athena.kinematics import leg_ik
+from hexapod_envs.stability import zmp_margin
+
+ENV_ID = "HexapodIrregularTerrain-v0"
+
+
+def controller_step_us(terrain: str = "ramp", steps: int = 2400) -> tuple[float, float, float]:
+    """(median, mean, phase-start mean) µs of AthenaPostureController.step on recorded sensors.
+
+    The sensor readings of a real walk are recorded first, then the controller (paper's ramp
+    gains) is timed alone on them; a phase start (plane fit, new foot paths) costs more than the
+    19 ticks that follow it.
+    """
+    env = gym.make(ENV_ID, terrain=terrain, action_mode="gains", max_episode_steps=steps)
+    base = env.unwrapped
+    env.reset(seed=0)
+    readings = []
+    for _ in range(steps):
+        readings.append(base._controller_sensors())
+        env.step(np.array([0.8, 0.6, 0.0], np.float32))
+    ctrl = AthenaPostureController(base.robot, **base.gait_config, kz=0.8, k_alpha=0.6)
+    times, starts = [], []
+    for sensors in readings:
+        at_start = ctrl.at_phase_start
+        t0 = time.perf_counter()
+        ctrl.step(sensors)
+        dt = (time.perf_counter() - t0) * 1e6
+        times.append(dt)
+        if at_start:
+            starts.append(dt)
+    env.close()
+    return float(np.median(times)), float(np.mean(times)), float(np.mean(starts))
+
+
+def env_piece_costs(terrain: str = "ramp") -> dict[str, float]:
+    """µs per call of what the env computes every step besides the physics."""
+    env = gym.make(ENV_ID, terrain=terrain, action_mode="joint")
+    base = env.unwrapped
+    env.reset(seed=0)
+    s = base.sensors
+    feet, forces, cog, loaded = s.foot_positions(), s.foot_forces(), s.cog(), base._loaded
+    torso_feet = (feet - s.torso_position()) @ s.torso_rotation()
+    normal = np.where(loaded, np.maximum(forces[:, 2], 0.0), 0.0)
+    action = np.zeros(18, np.float32)
+    costs = {
+        "read sensors (forces, FASM, ZMP)": per_call_us(base._read_sensors, repeat=4000),
+        "  of which FASM": per_call_us(fasm_from_feet, feet, forces, cog, loaded, repeat=4000),
+        "  of which ZMP margin": per_call_us(zmp_margin, torso_feet, normal, repeat=4000),
+        "observation": per_call_us(base._observation, repeat=4000),
+        "info dict": per_call_us(base._info, {}, False, None, repeat=4000),
+        "action check": per_call_us(base._validate_action, action, base.action_space, repeat=4000),
+    }
+    env.close()
+    return costs
+
+
+def main() -> None:
+    print(f"{'terrain':8s} {'mode':9s} {'raw mj_step/s':>14s} {'env steps/s':>12s} {'env/raw':>8s}")
+    for terrain in ("ramp", "blocks", "flat"):
+        for mode in ("residual", "gains", "joint"):
+            raw, env_rate = env_vs_raw(ENV_ID, steps=1200, terrain=terrain, action_mode=mode)
+            print(f"{terrain:8s} {mode:9s} {raw:14.0f} {env_rate:12.0f} {env_rate / raw:8.2f}")
+    physics_us = 25 / env_vs_raw(ENV_ID, steps=1200, terrain="ramp", action_mode="joint")[0] * 1e6
+    print(f"\nphysics per 50 ms control step (25 x 2 ms mj_step, ramp): {physics_us:6.0f} us")
+    median, mean, start = controller_step_us()
+    print(
+        f"posture controller step: median {median:5.1f} us, mean {mean:5.1f} us "
+        f"(phase start {start:5.1f} us)"
+    )
+    ik = leg_ik("LF")
+    print(f"  leg IK (LegIK.solve):  {per_call_us(ik.solve, 0.2, 0.15, -0.08):5.1f} us per leg")
+    for name, us in env_piece_costs().items():
+        print(f"env per step, {name:34s} {us:6.1f} us")
+
+
+if __name__ == "__main__":
+    main()
