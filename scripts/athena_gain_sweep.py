@@ -25,6 +25,13 @@ from agents.athena_study import PAPER_GAINS, SIMPLE, run_episode, summarize  # n
 
 VALUES = (0.0, 0.2, 0.4, 0.6, 0.8, 1.0)
 GAIN_NAMES = ("k_z", "k_α", "k_β")
+KP_NOTE = (
+    "Simple control vs the paper's ramp gains (0.8, 0.6, 0.0) for several position-servo "
+    "stiffnesses (all with the 1.89 N·m torque limit) and both ways of starting a phase "
+    "(`measured`: the paper's eq. 12 on the encoders for x, y and z; `measured_height`: the "
+    "default, z only). Directions as the paper: height up (h), pitch rate not up (p), roll rate "
+    "down (r)."
+)
 COLUMNS = (
     ("height_median", "height [m]", "{:.4f}"),
     ("pitch_rate_median", "pitch rate [rad/s]", "{:.4f}"),
@@ -126,11 +133,7 @@ def main(argv: list[str] | None = None) -> None:
             [
                 "## Ramp: sensitivity to the servo stiffness and the phase-start rule",
                 "",
-                "Simple control vs the paper's ramp gains (0.8, 0.6, 0.0) for several position-servo "
-                "stiffnesses (all with the 1.89 N·m torque limit) and both ways of starting a phase "
-                "(`measured`: the paper's eq. 12 on the encoders for x, y and z; `measured_height`: "
-                "the default, z only). Directions as the paper: height up (h), pitch rate not up "
-                "(p), roll rate down (r).",
+                KP_NOTE,
                 "",
             ]
             + kp_sensitivity(args.servo_kp, seeds, args.cycles)
