@@ -253,6 +253,47 @@ def test_gains_set_mid_phase_take_effect_at_the_next_phase():
     assert ctrl.ticks_per_cycle == 40
 
 
+def test_cycle_clock_counts_two_phases_per_cycle():
+    ctrl = AthenaPostureController()
+    feet = kin.standing_foot_positions()
+    n = ctrl.ticks_per_phase
+    seen = []
+    for k in range(2 * ctrl.ticks_per_cycle):
+        seen.append((ctrl.at_cycle_start, ctrl.cycle_phase, ctrl.next_phase_index))
+        ctrl.step(_sensors(feet, TRIPODS[(k // n + 1) % 2]))
+    starts = [k for k, (start, _, _) in enumerate(seen) if start]
+    assert starts == [0, ctrl.ticks_per_cycle]
+    assert [p for _, p, _ in seen[: 2 * n]] == pytest.approx([k / (2 * n) for k in range(2 * n)])
+    assert seen[n][2] == 1 and seen[n - 1][2] == 0
+
+
+@pytest.mark.parametrize("start_from", ["measured", "commanded", "measured_height"])
+def test_phase_start_rules_take_the_foot_positions_they_name(start_from):
+    """Encoders report every foot 5 mm further forward and 4 mm lower than commanded."""
+    ctrl = AthenaPostureController(start_from=start_from)
+    commanded = kin.standing_foot_positions()
+    measured = commanded + [0.005, 0.0, -0.004]
+    ctrl.step(_sensors(measured, TRIPODS[1]))
+    start = ctrl.commanded_feet  # after the first tick: start + 1/20 of the path
+    swing = [IDX[leg] for leg in TRIPODS[0]]
+    u = 1 / ctrl.ticks_per_phase
+    expected_start = {
+        "measured": measured,
+        "commanded": commanded,
+        "measured_height": np.column_stack([commanded[:, :2], measured[:, 2]]),
+    }[start_from]
+    stance = [IDX[leg] for leg in TRIPODS[1]]
+    np.testing.assert_allclose(
+        start[stance], expected_start[stance] + [-u * S / 2, 0, 0], atol=1e-12
+    )
+    np.testing.assert_allclose(
+        start[swing, :2],
+        expected_start[swing, :2]
+        + [S / 2 * (3 * u * (1 - u) ** 2 / 4 + 3 * u * u * (1 - u) * 3 / 4 + u**3), 0],
+        atol=1e-12,
+    )
+
+
 def test_bad_arguments_raise_clear_errors():
     with pytest.raises(ValueError, match="k_alpha"):
         AthenaPostureController(k_alpha=1.5)

@@ -69,6 +69,17 @@ def test_blocks_tile_the_region_at_the_sampled_heights():
     assert _ray_height(model, data, 0.0, 0.0) == pytest.approx(0.0, abs=1e-9)
 
 
+def test_scalar_height_at_matches_surface_height_on_and_off_the_pieces():
+    ramp = add_ramp(mujoco.MjSpec(), start_x=-0.4, length=3.0, top_length=1.0, width=1.0)
+    field = add_blocks(mujoco.MjSpec(), np.random.default_rng(3), region=((0.0, 1.0), (-0.5, 0.5)))
+    rng = np.random.default_rng(2)
+    for x, y in rng.uniform([-1.0, -0.8], [4.0, 0.8], size=(300, 2)):
+        assert ramp.height_at(x, y) == pytest.approx(float(ramp.surface_height(x, y)), abs=1e-15)
+        assert field.height_at(x, y) == float(field.surface_height(x, y))
+    assert ramp.height_at(3.3, 0.0) == pytest.approx(ramp.top_height)
+    assert ramp.height_at(3.3, 0.6) == 0.0 and field.height_at(1.2, 0.0) == 0.0
+
+
 def test_bad_terrain_arguments_raise_clear_errors():
     spec = mujoco.MjSpec()
     with pytest.raises(ValueError, match="slope_deg"):
