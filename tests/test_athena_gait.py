@@ -1,4 +1,5 @@
-"""Seed 002's tripod gait and posture controller (agents/athena_gait.py): closed-form checks."""
+"""Seed 002's tripod gait and posture controller (hexapod_envs/robots/athena/gait.py, re-exported
+by agents/athena_gait.py): closed-form checks."""
 
 import math
 

@@ -1,10 +1,13 @@
 """ATHENA's tripod gait and posture controller (seed 002, Section 4), pure numpy.
 
+It lives in the robot package because ``HexapodIrregularTerrain-v0`` runs it as the reference
+gait of its "residual" and "gains" action modes; `agents.athena_gait` re-exports it.
+
 Gait (Section 4.1). A tripod gait in phases of t_g = 1 s at 20 Hz: in each phase one tripod swings
 along a cubic Bezier curve (eqs. 19-22, stride s, height h) while the other tripod's feet move
 linearly backwards by s (eq. 23). All foot paths are in the body frame and start where the foot
-is at the start of the phase (p_{i,0}, eq. 12 on the measured joint angles); joint targets come
-from the analytic inverse kinematics.
+is at the start of the phase (p_{i,0}, eq. 12 on the measured joint angles, or see `START_FROM`);
+joint targets come from the analytic inverse kinematics.
 
 Posture control (Section 4.2), evaluated at the start of every phase:
   1. contacts from the foot force sensors; the ground plane (eq. 24) through three feet in
