@@ -256,10 +256,10 @@ def test_verdicts_use_each_metrics_direction():
 
 
 # --- registry ------------------------------------------------------------------------------
-def test_registry_gives_the_cliff_walk_tripod_gait():
+def test_registry_gives_the_cliff_walk_gait_with_recovery():
     env = gym.make("HexapodCliffWalk-v0")
     policy = analytical_policy(env)
-    assert type(policy).__name__ == "TripodGaitPolicy"
+    assert type(policy).__name__ == "GaitWithRecoveryPolicy"
     obs, _ = env.reset(seed=0)
     assert env.action_space.contains(policy(obs))
 

@@ -196,13 +196,17 @@ class StewartTiltEnv(HeavyDutyEnv):
             self.max_tilt = min(self.max_tilt, 0.95 * reach)
         self.data.qpos[self._platform_qpos] = 0.0
         self.data.ctrl[self._platform_act] = 0.0
+        self.data.act[self.model.actuator_actadr[self._platform_act]] = 0.0
         self._first_tipping_time = None
         self._adjustment_leg = None
         self._recovery_time = None
 
     def _before_physics(self) -> None:
-        roll, pitch, _ = self._rpy(self.tilt_at(self.time + self.control_dt))
-        self.data.ctrl[self._platform_act] = (pitch, roll)
+        """Command the tilt rate that carries the platform to tilt_at(t + dt) within the period."""
+        t = self.time
+        rate = (self.tilt_at(t + self.control_dt) - self.tilt_at(t)) / self.control_dt
+        roll_rate, pitch_rate, _ = self._rpy(rate)
+        self.data.ctrl[self._platform_act] = (pitch_rate, roll_rate)
 
     # --- stability, termination, reward ---------------------------------------------------
     def _platform_up(self) -> np.ndarray:

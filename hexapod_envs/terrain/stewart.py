@@ -1,6 +1,6 @@
 """The 6-UPS Stewart platform of seed 000 §5.2 as a MuJoCo terrain piece.
 
-The moving platform is a rigid plate whose tilt is driven by two stiff position servos about its
+The moving platform is a rigid plate whose tilt is driven by two stiff servos about its
 centre (pitch about y, then roll about x, so R = Ry(pitch) Rx(roll) as in `stewart_kinematics`).
 Driving the pose through joints, rather than a mocap body, gives the plate a real velocity, so
 the feet's friction sees the platform move. The six actuator lengths that would produce the pose
@@ -66,8 +66,14 @@ def add_stewart_platform(
             damping=damping,
             armature=1.0e4,
         )
+        # Integrated-velocity servo: ctrl is the tilt rate, integrated every physics substep
+        # into the position target, so the plate moves smoothly between control instants
+        # (a position target that jumps once per control period jerks the plate at 50 Hz and
+        # biases the foot forces sampled at the control instants).
         act = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
-        act.set_to_position(kp=servo_stiffness)
+        act.set_to_intvelocity(kp=servo_stiffness)
+        act.actlimited = True
+        act.actrange = [-1.2, 1.2]
     kw = ground_geom_kwargs(friction)
     body.add_geom(
         name="platform_plate",
