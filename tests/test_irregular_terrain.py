@@ -102,6 +102,11 @@ def test_observation_info_and_reward_terms(terrain):
     assert first["gains"] == pytest.approx((0.6, 0.4, 0.4))
     assert 0.03 < first["height_rms"] < 0.25 and first["pitch_rate_rms"] >= 0.0
     assert info["distance"] > 0.05  # it walks forward
+    metrics = info["episode_metrics"]  # the evaluation pipeline's per-cycle lists
+    assert metrics["cycle_height_rms"] == [c["height_rms"] for c in cycles]
+    assert metrics["cycle_zmp_margin"] == [c["zmp_margin_mean"] for c in cycles]
+    assert set(base.evaluation_metrics) >= set(metrics) | {"torso_collisions", "zmp_margin"}
+    assert info["actuator_power_w"] > 0.0
     assert obs[structure["posture_gains"]] == pytest.approx([0.6, 0.4, 0.4])
 
 

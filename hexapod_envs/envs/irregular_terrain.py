@@ -77,7 +77,10 @@ distance torso bottom - terrain below the torso centre, privileged, m), ``pitch_
 ``cycle_stats``: on the first step of every new gait cycle a dict of per-cycle statistics of the
 cycle just finished (``index``, ``steps``, ``height_rms``, ``pitch_rate_rms``, ``roll_rate_rms``,
 ``zmp_margin_mean``, ``zmp_margin_min``, ``torso_contact``, ``distance``, ``x_start``, ``x_end``,
-``gains``), otherwise None. The seed's box plots are made from these.
+``gains``), otherwise None. The seed's box plots are made from these. ``actuator_power_w``
+(sum of |torque x joint speed|, W) and ``episode_metrics`` (the running lists of this episode's
+per-cycle height, pitch-rate and roll-rate RMS and mean ZMP margin, one dict per episode that
+grows as cycles finish) feed the evaluation pipeline (`evaluation_metrics`).
 """
 
 from __future__ import annotations
@@ -115,6 +118,44 @@ _CONTACT_CHECKS = 5
 
 class IrregularTerrainEnv(HexapodEnv):
     """ATHENA on a ramp, a block test bed or flat ground; see the module docstring."""
+
+    evaluation_metrics = {
+        "torso_collisions": {
+            "reduce": "last",
+            "better": "lower",
+            "description": "control steps with torso-terrain contact",
+        },
+        "zmp_margin": {
+            "reduce": "mean",
+            "better": "higher",
+            "description": "ZMP stability margin, eqs. 32-33 [m]",
+        },
+        "torso_clearance": {
+            "reduce": "min",
+            "better": "higher",
+            "description": "smallest true torso clearance [m]",
+        },
+        "cycle_height_rms": {
+            "reduce": "episode",
+            "description": "per-gait-cycle RMS torso height [m] (seed 002 Figs. 10-17)",
+        },
+        "cycle_pitch_rate_rms": {
+            "reduce": "episode",
+            "better": "lower",
+            "description": "per-gait-cycle RMS pitch rate [rad/s]",
+        },
+        "cycle_roll_rate_rms": {
+            "reduce": "episode",
+            "better": "lower",
+            "description": "per-gait-cycle RMS roll rate [rad/s]",
+        },
+        "cycle_zmp_margin": {
+            "reduce": "episode",
+            "better": "higher",
+            "description": "per-gait-cycle mean ZMP margin [m]",
+        },
+    }
+    """What the evaluation pipeline reduces over an episode (see agents/pipeline/episode.py)."""
 
     def __init__(
         self,
@@ -339,6 +380,12 @@ class IrregularTerrainEnv(HexapodEnv):
         self._cycle_id = 0
         self._window: list[tuple] = []
         self._window_x0 = float(self._start_cog[0])
+        self._episode_metrics = {
+            "cycle_height_rms": [],
+            "cycle_pitch_rate_rms": [],
+            "cycle_roll_rate_rms": [],
+            "cycle_zmp_margin": [],
+        }
         self._read_sensors()
         self._last_obs = self._observation()
         return self._last_obs, self._info({}, unstable=False, cycle_stats=None)
@@ -452,6 +499,11 @@ class IrregularTerrainEnv(HexapodEnv):
         stats = None
         if cid != self._cycle_id and self._window:
             stats = self._cycle_stats(self._cycle_id, self._window)
+            m = self._episode_metrics
+            m["cycle_height_rms"].append(stats["height_rms"])
+            m["cycle_pitch_rate_rms"].append(stats["pitch_rate_rms"])
+            m["cycle_roll_rate_rms"].append(stats["roll_rate_rms"])
+            m["cycle_zmp_margin"].append(stats["zmp_margin_mean"])
             self._window = []
             self._window_x0 = float(self._prev_cog[0])
         self._cycle_id = cid
@@ -531,6 +583,9 @@ class IrregularTerrainEnv(HexapodEnv):
             is_tipped_over=self._tipped,
             is_success=not self._tipped and not unstable and self._collisions == 0,
             sim_unstable=unstable,
+            actuator_power_w=float(
+                np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
+            ),
             time=self._step_count * self.control_dt,
             cog=self._cog.copy(),
             distance=float(self._cog[0] - self._start_cog[0]),
@@ -545,6 +600,7 @@ class IrregularTerrainEnv(HexapodEnv):
             posture_gains=self.controller.gains if self.action_mode != "joint" else None,
             gait_cycle=self._gait_cycle_index(),
             cycle_stats=cycle_stats,
+            episode_metrics=self._episode_metrics,
         )
         return info
 
