@@ -78,9 +78,9 @@ distance torso bottom - terrain below the torso centre, privileged, m), ``pitch_
 cycle just finished (``index``, ``steps``, ``height_rms``, ``pitch_rate_rms``, ``roll_rate_rms``,
 ``zmp_margin_mean``, ``zmp_margin_min``, ``torso_contact``, ``distance``, ``x_start``, ``x_end``,
 ``gains``), otherwise None. The seed's box plots are made from these. ``actuator_power_w``
-(sum of |torque x joint speed|, W) and ``episode_metrics`` (the running lists of this episode's
-per-cycle height, pitch-rate and roll-rate RMS and mean ZMP margin, one dict per episode that
-grows as cycles finish) feed the evaluation pipeline (`evaluation_metrics`).
+(sum of |torque x joint speed|, W) and ``episode_metrics`` (at reset and whenever a cycle
+finishes: the lists so far of this episode's per-cycle height, pitch-rate and roll-rate RMS and
+mean ZMP margin) feed the evaluation pipeline (`evaluation_metrics`).
 """
 
 from __future__ import annotations
@@ -600,8 +600,10 @@ class IrregularTerrainEnv(HexapodEnv):
             posture_gains=self.controller.gains if self.action_mode != "joint" else None,
             gait_cycle=self._gait_cycle_index(),
             cycle_stats=cycle_stats,
-            episode_metrics=self._episode_metrics,
         )
+        if cycle_stats is not None or self._step_count == 0:
+            # A fresh copy whenever the lists change (and at reset): infos must not share data.
+            info["episode_metrics"] = {k: list(v) for k, v in self._episode_metrics.items()}
         return info
 
 
