@@ -18,10 +18,12 @@ A ditch the mechanism cannot cross gets no plan: `status` is "too_deep", "too_wi
 standing pose instead of walking into the ditch.
 
 Action modes: in ``"joint"`` mode the action is the command normalised over the actuator
-ranges; in ``"residual"`` mode it is the difference to the env's reference gait (observation
-piece ``reference_action``), which is the same schedule, so it is zero while the gates pass on
-time. A wait at a gate puts the policy behind the reference; the residual then grows and may
-saturate at residual_scale, so use ``action_mode="joint"`` for the full closed-loop behaviour.
+ranges; in ``"residual"`` mode it is the action that moves the env's filtered residual
+(observation piece ``residual_state``) toward the difference between the policy's command and
+the env's reference gait (piece ``reference_action``). The reference is the same schedule, so
+the action is zero while the gates pass on time. A wait at a gate puts the policy behind the
+reference by more than the residual's few mm can make up, so use ``action_mode="joint"`` for
+the full closed-loop behaviour.
 """
 
 from __future__ import annotations
@@ -156,8 +158,14 @@ class UpuGaitPolicy:
             command = sched.command(self.tick)
             self.tick += 1
         if self.env.action_mode == "residual":
+            e = self.env
             reference = self._center + self._half * obs["reference_action"]
-            action = (command - reference) / (self.env.residual_scale * self._half)
+            gain = e.residual_gain
+            current = obs["residual_state"] * gain
+            # The env filters: r <- r + alpha (gain a - r); choose a so that r becomes the wanted
+            # offset (as far as |a| <= 1 allows).
+            wanted = current + (command - reference - current) / e.residual_filter_alpha
+            action = np.divide(wanted, gain, out=np.zeros_like(wanted), where=gain > 0)
         else:
             action = (command - self._center) / self._half
         return np.clip(action, -1.0, 1.0).astype(self._dtype)

@@ -31,6 +31,8 @@ def test_bad_keyword_arguments_are_named():
         DitchCrossingEnv(ditch_width=0.0)
     with pytest.raises(TypeError, match="valid"):
         DitchCrossingEnv(ditch_wdth=0.3)
+    with pytest.raises(ValueError, match="residual_leg_m"):
+        DitchCrossingEnv(residual_leg_m=-0.001)
     with pytest.raises(ValueError, match="not a whole multiple"):
         DitchCrossingEnv(control_dt=0.1, physics_dt=0.003)
 
@@ -50,6 +52,7 @@ def test_observation_layout_and_reset_state():
         "imu_accel": 3,
         "imu_quat": 4,
         "reference_action": 9,
+        "residual_state": 9,
     }
     o = {k: obs[s] for k, s in env.observation_structure.items()}
     # Standing on six feet: all in contact, they carry the weight, margin = hexagon inradius-ish.
@@ -184,3 +187,28 @@ def test_reward_is_the_sum_of_named_terms_and_progress_follows_the_cog():
     moved = env.data.subtree_com[env._torso][0] - x0
     assert moved > 0.05
     assert total_progress == pytest.approx(env.weights["progress"] * moved / env.control_dt)
+
+
+def test_residual_is_filtered_and_observed():
+    env = DitchCrossingEnv(residual_filter_tau=0.3)
+    obs, _ = env.reset(seed=0)
+    state = env.observation_structure["residual_state"]
+    np.testing.assert_array_equal(obs[state], 0.0)
+    alpha = env.control_dt / (0.3 + env.control_dt)
+    assert env.residual_filter_alpha == pytest.approx(alpha)
+    action = np.array([1.0, -1.0, 0.5, 0, 0, 0, 0, 0, -0.5])
+    expected = np.zeros(9)
+    for _ in range(3):
+        obs, *_ = env.step(action)
+        expected += alpha * (action - expected)
+        np.testing.assert_allclose(obs[state], expected)
+    # The servo targets follow reference + residual [m] (limb gain 2 mm, leg gain 5 mm).
+    np.testing.assert_allclose(env.residual_gain, [0.002] * 3 + [0.005] * 6)
+    # (clamped to the actuator ranges, as MuJoCo clamps the activation)
+    target = env.reference_command(env._tick - 1) + expected * env.residual_gain
+    target = np.clip(target, env.command_low, env.command_high)
+    np.testing.assert_allclose(env.data.act[env._act_state], target, atol=1e-12)
+    joint = DitchCrossingEnv(action_mode="joint")
+    joint.reset(seed=0)
+    obs, *_ = joint.step(np.zeros(9))
+    np.testing.assert_array_equal(obs[state], 0.0)

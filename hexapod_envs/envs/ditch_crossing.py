@@ -25,6 +25,7 @@ reference stands still and ``info["planner_status"]`` says why ("too_deep", "too
 | imu_accel | 3 | accelerometer [m/s²] |
 | imu_quat | 4 | lower-platform orientation (w, x, y, z) |
 | reference_action | 9 | the reference gait's command now, normalised like a "joint" action |
+| residual_state | 9 | the filtered residual now, in units of the residual gains (0 if "joint") |
 
 The CoG is that of the kinematic model with the known masses (MuJoCo's subtree centre of mass,
 which is exactly that), so static_margin_m is the paper's d of Fig. 5 (eqs. 12-14).
@@ -32,12 +33,18 @@ which is exactly that), so static_margin_m is the paper's d of Fig. 5 (eqs. 12-1
 Actions: 9 values in [-1, 1], in the order of joint_pos. ``action_mode="joint"``: each is a
 target normalised over its range (limb length over [l_min, l_max] = [0.365, 0.465] m, leg
 extension over [-leg_retract, leg_extend] = [-0.08, 0.16] m). ``"residual"`` (default): an
-offset from the reference gait's target of residual_scale x the half range; the zero action
-walks (and crosses) with the reference gait. Control runs at 10 Hz (control_dt = 0.1 s,
-physics 2 ms); the servo drives interpolate: each target is approached linearly over the
-control period, at most 0.25 m/s for a limb and 1 m/s for a leg (`model.add_upu`,
-``command="interpolated"``), as the stiff limb servos would otherwise jerk the feet into
-slipping on every step of the command.
+offset from the reference gait's targets of up to residual_limb_m (limbs) and residual_leg_m
+(legs), low-pass filtered with time constant residual_filter_tau (observation piece
+residual_state); the zero action walks (and crosses) with the reference gait. The defaults
+(2 mm, 5 mm, 0.5 s) are small because the paper's gait is fragile: at the full stride the
+CoG passes 15 mm from a support edge at 0.4 m height, the nearly vertical limbs turn 1 mm of
+length into ~10 mm of platform travel, and 1 mm of leg-length difference tilts the body by
+0.2 degrees; uniformly random actions with these defaults still cross in most episodes.
+
+Control runs at 10 Hz (control_dt = 0.1 s, physics 2 ms); the servo drives interpolate: each
+target is approached linearly over the control period, at most 0.25 m/s for a limb and 1 m/s
+for a leg (`model.add_upu`, ``command="interpolated"``), as the stiff limb servos would
+otherwise jerk the feet into slipping on every step of the command.
 
 The reference gait (`hexapod_envs.robots.upu.gait_schedule.GaitTiming`) takes 5.1 s per
 platform step: unload 0.4, lift 0.8, hold 0.2, transfer 2.5, hold 0.3, land 0.6, hold 0.3.
@@ -123,7 +130,8 @@ class DitchCrossingEnv(HexapodEnv):
     Keyword arguments (SI units): terrain ("ditch" | "flat"); ditch_start_x, ditch_width,
     ditch_depth [m] (defaults 0.6, 0.35, 0.14); ditch_start_x_range, ditch_width_range,
     ditch_depth_range ((low, high) [m] or None): when given, sampled uniformly from np_random at
-    every reset; action_mode ("residual" | "joint"), residual_scale; control_dt, physics_dt [s];
+    every reset; action_mode ("residual" | "joint"), residual_limb_m, residual_leg_m [m],
+    residual_filter_tau [s] (0: no filter); control_dt, physics_dt [s];
     progress_weight, stability_weight, tip_over_penalty, effort_weight; contact_threshold
     (fraction of the weight); tip_over_angle_deg; reset_noise_scale [m] (the robot starts
     shifted by up to this along x and y, and turned so that its feet move up to this much);
@@ -147,7 +155,9 @@ class DitchCrossingEnv(HexapodEnv):
         ditch_width_range: tuple[float, float] | None = None,
         ditch_depth_range: tuple[float, float] | None = None,
         action_mode: str = "residual",
-        residual_scale: float = 0.25,
+        residual_limb_m: float = 0.002,
+        residual_leg_m: float = 0.005,
+        residual_filter_tau: float = 0.5,
         control_dt: float = 0.1,
         physics_dt: float = 0.002,
         progress_weight: float = 20.0,
@@ -178,8 +188,13 @@ class DitchCrossingEnv(HexapodEnv):
             raise ValueError(f"terrain must be one of {TERRAINS}, got {terrain!r}")
         if action_mode not in ACTION_MODES:
             raise ValueError(f"action_mode must be one of {ACTION_MODES}, got {action_mode!r}")
-        if not (math.isfinite(residual_scale) and residual_scale > 0):
-            raise ValueError(f"residual_scale must be a finite number > 0, got {residual_scale}")
+        for name, value in (
+            ("residual_limb_m", residual_limb_m),
+            ("residual_leg_m", residual_leg_m),
+            ("residual_filter_tau", residual_filter_tau),
+        ):
+            if not (math.isfinite(value) and value >= 0):
+                raise ValueError(f"{name} must be a finite number >= 0, got {value}")
         if not 0 < contact_threshold < 1:
             raise ValueError(f"contact_threshold must be in (0, 1), got {contact_threshold}")
         if not 0 < tip_over_angle_deg < 90:
@@ -188,7 +203,10 @@ class DitchCrossingEnv(HexapodEnv):
             raise ValueError(f"reset_noise_scale must be >= 0 m, got {reset_noise_scale}")
         self.terrain = terrain
         self.action_mode = action_mode
-        self.residual_scale = residual_scale
+        self.residual_gain = np.array([residual_limb_m] * 3 + [residual_leg_m] * 6)
+        """Residual per unit action [m] (limbs, then legs)."""
+        self.residual_filter_alpha = control_dt / (residual_filter_tau + control_dt)
+        """Weight of a new residual action in the first-order filter (1: no filter)."""
         self.params = params or UpuParams()
         self.gait_timing = gait_timing or GaitTiming()
         self.gait_settings = gait_settings or GaitSettings()
@@ -237,7 +255,6 @@ class DitchCrossingEnv(HexapodEnv):
         self.command_low, self.command_high = low, high
         self._center = (low + high) / 2
         self._half = (high - low) / 2
-        self._residual_gain = residual_scale * self._half
         self.action_space = spaces.Box(-1.0, 1.0, shape=(len(COMMAND_NAMES),), dtype=np.float32)
         self._reference_power = self.weight_n * 0.1
         self._inv_dt = 1.0 / control_dt
@@ -256,6 +273,7 @@ class DitchCrossingEnv(HexapodEnv):
                 "imu_accel": 3,
                 "imu_quat": 4,
                 "reference_action": 9,
+                "residual_state": 9,
             }
         )
         self._set_plan(self.ditch)
@@ -388,6 +406,7 @@ class DitchCrossingEnv(HexapodEnv):
         # Settle onto the feet under the standing command (not part of the episode).
         for _ in range(int(round(0.5 / self.control_dt))):
             self._simulate()
+        self._residual = np.zeros(len(COMMAND_NAMES))
         self._tick = 0
         self._tipped = False
         self._success = False
@@ -407,7 +426,9 @@ class DitchCrossingEnv(HexapodEnv):
         if self.action_mode == "joint":
             target = self._center + self._half * action
         else:
-            target = self.schedule.command(self._tick) + self._residual_gain * action
+            r = self._residual
+            r += self.residual_filter_alpha * (self.residual_gain * action - r)
+            target = self.schedule.command(self._tick) + r
         # Interpolated commands: the servo targets (act) move linearly to `target` during the
         # control period; MuJoCo clamps the rate to the speed limits, the target to the ranges.
         d = self.data
@@ -478,7 +499,12 @@ class DitchCrossingEnv(HexapodEnv):
             "reference_action": self._reference_actions[
                 min(self._tick, len(self._reference_actions) - 1)
             ],
+            "residual_state": self._residual_units(),
         }
+
+    def _residual_units(self) -> np.ndarray:
+        gain = self.residual_gain
+        return np.divide(self._residual, gain, out=np.zeros_like(self._residual), where=gain > 0)
 
     def _observation(self) -> np.ndarray:
         """`_observation_pieces` written straight into the flat vector (the per-step path)."""
@@ -495,6 +521,7 @@ class DitchCrossingEnv(HexapodEnv):
         b[o["reference_action"]] = self._reference_actions[
             min(self._tick, len(self._reference_actions) - 1)
         ]
+        b[o["residual_state"]] = self._residual_units()
         return b.copy()
 
     def _reward_terms(self, cog_x: float, tipped: bool) -> dict[str, float]:
