@@ -161,7 +161,7 @@ class DitchCrossingEnv(HexapodEnv):
         control_dt: float = 0.1,
         physics_dt: float = 0.002,
         progress_weight: float = 20.0,
-        stability_weight: float = 0.25,
+        stability_weight: float = 0.05,
         tip_over_penalty: float = 100.0,
         effort_weight: float = 0.02,
         contact_threshold: float = 0.005,
