@@ -19,13 +19,16 @@ def test_bad_keyword_arguments_are_named():
         DitchCrossingEnv(terrain="lava")
     with pytest.raises(ValueError, match="action_mode"):
         DitchCrossingEnv(action_mode="torque")
-    with pytest.raises(ValueError, match="under the robot"):
+    with pytest.raises(ValueError, match="under or right in front"):
         DitchCrossingEnv(ditch_start_x=0.15)
+    with pytest.raises(ValueError, match="x >= 0.240"):
+        DitchCrossingEnv(ditch_start_x=0.23)
+    DitchCrossingEnv(ditch_start_x=0.241).reset(seed=0)  # about the closest that can be planned
     with pytest.raises(ValueError, match="ditch_width_range"):
         DitchCrossingEnv(ditch_width_range=(0.4, 0.3))
     with pytest.raises(ValueError, match="ditch_depth_range"):
         DitchCrossingEnv(ditch_depth_range=0.1)
-    with pytest.raises(ValueError, match="under the robot"):
+    with pytest.raises(ValueError, match="under or right in front"):
         DitchCrossingEnv(ditch_start_x_range=(0.1, 0.6))
     with pytest.raises(ValueError, match="width"):
         DitchCrossingEnv(ditch_width=0.0)

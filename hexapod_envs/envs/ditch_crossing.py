@@ -281,13 +281,14 @@ class DitchCrossingEnv(HexapodEnv):
     # --- geometry, model, plan -----------------------------------------------------------------
     def _check_geometry(self, ditch_start_x: float, ditch_width: float, ditch_depth: float):
         Ditch(ditch_start_x, ditch_width, ditch_depth)  # finite, width and depth > 0
-        band = self.params.foot_radius + 0.001
+        # The planner needs every foot a foot radius plus the edge clearance from the ditch.
+        band = self.params.foot_radius + self.gait_settings.edge_clearance
         front = self.start_x + self.params.leg_circle_radius
         if ditch_start_x - band < front:
             raise ValueError(
-                f"ditch_start_x = {ditch_start_x} m puts the ditch under the robot: its front "
-                f"feet stand at x = {front} m, so the ditch must start beyond "
-                f"{front + band:.3f} m"
+                f"ditch_start_x = {ditch_start_x} m puts the ditch under or right in front of "
+                f"the robot: its front feet stand at x = {front} m, so the ditch must start at "
+                f"x >= {front + band:.3f} m"
             )
 
     @property
