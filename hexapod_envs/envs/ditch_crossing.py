@@ -207,6 +207,8 @@ class DitchCrossingEnv(HexapodEnv):
         """Residual per unit action [m] (limbs, then legs)."""
         self.residual_filter_alpha = control_dt / (residual_filter_tau + control_dt)
         """Weight of a new residual action in the first-order filter (1: no filter)."""
+        gain = self.residual_gain
+        self._inv_residual_gain = np.divide(1.0, gain, out=np.zeros(9), where=gain > 0)
         self.params = params or UpuParams()
         self.gait_timing = gait_timing or GaitTiming()
         self.gait_settings = gait_settings or GaitSettings()
@@ -277,6 +279,17 @@ class DitchCrossingEnv(HexapodEnv):
             }
         )
         self._set_plan(self.ditch)
+        # The three IMU pieces are adjacent in the observation and in sensordata: one copy.
+        o = self.observation_layout.slices
+        self._imu_obs = slice(o["imu_gyro"].start, o["imu_quat"].stop)
+        sensors = self.sensors
+        self._imu_sensors = slice(sensors._gyro.start, sensors._quat.stop)
+        if not (
+            sensors._accel.start == sensors._gyro.stop
+            and sensors._quat.start == sensors._accel.stop
+            and o["imu_accel"].start == o["imu_gyro"].stop
+        ):  # pragma: no cover - the model builder adds the IMU sensors in this order
+            raise RuntimeError("IMU sensors are expected to be adjacent in sensordata")
 
     # --- geometry, model, plan -----------------------------------------------------------------
     def _check_geometry(self, ditch_start_x: float, ditch_width: float, ditch_depth: float):
@@ -408,6 +421,11 @@ class DitchCrossingEnv(HexapodEnv):
         for _ in range(int(round(0.5 / self.control_dt))):
             self._simulate()
         self._residual = np.zeros(len(COMMAND_NAMES))
+        self._episode_info = {  # info entries fixed for the episode
+            "planner_status": self.plan.status,
+            "planner_reason": self.plan.reason,
+            "finish_x": self.finish_x,
+        }
         self._tick = 0
         self._tipped = False
         self._success = False
@@ -472,11 +490,18 @@ class DitchCrossingEnv(HexapodEnv):
             pts = soles[loaded].tolist()
             xs = [q[0] for q in pts]
             ys = [q[1] for q in pts]
+            px, py = float(cog[0]), float(cog[1])
+            if len(xs) == 3:  # a tripod (most steps): its hull is the triangle, ordered ccw
+                area2 = (xs[1] - xs[0]) * (ys[2] - ys[0]) - (ys[1] - ys[0]) * (xs[2] - xs[0])
+                if area2 != 0.0:
+                    hull = [0, 1, 2] if area2 > 0 else [0, 2, 1]
+                    self._static_margin = signed_distance_2d(xs, ys, hull, px, py)
+                    return
             try:  # same computation as stability.static_stability_margin, gravity along -z
                 hull = hull_2d(xs, ys)
             except ValueError:  # loaded feet on a line: no polygon
                 return
-            self._static_margin = signed_distance_2d(xs, ys, hull, float(cog[0]), float(cog[1]))
+            self._static_margin = signed_distance_2d(xs, ys, hull, px, py)
 
     def _all_feet_past_finish(self) -> bool:
         if not self._loaded.all():
@@ -504,8 +529,7 @@ class DitchCrossingEnv(HexapodEnv):
         }
 
     def _residual_units(self) -> np.ndarray:
-        gain = self.residual_gain
-        return np.divide(self._residual, gain, out=np.zeros_like(self._residual), where=gain > 0)
+        return self._residual * self._inv_residual_gain
 
     def _observation(self) -> np.ndarray:
         """`_observation_pieces` written straight into the flat vector (the per-step path)."""
@@ -516,9 +540,7 @@ class DitchCrossingEnv(HexapodEnv):
         b[o["foot_contact"]] = self._loaded
         b[o["fasm_margin_deg"]] = self._fasm_deg
         b[o["static_margin_m"]] = self._static_margin
-        b[o["imu_gyro"]] = d.sensordata[self.sensors._gyro]
-        b[o["imu_accel"]] = d.sensordata[self.sensors._accel]
-        b[o["imu_quat"]] = d.sensordata[self.sensors._quat]
+        b[self._imu_obs] = d.sensordata[self._imu_sensors]  # gyro, accel, quat
         b[o["reference_action"]] = self._reference_actions[
             min(self._tick, len(self._reference_actions) - 1)
         ]
@@ -541,26 +563,23 @@ class DitchCrossingEnv(HexapodEnv):
 
     def _info(self, terms: dict[str, float], unstable: bool) -> dict:
         step, phase = self.schedule.phase(self._tick)
-        cog = self.sensors.cog()
+        cog = self.data.subtree_com[self._torso]
         up_z = min(1.0, max(-1.0, float(self.data.xmat[self._torso, 8])))
-        info = {f"reward_{name}": value for name, value in terms.items()}
-        info.update(
-            fasm_margin_deg=self._fasm_deg,
-            static_margin_m=self._static_margin,
-            stance_legs=tuple(compress(LEG_NAMES, self._loaded.tolist())),
-            is_tipping=self._static_margin <= 0.0,
-            is_tipped_over=self._tipped,
-            is_success=self._success and not unstable,
-            sim_unstable=unstable,
-            distance=float(cog[0]) - self._start_cog_x,
-            tilt_deg=math.degrees(math.acos(up_z)),
-            planner_status=self.plan.status,
-            planner_reason=self.plan.reason,
-            ditch=self._ditch_info,
-            finish_x=self.finish_x,
-            gait_step=step,
-            gait_phase=phase,
-            time=self._tick * self.control_dt,
-            cog=cog.copy(),
-        )
-        return info
+        return {
+            **{f"reward_{name}": value for name, value in terms.items()},
+            "fasm_margin_deg": self._fasm_deg,
+            "static_margin_m": self._static_margin,
+            "stance_legs": tuple(compress(LEG_NAMES, self._loaded.tolist())),
+            "is_tipping": self._static_margin <= 0.0,
+            "is_tipped_over": self._tipped,
+            "is_success": self._success and not unstable,
+            "sim_unstable": unstable,
+            "distance": float(cog[0]) - self._start_cog_x,
+            "tilt_deg": math.degrees(math.acos(up_z)),
+            **self._episode_info,
+            "ditch": self._ditch_info,  # a new dict every step (callers may keep infos)
+            "gait_step": step,
+            "gait_phase": phase,
+            "time": self._tick * self.control_dt,
+            "cog": cog.copy(),
+        }
