@@ -200,8 +200,11 @@ def _learn(
     specs: list,
     resumed: bool,
 ) -> TrainResult:
+    import torch
     from stable_baselines3.common.callbacks import CallbackList
     from stable_baselines3.common.logger import Logger, make_output_format
+
+    torch.set_num_threads(config.train.num_threads)
 
     from .callbacks import (
         CheckpointEvery,
