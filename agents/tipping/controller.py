@@ -89,7 +89,7 @@ from agents.tipping.trajectory import (
 )
 from hexapod_envs.robots.heavy_duty.kinematics import joints_for_foot
 from hexapod_envs.robots.heavy_duty.params import LEG_NAMES, HeavyDutyParams
-from hexapod_envs.stability import fasm
+from hexapod_envs.stability import fasm_from_feet
 
 PHASES: tuple[str, ...] = ("monitor", "swing", "touchdown", "supported", "holding")
 """Controller phases: watching the margin; adjustment leg on its quintic; descending until
@@ -327,27 +327,7 @@ class TippingRecoveryController:
 
         f_r and n_r are minus the measured support wrench about the CoG (seed 000 eq. 4).
         """
-        idx = [i for i, on in enumerate(loaded.tolist()) if on]
-        if len(idx) < 3:
-            return 0.0, None
-        all_p, all_f = feet.tolist(), forces.tolist()
-        cx, cy, cz = cog.tolist()
-        fx = fy = fz = mx = my = mz = 0.0
-        for i in idx:  # plain floats: a few feet, numpy overhead would dominate
-            px, py, pz = all_p[i]
-            gx, gy, gz = all_f[i]
-            rx, ry, rz = px - cx, py - cy, pz - cz
-            fx -= gx
-            fy -= gy
-            fz -= gz
-            mx -= ry * gz - rz * gy
-            my -= rz * gx - rx * gz
-            mz -= rx * gy - ry * gx
-        try:
-            result = fasm([all_p[i] for i in idx], (cx, cy, cz), (fx, fy, fz), (mx, my, mz))
-        except ValueError:  # collinear feet, zero force: no polygon to tip about
-            return 0.0, None
-        return float(result.margin_deg), (idx[result.edge[0]], idx[result.edge[1]])
+        return fasm_from_feet(feet, forces, cog, loaded)
 
     # --- main step -------------------------------------------------------------------------
     def step(self, reading: SensorReading, nominal: np.ndarray, time: float) -> np.ndarray:

@@ -91,11 +91,11 @@ from ..robots.upu.gait_schedule import (
 )
 from ..robots.upu.model import add_upu
 from ..robots.upu.params import LEG_NAMES, UpuParams
+from ..stability import fasm_from_feet
 from ..stability._geometry import hull_2d, signed_distance_2d
 from ..terrain.ditch import add_ditch
 from ..terrain.flat import add_flat
 from .base import HexapodEnv
-from .heavy_duty import fasm_from_feet
 from .sensors import RobotSensors
 
 TERRAINS = ("ditch", "flat")

@@ -20,7 +20,7 @@ from gymnasium import spaces
 from ..robots.heavy_duty import LEG_NAMES, HeavyDutyParams
 from ..robots.heavy_duty.gait import TripodGait, TripodGaitParams
 from ..robots.heavy_duty.model import add_heavy_duty
-from ..stability import fasm
+from ..stability import fasm_from_feet
 from .base import HexapodEnv
 from .sensors import RobotSensors
 
@@ -44,37 +44,6 @@ class JointActionMap:
 
     def to_action(self, joints: np.ndarray) -> np.ndarray:
         return np.clip((np.asarray(joints).reshape(-1) - self.center) / self.half, -1.0, 1.0)
-
-
-def fasm_from_feet(
-    feet: np.ndarray, forces: np.ndarray, cog: np.ndarray, loaded: np.ndarray
-) -> tuple[float, tuple[int, int] | None]:
-    """FASM [deg] from measured foot forces: f_r, n_r = minus the support wrench about the CoG.
-
-    Returns (0, None) when fewer than three feet carry load: no support polygon exists.
-    """
-    idx = [i for i, on in enumerate(loaded.tolist()) if on]
-    if len(idx) < 3:
-        return 0.0, None
-    # Plain floats: at k <= 6 feet this is several times faster than numpy calls.
-    all_p, all_f = feet.tolist(), forces.tolist()
-    p = [all_p[i] for i in idx]
-    cx, cy, cz = cog.tolist()
-    fx = fy = fz = mx = my = mz = 0.0
-    for i, (px, py, pz) in zip(idx, p, strict=True):
-        gx, gy, gz = all_f[i]
-        rx, ry, rz = px - cx, py - cy, pz - cz
-        fx -= gx
-        fy -= gy
-        fz -= gz
-        mx -= ry * gz - rz * gy
-        my -= rz * gx - rx * gz
-        mz -= rx * gy - ry * gx
-    try:
-        result = fasm(p, (cx, cy, cz), (fx, fy, fz), (mx, my, mz))
-    except ValueError:  # collinear feet: the robot is balanced on a line
-        return 0.0, None
-    return float(result.margin_deg), (idx[result.edge[0]], idx[result.edge[1]])
 
 
 class HeavyDutyEnv(HexapodEnv):

@@ -96,11 +96,12 @@ from ..robots.athena.gait import AthenaPostureController, AthenaSensors
 from ..robots.athena.kinematics import standing_foot_positions
 from ..robots.athena.model import add_athena
 from ..robots.athena.params import ATHENA, LEG_NAMES
+from ..stability import fasm_from_feet
 from ..stability.zmp import zmp_margin
 from ..terrain.flat import add_flat
 from ..terrain.irregular import PAPER_FRICTION, add_blocks, add_ramp
 from .base import HexapodEnv
-from .heavy_duty import JointActionMap, fasm_from_feet
+from .heavy_duty import JointActionMap
 from .sensors import RobotSensors
 
 TERRAINS = ("ramp", "blocks", "flat")

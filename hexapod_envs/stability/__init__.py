@@ -4,14 +4,15 @@ All functions take contact points in one frame (metres) and are cheap enough to 
 control step:
 
 - :func:`support_polygon` - convex hull of the contacts, counter-clockwise seen from above.
-- :func:`fasm` - Force-Angle Stability Measure (seed 000 eqs. 5-9), degrees.
+- :func:`fasm` - Force-Angle Stability Measure (seed 000 eqs. 5-9), degrees;
+  :func:`fasm_from_feet` - the same from measured foot forces (minus the support wrench).
 - :func:`static_stability_margin` - CoG projection to support polygon boundary, metres.
 - :func:`zmp`, :func:`zmp_margin` - force-weighted ZMP and its margin (seed 002 eqs. 32-33).
 - :func:`nesm` - Hirose's normalised energy stability margin, metres.
 - :func:`fit_plane` - least-squares ground plane z = a x + b y + c (seed 000 §4.2).
 """
 
-from hexapod_envs.stability.fasm import FasmResult, fasm
+from hexapod_envs.stability.fasm import FasmResult, fasm, fasm_from_feet
 from hexapod_envs.stability.nesm import nesm, nesm_per_edge
 from hexapod_envs.stability.plane_fit import Plane, fit_plane
 from hexapod_envs.stability.static_margin import static_stability_margin
@@ -22,6 +23,7 @@ __all__ = [
     "FasmResult",
     "Plane",
     "fasm",
+    "fasm_from_feet",
     "fit_plane",
     "nesm",
     "nesm_per_edge",

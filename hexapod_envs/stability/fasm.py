@@ -193,3 +193,38 @@ def _ordered_hull(pts: list[list[float]], cog, up) -> list[int]:
     if (gx - cx) * ux + (gy - cy) * uy + (gz - cz) * uz < 0.0:
         ux, uy, uz = -ux, -uy, -uz
     return hull_3d(pts, (ux, uy, uz))
+
+
+def fasm_from_feet(
+    feet: np.ndarray, forces: np.ndarray, cog: np.ndarray, loaded: np.ndarray
+) -> tuple[float, tuple[int, int] | None]:
+    """FASM [deg] and its edge from measured foot forces, as a robot computes it online.
+
+    `feet` (n, 3) contact points and `forces` (n, 3) ground reactions on the feet [N], in one
+    frame with `cog`; `loaded` (n,) marks the feet that carry load. f_r and n_r are minus the
+    measured support wrench about the CoG (seed 000 eq. 4). Returns (margin_deg, (i, j)) with
+    the edge as indices into `feet`, or (0, None) when the loaded feet span no support polygon
+    (fewer than three, or collinear): the robot is at the tipping limit.
+    """
+    idx = [i for i, on in enumerate(loaded.tolist()) if on]
+    if len(idx) < 3:
+        return 0.0, None
+    # Plain floats: at k <= 6 feet this is several times faster than numpy calls.
+    all_p, all_f = feet.tolist(), forces.tolist()
+    p = [all_p[i] for i in idx]
+    cx, cy, cz = cog.tolist()
+    fx = fy = fz = mx = my = mz = 0.0
+    for i, (px, py, pz) in zip(idx, p, strict=True):
+        gx, gy, gz = all_f[i]
+        rx, ry, rz = px - cx, py - cy, pz - cz
+        fx -= gx
+        fy -= gy
+        fz -= gz
+        mx -= ry * gz - rz * gy
+        my -= rz * gx - rx * gz
+        mz -= rx * gy - ry * gx
+    try:
+        result = fasm(p, (cx, cy, cz), (fx, fy, fz), (mx, my, mz))
+    except ValueError:  # collinear feet or zero force: no polygon to stand on
+        return 0.0, None
+    return float(result.margin_deg), (idx[result.edge[0]], idx[result.edge[1]])

@@ -1,0 +1,41 @@
+"""fasm_from_feet: the FASM a robot computes from its measured foot forces."""
+
+import numpy as np
+import pytest
+
+from hexapod_envs.stability import fasm, fasm_from_feet
+
+FEET = np.array([[x, y, -1.75] for y in (1.9, -1.9) for x in (2.4, 0.0, -2.4)])
+WEIGHT = 5000 * 9.81
+
+
+def static_forces(feet, cog):
+    """Vertical foot forces in static balance (least-norm solution of the two moment equations)."""
+    a = np.vstack([np.ones(len(feet)), feet[:, 0] - cog[0], feet[:, 1] - cog[1]])
+    fz = np.linalg.lstsq(a, [WEIGHT, 0.0, 0.0], rcond=None)[0]
+    return np.column_stack([np.zeros(len(feet)), np.zeros(len(feet)), fz])
+
+
+def test_static_balance_matches_fasm_with_gravity():
+    cog = np.array([0.3, -0.2, 0.0])
+    forces = static_forces(FEET, cog)
+    margin, edge = fasm_from_feet(FEET, forces, cog, np.ones(6, bool))
+    expected = fasm(FEET, cog, (0.0, 0.0, -WEIGHT))
+    assert margin == pytest.approx(expected.margin_deg, abs=1e-9)
+    assert edge == expected.edge
+
+
+def test_unloaded_feet_are_left_out_and_edge_indexes_the_full_array():
+    loaded = np.array([True, False, True, False, True, False])  # LF LR RM of this ordering
+    feet = FEET.copy()
+    forces = static_forces(feet[loaded], np.zeros(3))
+    full = np.zeros((6, 3))
+    full[loaded] = forces
+    margin, edge = fasm_from_feet(feet, full, np.zeros(3), loaded)
+    assert margin == pytest.approx(np.degrees(np.arctan2(1.0147, 1.75)), abs=0.05)
+    assert set(edge) <= set(np.flatnonzero(loaded).tolist())
+
+
+def test_fewer_than_three_loaded_feet_is_zero_margin():
+    loaded = np.array([True, True, False, False, False, False])
+    assert fasm_from_feet(FEET, np.zeros((6, 3)), np.zeros(3), loaded) == (0.0, None)
