@@ -78,6 +78,6 @@ def test_docstring_tables_name_every_observation_piece_and_reward_term(env_id):
     _, info = env.reset(seed=0)
     _, _, _, _, info = env.step(env.action_space.sample())
     missing = [name for name in base.observation_structure if name not in doc]
-    missing += [k for k in info if k.startswith("reward_") and k[len("reward_"):] not in doc]
+    missing += [k for k in info if k.startswith("reward_") and k[len("reward_") :] not in doc]
     env.close()
     assert not missing, f"{env_id} docstring does not mention {missing}"
