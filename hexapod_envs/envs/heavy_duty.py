@@ -97,8 +97,8 @@ class HeavyDutyEnv(HexapodEnv):
         self.contact_threshold = contact_threshold
         self.tip_over_cos = float(np.cos(np.radians(tip_over_angle_deg)))
         self.reset_noise_scale = reset_noise_scale
-        self.settle_time = 0.5
         # Physics run in reset() so the episode starts with the robot resting on its feet [s].
+        self.settle_time = 0.5
         self.weight_n = self.robot.total_mass * 9.81
         self._contact_force_sq = (contact_threshold * self.weight_n) ** 2
         self.action_map = JointActionMap(np.tile(self.robot.joint_ranges, (6, 1)))
