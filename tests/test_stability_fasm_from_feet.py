@@ -39,3 +39,10 @@ def test_unloaded_feet_are_left_out_and_edge_indexes_the_full_array():
 def test_fewer_than_three_loaded_feet_is_zero_margin():
     loaded = np.array([True, True, False, False, False, False])
     assert fasm_from_feet(FEET, np.zeros((6, 3)), np.zeros(3), loaded) == (0.0, None)
+
+
+def test_non_finite_forces_are_a_clear_error():
+    forces = static_forces(FEET, np.zeros(3))
+    forces[2, 2] = np.nan
+    with pytest.raises(ValueError, match="NaN"):
+        fasm_from_feet(FEET, forces, np.zeros(3), np.ones(6, bool))

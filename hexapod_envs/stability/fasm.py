@@ -105,19 +105,33 @@ def fasm(feet, cog, force, moment=None, up=None) -> FasmResult:
     k = len(pts)
     if k < 3:
         raise ValueError(f"FASM needs at least 3 feet in contact, got {k}")
-    gx, gy, gz = as_vec3(cog, "cog")
-    fx, fy, fz = as_vec3(force, "force")
+    cog_v = as_vec3(cog, "cog")
+    force_v = as_vec3(force, "force")
+    moment_v = (0.0, 0.0, 0.0) if moment is None else as_vec3(moment, "moment")
+    angles, forces, edges = _edge_angles(pts, cog_v, force_v, moment_v, up)
+    margin = min(angles)
+    index = angles.index(margin)
+    return FasmResult(
+        margin_deg=margin,
+        angles_deg=np.array(angles),
+        edges=np.array(edges, dtype=np.intp),
+        edge=edges[index],
+        edge_index=index,
+        tipping_forces=np.array(forces),
+    )
+
+
+def _edge_angles(pts, cog, force, moment, up):
+    """Per-edge angles [deg], tipping forces [N] and (i, j) edges on validated plain floats."""
+    gx, gy, gz = cog
+    fx, fy, fz = force
+    nx, ny, nz = moment
     f_norm = math.sqrt(fx * fx + fy * fy + fz * fz)
     if f_norm == 0.0:
         raise ValueError(
             "the net destabilising force is zero, so the force angles are undefined; "
             "pass gravity + external + inertial force (e.g. (0, 0, -m*g))"
         )
-    if moment is None:
-        nx = ny = nz = 0.0
-    else:
-        nx, ny, nz = as_vec3(moment, "moment")
-
     hull = _ordered_hull(pts, (gx, gy, gz), up)
 
     m = len(hull)
@@ -159,16 +173,7 @@ def fasm(feet, cog, force, moment=None, up=None) -> FasmResult:
             angles[j] = math.degrees(math.atan2(f_t, f_l))
         forces[j] = size / l_norm
 
-    margin = min(angles)
-    index = angles.index(margin)
-    return FasmResult(
-        margin_deg=margin,
-        angles_deg=np.array(angles),
-        edges=np.array(edges, dtype=np.intp),
-        edge=edges[index],
-        edge_index=index,
-        tipping_forces=np.array(forces),
-    )
+    return angles, forces, edges
 
 
 def _ordered_hull(pts: list[list[float]], cog, up) -> list[int]:
@@ -223,8 +228,12 @@ def fasm_from_feet(
         mx -= ry * gz - rz * gy
         my -= rz * gx - rx * gz
         mz -= rx * gy - ry * gx
-    try:
-        result = fasm(p, (cx, cy, cz), (fx, fy, fz), (mx, my, mz))
+    if not math.isfinite(fx + fy + fz + mx + my + mz + cx + cy + cz):
+        raise ValueError("foot forces, feet or CoG contain NaN or infinite values")
+    try:  # the inputs are plain floats already: skip fasm()'s array validation
+        angles, _, edges = _edge_angles(p, (cx, cy, cz), (fx, fy, fz), (mx, my, mz), None)
     except ValueError:  # collinear feet or zero force: no polygon to stand on
         return 0.0, None
-    return float(result.margin_deg), (idx[result.edge[0]], idx[result.edge[1]])
+    margin = min(angles)
+    i, j = edges[angles.index(margin)]
+    return margin, (idx[i], idx[j])
