@@ -44,11 +44,11 @@ def timings(fn, repeats: int) -> np.ndarray:
     return out * 1e6
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=3000)
-    args = parser.parse_args()
+STAGES = ("solver call", "solve_qp (+bookkeeping)", "build", "build + solve")
 
+
+def print_qp_timings(repeats: int, stages: tuple[str, ...] = STAGES) -> None:
+    """Median and 90th-percentile times [µs] of the 4-stance-foot QP per back end and stage."""
     params = HeavyDutyParams()
     feet_by_leg = standing_feet(params)
     feet = np.array([feet_by_leg[leg] for leg in ("LF", "LR", "RM", "RR")])
@@ -57,7 +57,7 @@ def main() -> None:
     gravity = GRAVITY * np.array([math.sin(pitch), 0.0, -math.cos(pitch)])
     wrench = desired_wrench(params.total_mass, np.diag([3.0e3, 8.5e3, 1.0e4]), gravity)
 
-    print(f"force distribution QP, 4 stance feet, {args.repeats} repeats, times in µs")
+    print(f"force distribution QP, 4 stance feet, {repeats} repeats, times in µs")
     print(f"{'solver':10s} {'stage':24s} {'median':>8s} {'p90':>8s}")
     reference = None
     for solver in SOLVERS:
@@ -68,7 +68,7 @@ def main() -> None:
         if reference is None:
             reference = result.forces
         gap = float(np.abs(result.forces - reference).max())
-        stages = {
+        calls = {
             "solver call": lambda qp=qp, s=solver: qpsolvers.solve_qp(
                 qp.U, qp.f, qp.G, qp.h, solver=s
             ),
@@ -76,10 +76,17 @@ def main() -> None:
             "build": lambda d=distributor: d.build(feet, cog, wrench),
             "build + solve": lambda d=distributor: d.solve(feet, cog, wrench),
         }
-        for stage, fn in stages.items():
-            t = timings(fn, args.repeats)
+        for stage in stages:
+            t = timings(calls[stage], repeats)
             print(f"{solver:10s} {stage:24s} {np.median(t):8.1f} {np.percentile(t, 90):8.1f}")
         print(f"{solver:10s} {'max |Δforce| vs daqp':24s} {gap:8.2e} N")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=3000)
+    args = parser.parse_args()
+    print_qp_timings(args.repeats)
 
 
 if __name__ == "__main__":

@@ -20,48 +20,14 @@ from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
-import qpsolvers
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from bench_force_distribution import timings  # noqa: E402
+from bench_force_distribution import print_qp_timings  # noqa: E402
 
 import hexapod_envs  # noqa: E402, F401
 from agents.tipping.controller import TippingRecoveryPolicy  # noqa: E402
-from agents.tipping.force_distribution import (  # noqa: E402
-    GRAVITY,
-    SOLVERS,
-    ForceDistributionConfig,
-    ForceDistributor,
-    desired_wrench,
-)
-from hexapod_envs.robots.heavy_duty import HeavyDutyParams, standing_feet  # noqa: E402
 
 CASES = [(s, st) for s in ("climb", "descend", "side") for st in ("LF-LR-RM", "LM-RF-RR")]
-
-
-def qp_figures(repeats: int) -> None:
-    params = HeavyDutyParams()
-    feet_by_leg = standing_feet(params)
-    feet = np.array([feet_by_leg[leg] for leg in ("LF", "LR", "RM", "RR")])
-    cog = np.zeros(3)
-    pitch = np.radians(10.0)
-    gravity = GRAVITY * np.array([np.sin(pitch), 0.0, -np.cos(pitch)])
-    wrench = desired_wrench(params.total_mass, np.diag([3.0e3, 8.5e3, 1.0e4]), gravity)
-    print(f"force-distribution QP, 4 stance feet, stability cone on, {repeats} repeats [µs]")
-    print(f"  {'solver':9s} {'stage':16s} {'median':>8s} {'p90':>8s}")
-    for solver in SOLVERS:
-        distributor = ForceDistributor(4, ForceDistributionConfig(solver=solver))
-        qp = distributor.build(feet, cog, wrench)
-        assert distributor.solve_qp(qp).ok
-        stages = {
-            "solver call": lambda qp=qp, s=solver: qpsolvers.solve_qp(
-                qp.U, qp.f, qp.G, qp.h, solver=s
-            ),
-            "build + solve": lambda d=distributor: d.solve(feet, cog, wrench),
-        }
-        for stage, fn in stages.items():
-            t = timings(fn, repeats)
-            print(f"  {solver:9s} {stage:16s} {np.median(t):8.1f} {np.percentile(t, 90):8.1f}")
 
 
 def controller_figures(cases: list[tuple[str, str]]) -> None:
@@ -117,7 +83,7 @@ def main() -> None:
     parser.add_argument("--repeats", type=int, default=3000)
     parser.add_argument("--cases", choices=("all", "climb"), default="all")
     args = parser.parse_args()
-    qp_figures(args.repeats)
+    print_qp_timings(args.repeats, stages=("solver call", "build + solve"))
     controller_figures(CASES if args.cases == "all" else CASES[:1])
 
 

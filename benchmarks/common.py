@@ -9,32 +9,6 @@ import mujoco
 import numpy as np
 
 
-def raw_step_rate(model: mujoco.MjModel, data: mujoco.MjData, seconds: float = 2.0) -> float:
-    """mj_step calls per second on `model` from its current state (one call per physics step)."""
-    n, start = 0, time.perf_counter()
-    while time.perf_counter() - start < seconds:
-        for _ in range(100):
-            mujoco.mj_step(model, data)
-        n += 100
-    return n / (time.perf_counter() - start)
-
-
-def env_physics_rate(env: gym.Env, policy=None, seconds: float = 2.0, seed: int = 0) -> float:
-    """Physics steps per second through env.step (control steps x substeps), resetting as needed."""
-    base = env.unwrapped
-    substeps = getattr(base, "n_substeps", None) or getattr(base, "frame_skip", 1)
-    obs, _ = env.reset(seed=seed)
-    zero = np.zeros(env.action_space.shape, dtype=env.action_space.dtype)
-    n, start = 0, time.perf_counter()
-    while time.perf_counter() - start < seconds:
-        action = policy(obs) if policy is not None else zero
-        obs, _, terminated, truncated, _ = env.step(action)
-        n += 1
-        if terminated or truncated:
-            obs, _ = env.reset()
-    return n * substeps / (time.perf_counter() - start)
-
-
 def replay_step_rate(env: gym.Env, steps: int, seed: int = 0) -> tuple[float, float]:
     """(raw mj_step rate, env physics rate) over the same motion.
 
