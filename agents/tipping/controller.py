@@ -633,11 +633,13 @@ class TippingRecoveryPolicy:
     def reset(self) -> None:
         self.controller.reset()
         self._steps = 0
+        self._saturated = False
 
     @property
     def diagnostics(self) -> dict[str, Any]:
-        """The controller's state: phase, adjustment leg, foothold, t_s, forces, QP status..."""
-        return self.controller.diagnostics
+        """The controller's state (phase, adjustment leg, foothold, t_s, forces, QP status...)
+        plus ``saturated``: a target was clipped by the action's residual range."""
+        return {**self.controller.diagnostics, "saturated": self._saturated}
 
     def nominal(self, observation: np.ndarray) -> np.ndarray:
         """Joint targets without recovery: the env's reference posture."""
@@ -647,7 +649,9 @@ class TippingRecoveryPolicy:
         joints = np.asarray(targets).reshape(-1)
         if self.action_mode == "residual":
             reference = self.env.unwrapped.reference_joints()
-            action = np.clip((joints - reference) / self._gain, -1.0, 1.0)
+            raw = (joints - reference) / self._gain
+            self._saturated = self._saturated or bool(np.any(np.abs(raw) > 1.0 + 1e-9))
+            action = np.clip(raw, -1.0, 1.0)
         else:
             action = self.action_map.to_action(joints)
         return action.astype(self._dtype)

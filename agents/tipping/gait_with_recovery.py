@@ -23,26 +23,21 @@ through ``diagnostics["saturated"]``.
 
 from __future__ import annotations
 
-from typing import Any
-
 import gymnasium as gym
 import numpy as np
 
-from agents.policy import ObservationReader
-from agents.tipping.controller import (
-    RecoveryConfig,
-    SensorReading,
-    TippingRecoveryController,
-    _config_with,
-)
+from agents.tipping.controller import RecoveryConfig, TippingRecoveryPolicy
 from agents.tripod_gait import TripodGaitPolicy
 
 FULL_AUTHORITY_RESIDUAL_SCALE = 2.0
 """A residual scale from which any joint target is reachable from any reference."""
 
 
-class GaitWithRecoveryPolicy:
+class GaitWithRecoveryPolicy(TippingRecoveryPolicy):
     """Tripod gait + tipping recovery for the walking heavy-duty envs (HexapodCliffWalk-v0).
+
+    The recovery policy with the reference gait, instead of a fixed posture, as the nominal
+    motion; ``diagnostics["saturated"]`` tells when the residual range clipped a target.
 
     Args:
         env: a walking heavy-duty hexapod env (with the ``gait_phase`` observation).
@@ -56,46 +51,16 @@ class GaitWithRecoveryPolicy:
                 f"{type(base).__name__} has no gait_phase observation; GaitWithRecoveryPolicy "
                 "needs a walking heavy-duty hexapod env such as HexapodCliffWalk-v0"
             )
-        self.env = env
         self.gait = TripodGaitPolicy(env)
-        self.config = _config_with(config, overrides)
-        self.read = ObservationReader(base.observation_structure)
-        self.action_map = base.action_map
-        self.action_mode = base.action_mode
-        self.control_dt = float(base.control_dt)
+        super().__init__(env, config, **overrides)
         self.full_authority = (
             self.action_mode == "joint" or base.residual_scale >= FULL_AUTHORITY_RESIDUAL_SCALE
         )
-        if self.action_mode == "residual":
-            self._gain = base.residual_scale * self.action_map.half
-        self._dtype = env.action_space.dtype
-        self.controller = TippingRecoveryController(base.robot, self.config, self.control_dt)
-        self.reset()
 
     def reset(self) -> None:
-        self.controller.reset()
+        super().reset()
         self.gait.reset()
-        self._steps = 0
-        self._saturated = False
 
-    @property
-    def diagnostics(self) -> dict[str, Any]:
-        """The recovery controller's diagnostics plus ``saturated`` (targets clipped by the
-        action's residual range after the take-over)."""
-        return {**self.controller.diagnostics, "saturated": self._saturated}
-
-    def __call__(self, observation: np.ndarray) -> np.ndarray:
-        pieces = self.read(observation)
-        reading = SensorReading.from_observation(pieces)
-        time = self._steps * self.control_dt
-        self._steps += 1
-        nominal = self.gait.joint_targets(observation).reshape(6, 3)
-        targets = self.controller.step(reading, nominal, time).reshape(-1)
-        if self.action_mode == "residual":
-            reference = self.env.unwrapped.reference_joints()
-            raw = (targets - reference) / self._gain
-            self._saturated = self._saturated or bool(np.any(np.abs(raw) > 1.0 + 1e-9))
-            action = np.clip(raw, -1.0, 1.0)
-        else:
-            action = self.action_map.to_action(targets)
-        return action.astype(self._dtype)
+    def nominal(self, observation: np.ndarray) -> np.ndarray:
+        """Joint targets without recovery: the reference tripod gait at the observed phase."""
+        return self.gait.joint_targets(observation).reshape(6, 3)
