@@ -38,6 +38,28 @@ def check_kwargs(cls: type, kwargs: Mapping[str, Any]) -> None:
         )
 
 
+def check_choice(name: str, value: Any, choices) -> None:
+    """Raise a ValueError naming `name`, the bad value and the valid choices."""
+    if value not in choices:
+        raise ValueError(f"{name} must be one of {sorted(choices)}, got {value!r}")
+
+
+class JointActionMap:
+    """Maps normalised actions in [-1, 1] to joint targets in the robot's units and back."""
+
+    def __init__(self, ranges: np.ndarray):
+        ranges = np.asarray(ranges, dtype=float)
+        self.low, self.high = ranges[:, 0], ranges[:, 1]
+        self.center = (self.low + self.high) / 2
+        self.half = (self.high - self.low) / 2
+
+    def to_joints(self, action: np.ndarray) -> np.ndarray:
+        return self.center + self.half * np.asarray(action)
+
+    def to_action(self, joints: np.ndarray) -> np.ndarray:
+        return np.clip((np.asarray(joints).reshape(-1) - self.center) / self.half, -1.0, 1.0)
+
+
 def substeps_for(control_dt: float, physics_dt: float) -> int:
     """Physics steps per control step; the ratio must be a whole number."""
     if control_dt <= 0 or physics_dt <= 0:
@@ -92,10 +114,8 @@ class HexapodEnv(gym.Env):
         height: int = 480,
         camera_name: str | None = None,
     ):
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(
-                f"render_mode must be one of {self.metadata['render_modes']}, got {render_mode!r}"
-            )
+        if render_mode is not None:
+            check_choice("render_mode", render_mode, self.metadata["render_modes"])
         self.control_dt = control_dt
         self.physics_dt = physics_dt
         self.n_substeps = substeps_for(control_dt, physics_dt)

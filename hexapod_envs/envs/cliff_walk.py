@@ -32,6 +32,7 @@ import mujoco
 
 from ..terrain.cliff import CLIFF_SIDES, add_cliff
 from ..terrain.flat import add_flat
+from .base import check_choice
 from .heavy_duty import HeavyDutyEnv
 
 TERRAINS = ("cliff", "flat")
@@ -51,10 +52,8 @@ class CliffWalkEnv(HeavyDutyEnv):
         friction: float = 1.0,
         **kwargs,
     ):
-        if terrain not in TERRAINS:
-            raise ValueError(f"terrain must be one of {TERRAINS}, got {terrain!r}")
-        if cliff_side not in CLIFF_SIDES:
-            raise ValueError(f"cliff_side must be one of {CLIFF_SIDES}, got {cliff_side!r}")
+        check_choice("terrain", terrain, TERRAINS)
+        check_choice("cliff_side", cliff_side, CLIFF_SIDES)
         front_feet_x = 2.4 + 0.25  # hip_x + half the stroke: the farthest a foot starts
         if terrain == "cliff" and cliff_x <= front_feet_x:
             raise ValueError(

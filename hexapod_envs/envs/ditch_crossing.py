@@ -95,7 +95,7 @@ from ..stability import fasm_from_feet
 from ..stability._geometry import hull_2d, signed_distance_2d
 from ..terrain.ditch import add_ditch
 from ..terrain.flat import add_flat
-from .base import HexapodEnv
+from .base import HexapodEnv, check_choice
 from .sensors import RobotSensors
 
 TERRAINS = ("ditch", "flat")
@@ -184,10 +184,8 @@ class DitchCrossingEnv(HexapodEnv):
             height=height,
             camera_name=camera_name,
         )
-        if terrain not in TERRAINS:
-            raise ValueError(f"terrain must be one of {TERRAINS}, got {terrain!r}")
-        if action_mode not in ACTION_MODES:
-            raise ValueError(f"action_mode must be one of {ACTION_MODES}, got {action_mode!r}")
+        check_choice("terrain", terrain, TERRAINS)
+        check_choice("action_mode", action_mode, ACTION_MODES)
         for name, value in (
             ("residual_limb_m", residual_limb_m),
             ("residual_leg_m", residual_leg_m),

@@ -21,29 +21,13 @@ from ..robots.heavy_duty import LEG_NAMES, HeavyDutyParams
 from ..robots.heavy_duty.gait import TripodGait, TripodGaitParams
 from ..robots.heavy_duty.model import add_heavy_duty
 from ..stability import fasm_from_feet
-from .base import HexapodEnv
+from .base import HexapodEnv, JointActionMap, check_choice
 from .sensors import RobotSensors
 
 XI_F_DEG = 20.0
 """Tipping threshold ξ_f of seed 000 §3 [deg]."""
 
 ACTION_MODES = ("joint", "residual")
-
-
-class JointActionMap:
-    """Maps normalised actions in [-1, 1] to joint targets in the robot's units and back."""
-
-    def __init__(self, ranges: np.ndarray):
-        ranges = np.asarray(ranges, dtype=float)
-        self.low, self.high = ranges[:, 0], ranges[:, 1]
-        self.center = (self.low + self.high) / 2
-        self.half = (self.high - self.low) / 2
-
-    def to_joints(self, action: np.ndarray) -> np.ndarray:
-        return self.center + self.half * np.asarray(action)
-
-    def to_action(self, joints: np.ndarray) -> np.ndarray:
-        return np.clip((np.asarray(joints).reshape(-1) - self.center) / self.half, -1.0, 1.0)
 
 
 class HeavyDutyEnv(HexapodEnv):
@@ -82,8 +66,7 @@ class HeavyDutyEnv(HexapodEnv):
             height=height,
             camera_name=camera_name,
         )
-        if action_mode not in ACTION_MODES:
-            raise ValueError(f"action_mode must be one of {ACTION_MODES}, got {action_mode!r}")
+        check_choice("action_mode", action_mode, ACTION_MODES)
         self.action_mode = action_mode
         self.residual_scale = residual_scale
         self.robot = HeavyDutyParams()

@@ -100,8 +100,7 @@ from ..stability import fasm_from_feet
 from ..stability.zmp import zmp_margin
 from ..terrain.flat import add_flat
 from ..terrain.irregular import PAPER_FRICTION, add_blocks, add_ramp
-from .base import HexapodEnv
-from .heavy_duty import JointActionMap
+from .base import HexapodEnv, JointActionMap, check_choice
 from .sensors import RobotSensors
 
 TERRAINS = ("ramp", "blocks", "flat")
@@ -207,10 +206,8 @@ class IrregularTerrainEnv(HexapodEnv):
             height=height,
             camera_name=camera_name,
         )
-        if terrain not in TERRAINS:
-            raise ValueError(f"terrain must be one of {TERRAINS}, got {terrain!r}")
-        if action_mode not in ACTION_MODES:
-            raise ValueError(f"action_mode must be one of {ACTION_MODES}, got {action_mode!r}")
+        check_choice("terrain", terrain, TERRAINS)
+        check_choice("action_mode", action_mode, ACTION_MODES)
         if self.n_substeps % _CONTACT_CHECKS:
             raise ValueError(
                 f"control_dt / physics_dt = {self.n_substeps} substeps must be a multiple of "

@@ -36,6 +36,7 @@ import numpy as np
 from ..robots.heavy_duty import LEG_NAMES, TRIPODS, joints_for_foot
 from ..terrain.stewart import add_stewart_platform
 from ..terrain.stewart_kinematics import DEFAULT_PLATFORM
+from .base import check_choice
 from .heavy_duty import XI_F_DEG, HeavyDutyEnv
 
 SCENARIOS = ("climb", "descend", "side", "random")
@@ -85,10 +86,8 @@ class StewartTiltEnv(HeavyDutyEnv):
         tip_over_angle_deg: float = 10.0,
         **kwargs,
     ):
-        if scenario not in SCENARIOS:
-            raise ValueError(f"scenario must be one of {SCENARIOS}, got {scenario!r}")
-        if stance not in STANCES:
-            raise ValueError(f"stance must be one of {sorted(STANCES)}, got {stance!r}")
+        check_choice("scenario", scenario, SCENARIOS)
+        check_choice("stance", stance, STANCES)
         if tilt_rate_deg <= 0:
             raise ValueError(f"tilt_rate_deg must be > 0, got {tilt_rate_deg}")
         self.scenario, self.stance_name = scenario, stance
