@@ -61,8 +61,8 @@ def least_squares_normal(pts: list[list[float]]) -> Vec3:
     return normal_and_centroid(pts)[0]
 
 
-def normal_and_centroid(pts: list[list[float]]) -> tuple[Vec3, Vec3]:
-    """(least-squares unit normal with n_z >= 0, centroid) of ``pts``; see least_squares_normal."""
+def centred_moments(pts: list[list[float]]) -> tuple[Vec3, tuple[float, ...]]:
+    """(centroid, (xx, xy, xz, yy, yz, zz)): second moments of ``pts`` about their centroid."""
     k = len(pts)
     cx = cy = cz = 0.0
     for x, y, z in pts:
@@ -81,6 +81,13 @@ def normal_and_centroid(pts: list[list[float]]) -> tuple[Vec3, Vec3]:
         yy += dy * dy
         yz += dy * dz
         zz += dz * dz
+    return (cx, cy, cz), (xx, xy, xz, yy, yz, zz)
+
+
+def normal_and_centroid(pts: list[list[float]]) -> tuple[Vec3, Vec3]:
+    """(least-squares unit normal with n_z >= 0, centroid) of ``pts``; see least_squares_normal."""
+    k = len(pts)
+    (cx, cy, cz), (xx, xy, xz, yy, yz, zz) = centred_moments(pts)
     det_x = yy * zz - yz * yz
     det_y = xx * zz - xz * xz
     det_z = xx * yy - xy * xy

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hexapod_envs.stability._geometry import REL_TOL
+from hexapod_envs.stability._geometry import REL_TOL, centred_moments
 
 
 @dataclass(frozen=True)
@@ -77,23 +77,8 @@ def fit_plane(points) -> Plane:
         raise ValueError(f"fitting a plane needs at least 3 points, got {k}")
     if not np.isfinite(pts).all():
         raise ValueError("points contains NaN or infinite values")
-    if k <= 16:  # plain floats are faster than numpy reductions for a few feet
-        rows = pts.tolist()
-        x0 = sum(p[0] for p in rows) / k
-        y0 = sum(p[1] for p in rows) / k
-        z0 = sum(p[2] for p in rows) / k
-        sxx = sxy = syy = sxz = syz = 0.0
-        for x, y, z in rows:
-            dx, dy, dz = x - x0, y - y0, z - z0
-            sxx += dx * dx
-            sxy += dx * dy
-            syy += dy * dy
-            sxz += dx * dz
-            syz += dy * dz
-    else:
-        x0, y0, z0 = pts.mean(axis=0).tolist()
-        d = pts - (x0, y0, z0)
-        (sxx, sxy, sxz), (_, syy, syz) = (d[:, :2].T @ d).tolist()
+    # Plain floats: numpy reductions cost more than the arithmetic for a few feet.
+    (x0, y0, z0), (sxx, sxy, sxz, syy, syz, _) = centred_moments(pts.tolist())
     det = sxx * syy - sxy * sxy
     if not det > REL_TOL * (sxx + syy) ** 2:
         raise ValueError(
