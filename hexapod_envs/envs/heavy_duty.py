@@ -190,8 +190,8 @@ class HeavyDutyEnv(HexapodEnv):
             self._simulate()
         self._tipped = False
         self._power = 0.0
-        self._prev_cog = self.sensors.cog().copy()
-        self._start_cog = self._prev_cog.copy()
+        self._start_cog = self.sensors.cog().copy()
+        self._prev_cog_x = float(self._start_cog[0])
         self._update_stability()
         self._last_obs = self._observation()
         return self._last_obs, self._info({}, unstable=False)
@@ -212,8 +212,12 @@ class HeavyDutyEnv(HexapodEnv):
         self._update_stability()
         tipped = self._is_tipped_over()
         self._tipped = self._tipped or tipped
-        terms = self._reward_terms(tipped)
-        self._prev_cog = self.sensors.cog().copy()
+        self._power = float(
+            np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
+        )
+        cog_x = float(self.sensors.cog()[0])
+        terms = self._reward_terms(tipped, cog_x)
+        self._prev_cog_x = cog_x
         self._last_obs = self._observation()
         reward = float(sum(terms.values()))
         return self._last_obs, reward, tipped, False, self._info(terms, unstable=False)
@@ -254,24 +258,21 @@ class HeavyDutyEnv(HexapodEnv):
     def _extra_observation_pieces(self) -> dict[str, np.ndarray]:
         return {}
 
-    def _reward_terms(self, tipped: bool) -> dict[str, float]:
+    def _reward_terms(self, tipped: bool, cog_x: float) -> dict[str, float]:
+        """Named reward terms; the progress term only in walking scenarios."""
         w = self.weights
-        cog = self.sensors.cog()
-        speed = (cog[0] - self._prev_cog[0]) / self.control_dt
         v_ref = self.gait.gait.body_speed
         margin = min(max(self._fasm_deg, -XI_F_DEG), 45.0)
-        power = self._power = float(
-            np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
-        )
-        reference_power = self.weight_n * self.gait.gait.body_speed
-        return {
+        terms = {}
+        if self.walks:
             # Progress up to the reference gait's speed: faster is not rewarded, so a policy
             # cannot trade stability for a scramble (PPO did, at 1 m/s with FASM ~ 0).
-            "forward": w["forward"] * min(speed, v_ref) / v_ref,
-            "stability": w["stability"] * margin / 45.0,
-            "tip_over": -w["tip_over"] if tipped else 0.0,
-            "effort": -w["effort"] * power / reference_power,
-        }
+            speed = (cog_x - self._prev_cog_x) / self.control_dt
+            terms["forward"] = w["forward"] * min(speed, v_ref) / v_ref
+        terms["stability"] = w["stability"] * margin / 45.0
+        terms["tip_over"] = -w["tip_over"] if tipped else 0.0
+        terms["effort"] = -w["effort"] * self._power / (self.weight_n * v_ref)
+        return terms
 
     def _info(self, terms: dict[str, float], unstable: bool) -> dict:
         stance = tuple(leg for leg, on in zip(LEG_NAMES, self._loaded, strict=True) if on)

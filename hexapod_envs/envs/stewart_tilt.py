@@ -102,7 +102,6 @@ class StewartTiltEnv(HeavyDutyEnv):
             stability_weight=stability_weight,
             tip_over_penalty=tip_over_penalty,
             tip_over_angle_deg=tip_over_angle_deg,
-            forward_weight=0.0,
             **kwargs,
         )
         self._platform_act = np.array(
@@ -228,11 +227,6 @@ class StewartTiltEnv(HeavyDutyEnv):
                     self._adjustment_leg = leg
                     self._recovery_time = self.time - self._first_tipping_time
                     break
-
-    def _reward_terms(self, tipped: bool) -> dict[str, float]:
-        terms = super()._reward_terms(tipped)
-        del terms["forward"]
-        return terms
 
     def _extra_info(self) -> dict:
         rpy = np.array(
