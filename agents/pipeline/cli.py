@@ -19,6 +19,18 @@ REPO_ROOT = Path(__file__).resolve().parents[2]
 DEFAULT_SUITE = REPO_ROOT / "configs" / "evaluate_default.yaml"
 
 
+def _add_set_option(p: argparse.ArgumentParser, what: str) -> None:
+    """``--set KEY=VALUE`` (repeatable), collected in ``args.overrides``."""
+    p.add_argument(
+        "--set",
+        dest="overrides",
+        action="append",
+        default=[],
+        metavar="KEY=VALUE",
+        help=f"override a {what} key (dotted path, value read as YAML); repeatable",
+    )
+
+
 def _run(prog: str, body: Callable[[], int]) -> int:
     try:
         return body()
@@ -45,14 +57,7 @@ def train_parser() -> argparse.ArgumentParser:
     source.add_argument(
         "--resume", type=Path, metavar="RUN_DIR", help="continue a run from its last checkpoint"
     )
-    p.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a config key (dotted path, value read as YAML); repeatable",
-    )
+    _add_set_option(p, "config")
     p.add_argument("--output-dir", type=Path, default=Path("runs"), help="parent of run dirs")
     p.add_argument("--run-name", help="run directory name (default {env}__ppo__{seed}__{time})")
     p.add_argument("--force", action="store_true", help="overwrite an existing run directory")
@@ -129,14 +134,7 @@ def evaluate_parser() -> argparse.ArgumentParser:
     p.add_argument("--output-dir", type=Path, help="report directory")
     p.add_argument("--frames", action="store_true", help="add a frame strip per policy (EGL)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
-    p.add_argument(
-        "--set",
-        dest="overrides",
-        action="append",
-        default=[],
-        metavar="KEY=VALUE",
-        help="override a suite key (dotted path, value read as YAML); repeatable",
-    )
+    _add_set_option(p, "suite")
     p.add_argument("--force", action="store_true", help="overwrite an existing report directory")
     return p
 

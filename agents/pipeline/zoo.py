@@ -60,25 +60,9 @@ def zoo_hyperparams(config: TrainConfig) -> dict[str, Any]:
             "clip_obs": norm.clip_observation,
             "clip_reward": norm.clip_reward,
         }
-    entry.update(
-        learning_rate=_schedule(ppo.learning_rate, "learning_rate"),
-        n_steps=ppo.n_steps,
-        batch_size=ppo.batch_size,
-        n_epochs=ppo.n_epochs,
-        gamma=ppo.gamma,
-        gae_lambda=ppo.gae_lambda,
-        clip_range=_schedule(ppo.clip_range, "clip_range"),
-        normalize_advantage=ppo.normalize_advantage,
-        ent_coef=ppo.ent_coef,
-        vf_coef=ppo.vf_coef,
-        max_grad_norm=ppo.max_grad_norm,
-        use_sde=ppo.use_sde,
-        sde_sample_freq=ppo.sde_sample_freq,
-    )
-    if ppo.clip_range_vf is not None:
-        entry["clip_range_vf"] = _schedule(ppo.clip_range_vf, "clip_range_vf")
-    if ppo.target_kl is not None:
-        entry["target_kl"] = ppo.target_kl
+    for key, value in ppo.sb3_kwargs().items():  # the same PPO arguments train.py passes
+        if value is not None:
+            entry[key] = _schedule(value, key) if isinstance(value, Schedule) else value
     entry["policy_kwargs"] = (
         f"dict(log_std_init={pol.log_std_init}, ortho_init={pol.ortho_init}, "
         f"activation_fn={ACTIVATION_NAMES[pol.activation]}, "
