@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from ..sensors import add_foot_force_sensor, add_imu_sensors
 from .params import ATHENA, JOINT_NAMES, LEG_NAMES, AthenaParams
 
 _COLLIDE_GROUND = 1  # contype bit that terrain geoms accept (their conaffinity)
@@ -131,12 +132,7 @@ def add_athena(
         pos_sensors.append(tuple(f"{n}_pos" for n in names))
         vel_sensors.append(tuple(f"{n}_vel" for n in names))
 
-    for name, kind in (
-        ("imu_gyro", mujoco.mjtSensor.mjSENS_GYRO),
-        ("imu_accel", mujoco.mjtSensor.mjSENS_ACCELEROMETER),
-        ("imu_quat", mujoco.mjtSensor.mjSENS_FRAMEQUAT),
-    ):
-        spec.add_sensor(name=name, type=kind, objtype=mujoco.mjtObj.mjOBJ_SITE, objname="imu")
+    add_imu_sensors(spec)
     spec.add_sensor(
         name="torso_height",
         type=mujoco.mjtSensor.mjSENS_RANGEFINDER,
@@ -201,12 +197,7 @@ def _add_leg(
         **_collision_kwargs(p),
     )
     foot.add_site(name=f"{leg}_foot", pos=[0, 0, 0], size=[0.006, 0, 0])
-    spec.add_sensor(
-        name=f"{leg}_foot_force",
-        type=mujoco.mjtSensor.mjSENS_FORCE,
-        objtype=mujoco.mjtObj.mjOBJ_SITE,
-        objname=f"{leg}_foot",
-    )
+    add_foot_force_sensor(spec, leg)
 
     for k, name in enumerate(names):
         act = spec.add_actuator(name=name, target=name, trntype=mujoco.mjtTrn.mjTRN_JOINT)

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from ..sensors import add_foot_force_sensor, add_imu_sensors
 from .params import JOINT_NAMES, LEG_NAMES, HeavyDutyParams
 
 _COLLIDE_GROUND = 1  # contype/conaffinity bit shared with terrain geoms
@@ -170,29 +171,7 @@ def add_heavy_duty(
                 objtype=mujoco.mjtObj.mjOBJ_ACTUATOR,
                 objname=joint,
             )
-        spec.add_sensor(
-            name=f"{leg}_foot_force",
-            type=mujoco.mjtSensor.mjSENS_FORCE,
-            objtype=mujoco.mjtObj.mjOBJ_SITE,
-            objname=f"{leg}_foot",
-        )
+        add_foot_force_sensor(spec, leg)
 
-    spec.add_sensor(
-        name="imu_gyro",
-        type=mujoco.mjtSensor.mjSENS_GYRO,
-        objtype=mujoco.mjtObj.mjOBJ_SITE,
-        objname="imu",
-    )
-    spec.add_sensor(
-        name="imu_accel",
-        type=mujoco.mjtSensor.mjSENS_ACCELEROMETER,
-        objtype=mujoco.mjtObj.mjOBJ_SITE,
-        objname="imu",
-    )
-    spec.add_sensor(
-        name="imu_quat",
-        type=mujoco.mjtSensor.mjSENS_FRAMEQUAT,
-        objtype=mujoco.mjtObj.mjOBJ_SITE,
-        objname="imu",
-    )
+    add_imu_sensors(spec)
     return HeavyDutyHandles(legs=LEG_NAMES, joints=leg_joints, gears=gears)

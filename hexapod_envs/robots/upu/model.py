@@ -53,6 +53,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from ..sensors import add_foot_force_sensor, add_imu_sensors
 from .kinematics import inverse_kinematics
 from .params import (
     LEG_NAMES,
@@ -255,12 +256,7 @@ def _add_leg(
         objtype=mujoco.mjtObj.mjOBJ_JOINT,
         objname=joint,
     )
-    spec.add_sensor(
-        name=f"{leg}_foot_force",
-        type=mujoco.mjtSensor.mjSENS_FORCE,
-        objtype=site,
-        objname=f"{leg}_foot",
-    )
+    add_foot_force_sensor(spec, leg)
     spec.add_sensor(
         name=f"{leg}_foot_touch",
         type=mujoco.mjtSensor.mjSENS_TOUCH,
@@ -368,14 +364,7 @@ def add_upu(
     for leg in LOWER_LEGS:
         _add_leg(spec, torso, leg, p, interpolated)
 
-    site = mujoco.mjtObj.mjOBJ_SITE
-    spec.add_sensor(name="imu_gyro", type=mujoco.mjtSensor.mjSENS_GYRO, objtype=site, objname="imu")
-    spec.add_sensor(
-        name="imu_accel", type=mujoco.mjtSensor.mjSENS_ACCELEROMETER, objtype=site, objname="imu"
-    )
-    spec.add_sensor(
-        name="imu_quat", type=mujoco.mjtSensor.mjSENS_FRAMEQUAT, objtype=site, objname="imu"
-    )
+    add_imu_sensors(spec)
     return UpuHandles()
 
 
