@@ -176,7 +176,7 @@ def test_all_feet_in_contact_uses_the_stance_tripod():
 
 def test_a_landing_leg_without_contact_is_extended_until_it_touches():
     feet = kin.standing_foot_positions()
-    ctrl = AthenaPostureController(touchdown_wait=1, extend_step=0.002)
+    ctrl = AthenaPostureController(touchdown_wait=1, extend_step=0.002, ground_search="always")
     missing = "RR"
     others = [leg for leg in LEG_NAMES if leg != missing]
     z0 = feet[IDX[missing], 2]
@@ -199,7 +199,9 @@ def test_a_landing_leg_without_contact_is_extended_until_it_touches():
 
 def test_a_leg_that_never_touches_falls_back_to_the_widest_contact_triple():
     feet = kin.standing_foot_positions()
-    ctrl = AthenaPostureController(touchdown_wait=0, extend_step=0.01, max_extension=0.03)
+    ctrl = AthenaPostureController(
+        touchdown_wait=0, extend_step=0.01, max_extension=0.03, ground_search="always"
+    )
     contacts = ("LF", "LM", "LR", "RF")  # RR (a stance leg) and RM hang in the air
     for _ in range(3):
         ctrl.step(_sensors(feet, contacts))
@@ -208,6 +210,27 @@ def test_a_leg_that_never_touches_falls_back_to_the_widest_contact_triple():
     est = ctrl.last_estimate
     assert est.extension == pytest.approx(0.03)
     assert set(est.plane_legs) == {"LF", "LR", "RF"}  # the largest triangle among the contacts
+
+
+@pytest.mark.parametrize(
+    ("ground_search", "gains", "searches"),
+    [
+        ("auto", (0.0, 0.0, 0.0), False),  # the paper's non-adaptive simple control
+        ("auto", (1.0, 0.0, 0.0), False),  # height control alone needs no plane
+        ("auto", (0.0, 0.3, 0.0), True),
+        ("auto", (0.0, 0.0, 0.3), True),
+        ("always", (0.0, 0.0, 0.0), True),
+        ("never", (0.6, 0.4, 0.4), False),
+    ],
+)
+def test_ground_search_runs_when_the_phase_uses_the_plane(ground_search, gains, searches):
+    kz, ka, kb = gains
+    ctrl = AthenaPostureController(
+        kz=kz, k_alpha=ka, k_beta=kb, touchdown_wait=0, ground_search=ground_search
+    )
+    feet = kin.standing_foot_positions()
+    ctrl.step(_sensors(feet, [leg for leg in LEG_NAMES if leg != "RR"]))
+    assert ctrl.phase_index == (-1 if searches else 0)
 
 
 def test_fewer_than_three_contacts_after_extension_gives_no_tilt_correction():

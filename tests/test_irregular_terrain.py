@@ -259,6 +259,7 @@ def test_unknown_keyword_is_named_with_valid_choices():
         ({"physics_dt": 0.05 / 12}, "multiple of 5"),
         ({"servo_kp": 0.0}, "servo_kp"),
         ({"gait_start_from": "guess"}, "measured_height"),
+        ({"gait_ground_search": "sometimes"}, "always"),
         ({"phase_time": 0.33}, "whole number"),
     ],
 )

@@ -27,6 +27,10 @@ uses the measured heights but the commanded horizontal positions (``gait_start_f
 "measured_height"``, see `hexapod_envs.robots.athena.gait.START_FROM`): with measured x, y too
 the stance legs' lag makes the footholds wander ~4 mm per cycle until the legs reach their limits.
 `reports/athena_gain_sweep.md` shows how the ramp results depend on ``servo_kp`` and this rule.
+Landing legs that found no ground are extended until they touch only in phases that use the
+ground plane (k_α or k_β > 0; ``gait_ground_search``, see
+`hexapod_envs.robots.athena.gait.GROUND_SEARCH`), so that all gains 0 is the paper's
+non-adaptive "simple control".
 
 | Observation piece | size | unit |
 |---|---|---|
@@ -168,6 +172,7 @@ class IrregularTerrainEnv(HexapodEnv):
         swing_height: float | None = None,
         phase_time: float = 1.0,
         gait_start_from: str = "measured_height",
+        gait_ground_search: str = "auto",
         control_dt: float = 0.05,
         physics_dt: float = 0.002,
         servo_kp: float = 8.0,
@@ -236,6 +241,7 @@ class IrregularTerrainEnv(HexapodEnv):
             "control_dt": float(control_dt),
             "contact_threshold": float(contact_threshold),
             "start_from": gait_start_from,
+            "ground_search": gait_ground_search,
         }
         """Keyword arguments of `AthenaPostureController` that match this env (policies use it)."""
         self.reference_gains = tuple(float(g) for g in reference_gains)
@@ -311,7 +317,7 @@ class IrregularTerrainEnv(HexapodEnv):
         self._root_qpos = m.jnt_qposadr[m.joint(self.handles.root_joint).id]
         adr = m.sensor(self.handles.torso_height_sensor).adr[0]
         self._height_adr = int(adr)
-        self._torso_geom = m.geom(self.handles.torso_geom).id
+        self._torso_contact_adr = int(m.sensor(self.handles.torso_contact_sensor).adr[0])
         self._torso_half_height = self.robot.body.size[2] / 2
 
     def _add_terrain(self, spec: mujoco.MjSpec, rng: np.random.Generator):
@@ -395,7 +401,7 @@ class IrregularTerrainEnv(HexapodEnv):
         stable, touched = self._physics()
         self._step_count += 1
         if not stable:
-            return self._last_obs, 0.0, False, True, self._info({}, True, None)
+            return self._last_obs.copy(), 0.0, False, True, self._info({}, True, None)
         self._touched = touched
         self._collisions += touched
         self._read_sensors()
@@ -433,11 +439,10 @@ class IrregularTerrainEnv(HexapodEnv):
         touched = False
         for _ in range(_CONTACT_CHECKS):
             mujoco.mj_step(m, d, nstep=chunk)
-            if not touched and d.ncon:
-                touched = bool((d.contact.geom[: d.ncon] == self._torso_geom).any())
+            touched = touched or d.sensordata[self._torso_contact_adr] > 0.0
         if abs(d.time - t_expected) > 1e-6:
-            return False, touched
-        return not d.warning.number[self._UNSTABLE_WARNINGS].any(), touched
+            return False, bool(touched)
+        return not d.warning.number[self._UNSTABLE_WARNINGS].any(), bool(touched)
 
     # --- measurements --------------------------------------------------------------------
     def _read_sensors(self) -> None:

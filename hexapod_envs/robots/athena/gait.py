@@ -12,7 +12,8 @@ joint targets come from the analytic inverse kinematics.
 Posture control (Section 4.2), evaluated at the start of every phase:
   1. contacts from the foot force sensors; the ground plane (eq. 24) through three feet in
      contact (exactly three normally; more -> choose three; fewer -> the legs that should be in
-     contact are extended downwards until they touch, then the plane is fitted);
+     contact are extended downwards until they touch, then the plane is fitted; see
+     `GROUND_SEARCH` for when this search runs);
   2. pitch and roll of the torso relative to that plane, delta_alpha and delta_beta
      (eqs. 25-26), and the height deviation delta_z = torso-height reading - standing height;
   3. swing end point p_{i,3} = p_{i,0} + (s, 0, k_z delta_z) (eq. 27) and stance end point
@@ -64,6 +65,17 @@ little further forward: on the 10° ramp with 8 N·m/rad servos the feet wander 
 in x until the legs reach their limits after ~15 cycles. "measured_height" keeps the paper's
 measured heights (terrain following and the sag that the height control corrects) without that
 horizontal drift."""
+
+GROUND_SEARCH = ("auto", "always", "never")
+"""Choices of `AthenaPostureController(ground_search=...)`: when the landing legs that found no
+ground are extended until they touch. The paper describes this search as a step of the ground
+plane estimate (Section 4.2, Fig. 6: "after that, there are sufficient supporting limbs to
+estimate the terrain's characteristic plane"), and calls its baseline a "non-adaptive
+controller" whose "foothold positions were not properly adjusted to the terrain topology"
+(Sections 1 and 6). "auto" (default) therefore searches only in phases that use the plane, i.e.
+with k_alpha or k_beta > 0, so that all gains 0 is the paper's simple control; "always" and
+"never" force it on or off (with "always" and k = 0, legs that land early on a block push the
+torso up and nothing lowers it again: the torso rides on the tallest blocks)."""
 
 _TRIPOD_INDICES = tuple(tuple(LEG_NAMES.index(leg) for leg in tripod) for tripod in TRIPODS)
 _MIN_TRIANGLE_AREA = 1e-4  # m², a triple of feet closer to collinear gives no usable plane
@@ -208,6 +220,7 @@ class AthenaPostureController:
     touchdown_wait: ticks to hold a landing leg that has not touched yet before extending it.
     extend_step: downward extension per tick of a landing leg that has not found the ground, m.
     max_extension: give up extending after this much, m.
+    ground_search: when to extend landing legs that found no ground, one of `GROUND_SEARCH`.
     start_from: where each phase starts, p_{i,0}: "measured" (the paper: eq. 12 on the
         encoders), "commanded" (the previous phase's commanded end points, immune to servo
         tracking errors) or "measured_height" (x, y commanded, z measured: the feet follow the
@@ -234,6 +247,7 @@ class AthenaPostureController:
         extend_step: float = 0.002,
         max_extension: float = 0.06,
         start_from: str = "measured",
+        ground_search: str = "auto",
         rng: np.random.Generator | None = None,
     ):
         ticks = phase_time / control_dt
@@ -244,6 +258,8 @@ class AthenaPostureController:
             )
         if start_from not in START_FROM:
             raise ValueError(f"start_from must be one of {START_FROM}, got {start_from!r}")
+        if ground_search not in GROUND_SEARCH:
+            raise ValueError(f"ground_search must be one of {GROUND_SEARCH}, got {ground_search!r}")
         for label, value in (
             ("stride", stride),
             ("swing_height", swing_height),
@@ -270,6 +286,7 @@ class AthenaPostureController:
         self.extend_step = float(extend_step)
         self.max_extension = float(max_extension)
         self.start_from = start_from
+        self.ground_search = ground_search
         self.rng = rng
         self._iks = [leg_ik(leg, params) for leg in LEG_NAMES]
         self._gains = _checked_gains(kz, k_alpha, k_beta)
@@ -364,7 +381,7 @@ class AthenaPostureController:
         if self._tick == 0:
             stance = _TRIPOD_INDICES[(self._phase_index + 2) % 2]
             missing = [i for i in stance if not contact[i]]
-            if missing and self._extension < self.max_extension:
+            if missing and self._searches_ground() and self._extension < self.max_extension:
                 # Fewer legs on the ground than planned: extend them until they touch. The first
                 # `touchdown_wait` ticks only hold the command, so that a foot lagging behind its
                 # servo target lands without being pushed into the ground.
@@ -444,6 +461,12 @@ class AthenaPostureController:
             extension=self._extension,
         )
         self._extension = 0.0
+
+    def _searches_ground(self) -> bool:
+        """Whether the coming phase extends landing legs that found no ground (`GROUND_SEARCH`)."""
+        if self.ground_search == "auto":
+            return self._gains[1] > 0 or self._gains[2] > 0
+        return self.ground_search == "always"
 
     def _choose_plane_legs(
         self, feet: np.ndarray, contact: np.ndarray, stance: tuple[int, ...]

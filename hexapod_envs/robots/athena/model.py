@@ -14,7 +14,8 @@ Sensors: IMU site `imu` at the torso centre with `imu_gyro`, `imu_accel`, `imu_q
 infrared torso-height sensor is a rangefinder `torso_height` on site `torso_height` at the torso
 centre looking along the torso's -z (it ignores the torso's own geom, reads the distance to the
 first geom below, -1 if none; in the standing posture on flat ground it reads
-`AthenaParams.standing_torso_height` = 0.104 m). Per leg: `L_<joint>_pos` / `L_<joint>_vel`
+`AthenaParams.standing_torso_height` = 0.104 m); `torso_contact` counts the torso box's contacts
+(for evaluation, the real robot has no such sensor). Per leg: `L_<joint>_pos` / `L_<joint>_vel`
 (joint encoders), `L_foot_force` (3-D force sensor on site `L_foot`). MuJoCo's force sensor
 reads, in the site frame, the force that the foot body receives from its parent (the tibia); for a
 foot at rest that is minus the ground reaction force (plus the foot's 0.087 N weight), so
@@ -75,6 +76,8 @@ class AthenaHandles:
     imu_quat: str = "imu_quat"
     torso_height_site: str = "torso_height"
     torso_height_sensor: str = "torso_height"
+    torso_contact_sensor: str = "torso_contact"
+    """Contact sensor (evaluation only): number of contacts the torso geom has."""
 
     @property
     def actuators(self) -> tuple[tuple[str, ...], ...]:
@@ -139,6 +142,14 @@ def add_athena(
         objtype=mujoco.mjtObj.mjOBJ_SITE,
         objname="torso_height",
         intprm=[1 << int(mujoco.mjtRayDataField.mjRAYDATA_DIST), 0, 0],  # output: distance only
+    )
+    # Evaluation only (the real robot has no such sensor): number of contacts of the torso box.
+    spec.add_sensor(
+        name="torso_contact",
+        type=mujoco.mjtSensor.mjSENS_CONTACT,
+        objtype=mujoco.mjtObj.mjOBJ_GEOM,
+        objname="torso",
+        intprm=[1 << int(mujoco.mjtConDataField.mjCONDATA_FOUND), 1, 1],  # found; mindist; 1
     )
     return AthenaHandles(
         legs=LEG_NAMES,
