@@ -453,7 +453,7 @@ class DitchCrossingEnv(HexapodEnv):
         stable = self._simulate()
         self._tick += 1
         if not stable:
-            return self._last_obs, 0.0, False, True, self._info({}, unstable=True)
+            return self._last_obs.copy(), 0.0, False, True, self._info({}, unstable=True)
         self._update_stability()
         tipped = d.xmat[self._torso, 8] < self.tip_over_cos
         self._tipped = self._tipped or bool(tipped)

@@ -208,7 +208,7 @@ class HeavyDutyEnv(HexapodEnv):
         self._step_count += 1
         if not stable:
             # Keep training runs alive: end the episode with a flag, return the last good obs.
-            return self._last_obs, 0.0, False, True, self._info({}, unstable=True)
+            return self._last_obs.copy(), 0.0, False, True, self._info({}, unstable=True)
         self._update_stability()
         tipped = self._is_tipped_over()
         self._tipped = self._tipped or tipped
