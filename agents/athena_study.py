@@ -124,6 +124,12 @@ def summarize(records: list[EpisodeRecord]) -> dict[str, float]:
     return out
 
 
+def percent_change(before: float, after: float) -> float | None:
+    """100 (after / before - 1), or None when `before` is 0 (e.g. a median ZMP margin of 0 m
+    when the torso rests on the blocks and no foot carries load)."""
+    return None if before == 0 else 100.0 * (after / before - 1.0)
+
+
 def compare(terrain: str, seeds, gains=None, steps: int | None = None, **env_kwargs) -> dict:
     """Simple vs posture control (`gains`, default the paper's) on the same seeds.
 
@@ -136,7 +142,7 @@ def compare(terrain: str, seeds, gains=None, steps: int | None = None, **env_kwa
     }
     summary = {name: summarize(records) for name, records in runs.items()}
     change = {
-        m: 100.0 * (summary["posture"][f"{m}_median"] / summary["simple"][f"{m}_median"] - 1.0)
+        m: percent_change(summary["simple"][f"{m}_median"], summary["posture"][f"{m}_median"])
         for m in METRICS
     }
     return {**runs, "gains": gains, "summary": summary, "change_pct": change}

@@ -123,7 +123,10 @@ def main(argv: list[str] | None = None) -> None:
         "Medians over gait cycles of the per-cycle RMS torso height (infrared reading) and "
         "pitch/roll rates (IMU); the ZMP margin (eqs. 32-33) median over time steps; "
         "torso-contact steps summed over seeds; distance = mean CoG travel along x. On the ramp "
-        "only cycles with all feet on the slope count.",
+        "only cycles with all feet on the slope count. Landing legs that found no ground are "
+        "extended until they touch only when the plane is used (k_α or k_β > 0, "
+        '`gait_ground_search="auto"`): on the blocks the k_α and k_β rows ride on the tallest '
+        "blocks, the simple and k_z rows rest the torso on them (ZMP margin 0: no foot loaded).",
         "",
     ]
     for terrain in ("ramp", "blocks"):

@@ -8,6 +8,7 @@ the per-gait-cycle RMS torso height, pitch-rate and roll-rate RMS and the ZMP st
 `athena_posture_study.json`, and prints the medians next to the paper's changes.
 
 Run: python scripts/athena_posture_study.py [--seeds 3] [--steps 1200] [--out reports/figures]
+     [--block-size 0.1]
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from agents.athena_study import PAPER_CHANGES, compare, pooled  # noqa: E402
+from agents.athena_study import PAPER_CHANGES, compare, percent_change, pooled  # noqa: E402
 
 PANELS = (
     ("height", "torso height RMS per cycle [m]"),
@@ -64,7 +65,8 @@ def report(terrain: str, result: dict) -> dict:
         a, b = s["simple"][f"{metric}_median"], s["posture"][f"{metric}_median"]
         paper = PAPER_CHANGES.get(terrain, {}).get(metric)
         paper_txt = f"{paper:+8.2f}%" if paper is not None else f"{'-':>9s}"
-        change_txt = f"{100 * (b / a - 1):+8.1f}%"
+        change = percent_change(a, b)
+        change_txt = f"{change:+8.1f}%" if change is not None else f"{'n/a':>9s}"
         print(f"  {metric + ' median':24s} {a:10.4f} {b:10.4f} {change_txt} {paper_txt}")
     for key in ("episodes_with_collision", "torso_collision_steps", "mean_distance"):
         print(f"  {key:24s} {s['simple'][key]:10.3g} {s['posture'][key]:10.3g}")
@@ -76,11 +78,17 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--seeds", type=int, default=3, help="episodes per controller")
     parser.add_argument("--steps", type=int, default=1200, help="20 Hz steps per episode")
     parser.add_argument("--out", type=Path, default=Path("reports/figures"))
+    parser.add_argument(
+        "--block-size", type=float, default=None, help="block edge [m] (default: the env's)"
+    )
     args = parser.parse_args(argv)
     seeds = range(args.seeds)
     numbers = {}
     for terrain in ("ramp", "blocks"):
-        result = compare(terrain, seeds, steps=args.steps)
+        kwargs = {}
+        if terrain == "blocks" and args.block_size is not None:
+            kwargs["block_size"] = (args.block_size, args.block_size)
+        result = compare(terrain, seeds, steps=args.steps, **kwargs)
         plot(terrain, result, args.out / f"athena_{terrain}_posture.png")
         numbers[terrain] = report(terrain, result)
     numbers["seeds"], numbers["steps"] = list(seeds), args.steps
