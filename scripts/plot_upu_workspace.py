@@ -19,7 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from agents.upu_gait_plan import case_study_path  # noqa: E402
+from hexapod_envs.robots.upu.gait_plan import case_study_path  # noqa: E402
 from hexapod_envs.robots.upu.params import UpuParams  # noqa: E402
 from hexapod_envs.robots.upu.workspace import search_workspace  # noqa: E402
 

@@ -1,12 +1,13 @@
-"""Seed 002's tripod gait and posture controller (hexapod_envs/robots/athena/gait.py, re-exported
-by agents/athena_gait.py): closed-form checks."""
+"""Seed 002's tripod gait and posture controller (hexapod_envs/robots/athena/gait.py):
+closed-form checks."""
 
 import math
 
 import numpy as np
 import pytest
 
-from agents.athena_gait import (
+from hexapod_envs.robots.athena import kinematics as kin
+from hexapod_envs.robots.athena.gait import (
     AthenaPostureController,
     AthenaSensors,
     cubic_bezier,
@@ -15,7 +16,6 @@ from agents.athena_gait import (
     swing_control_points,
     torso_deviation_from_plane,
 )
-from hexapod_envs.robots.athena import kinematics as kin
 from hexapod_envs.robots.athena.params import ATHENA, LEG_NAMES, TRIPODS
 from hexapod_envs.stability.plane_fit import fit_plane
 

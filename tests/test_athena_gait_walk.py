@@ -7,29 +7,21 @@ import mujoco
 import numpy as np
 import pytest
 
-from agents.athena_gait import AthenaPostureController, AthenaSensors
+from hexapod_envs.envs.base import set_physics_options
+from hexapod_envs.robots.athena.gait import AthenaPostureController, AthenaSensors
 from hexapod_envs.robots.athena.model import add_athena
 from hexapod_envs.robots.athena.params import ATHENA, JOINT_NAMES, LEG_NAMES
-from hexapod_envs.terrain.irregular import add_ramp
+from hexapod_envs.terrain.flat import add_flat
+from hexapod_envs.terrain.irregular import PAPER_FRICTION, add_ramp
 
 DT, CONTROL_DT = 0.002, 0.05
 
 
 def _walk(ctrl, duration, ramp_start=None):
     spec = mujoco.MjSpec()
-    spec.option.timestep = DT
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
-    spec.option.impratio = 10.0
+    set_physics_options(spec, DT)
     if ramp_start is None:
-        spec.worldbody.add_geom(
-            name="ground",
-            type=mujoco.mjtGeom.mjGEOM_PLANE,
-            size=[5, 5, 0.1],
-            contype=0,
-            conaffinity=1,
-            friction=[0.9, 0.005, 0.0001],
-        )
+        add_flat(spec, friction=PAPER_FRICTION, size=5.0)
     else:
         add_ramp(spec, start_x=ramp_start)
     add_athena(spec)

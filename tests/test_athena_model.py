@@ -9,6 +9,8 @@ import pytest
 from hexapod_envs.robots.athena import kinematics as kin
 from hexapod_envs.robots.athena.model import FOOT_FORCE_SIGN, add_athena
 from hexapod_envs.robots.athena.params import ATHENA, JOINT_NAMES, LEG_NAMES
+from hexapod_envs.terrain.flat import add_flat
+from hexapod_envs.terrain.irregular import PAPER_FRICTION
 
 
 def _build(degree: bool = True, ground: bool = True, timestep: float = 0.002):
@@ -16,15 +18,8 @@ def _build(degree: bool = True, ground: bool = True, timestep: float = 0.002):
     spec.compiler.degree = degree
     spec.option.timestep = timestep
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    if ground:  # a plain plane with the terrain collision convention (contype 0, conaffinity 1)
-        spec.worldbody.add_geom(
-            name="ground",
-            type=mujoco.mjtGeom.mjGEOM_PLANE,
-            size=[5, 5, 0.1],
-            contype=0,
-            conaffinity=1,
-            friction=[0.9, 0.005, 0.0001],
-        )
+    if ground:  # the terrain collision convention (contype 0, conaffinity 1)
+        add_flat(spec, friction=PAPER_FRICTION, size=5.0)
     handles = add_athena(spec)
     model = spec.compile()
     return model, mujoco.MjData(model), handles

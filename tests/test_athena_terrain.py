@@ -6,6 +6,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from hexapod_envs.envs.base import set_physics_options
 from hexapod_envs.robots.athena.model import add_athena
 from hexapod_envs.robots.athena.params import ATHENA
 from hexapod_envs.terrain.irregular import add_blocks, add_ramp
@@ -100,10 +101,7 @@ def test_standing_robot_does_not_slide_on_the_ten_degree_ramp():
     # pyramidal cone and impratio 1); the elliptic cone with impratio 10 brings that to
     # about 0.25 mm/s, so envs on slopes should use these options.
     spec = mujoco.MjSpec()
-    spec.option.timestep = 0.002
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
-    spec.option.impratio = 10.0
+    set_physics_options(spec, 0.002)
     ramp = add_ramp(spec, start_x=-1.0, length=2.0)
     slope = ramp.slope
     x0 = 0.0

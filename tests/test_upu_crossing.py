@@ -10,7 +10,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from agents.upu_gait_plan import Ditch, plan_ditch_crossing
+from hexapod_envs.robots.upu.gait_plan import Ditch, plan_ditch_crossing
 from hexapod_envs.robots.upu.model import RECOMMENDED_TIMESTEP, add_upu, standing_controls
 from hexapod_envs.robots.upu.params import PLATFORM_LEGS, UpuParams
 from hexapod_envs.stability import static_stability_margin

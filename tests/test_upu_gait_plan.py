@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from agents.upu_gait_plan import (
+from hexapod_envs.robots.upu.gait_plan import (
     PLAN_STATUSES,
     Ditch,
     GaitSettings,

@@ -92,6 +92,16 @@ class ObservationLayout:
         return {name: observation[..., sl] for name, sl in self.slices.items()}
 
 
+def set_physics_options(spec: mujoco.MjSpec, timestep: float) -> None:
+    """The solver options every env uses: `timestep` [s], implicit-fast integration, and
+    elliptic friction cones with a high impedance ratio (the default pyramidal cone lets a
+    loaded foot creep down a slope at several cm/s, far below its friction limit)."""
+    spec.option.timestep = timestep
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    spec.option.impratio = 10.0
+
+
 class HexapodEnv(gym.Env):
     """Base class; see the module docstring. Keyword arguments are checked by name."""
 
@@ -130,12 +140,7 @@ class HexapodEnv(gym.Env):
     # --- model ---------------------------------------------------------------------------
     def _compile(self, spec: mujoco.MjSpec) -> None:
         """Compile `spec` with the env's physics timestep and (re)create data."""
-        spec.option.timestep = self.physics_dt
-        spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-        # Elliptic friction cones with a high impedance ratio: the default pyramidal cone lets a
-        # loaded foot creep down a slope at several cm/s, far below its friction limit.
-        spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
-        spec.option.impratio = 10.0
+        set_physics_options(spec, self.physics_dt)
         spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
         spec.visual.headlight.diffuse = [0.65, 0.65, 0.65]
         spec.worldbody.add_light(

@@ -1,7 +1,8 @@
 """ATHENA's tripod gait and posture controller (seed 002, Section 4), pure numpy.
 
 It lives in the robot package because ``HexapodIrregularTerrain-v0`` runs it as the reference
-gait of its "residual" and "gains" action modes; `agents.athena_gait` re-exports it.
+gait of its "residual" and "gains" action modes (and `hexapod_envs` must not import `agents`);
+`agents.athena_policy` wraps it as a policy.
 
 Gait (Section 4.1). A tripod gait in phases of t_g = 1 s at 20 Hz: in each phase one tripod swings
 along a cubic Bezier curve (eqs. 19-22, stride s, height h) while the other tripod's feet move
