@@ -380,7 +380,7 @@ class IrregularTerrainEnv(HexapodEnv):
         self._collisions = 0
         self._touched = False
         self._start_cog = self.sensors.cog().copy()
-        self._prev_cog = self._start_cog.copy()
+        self._prev_cog_x = float(self._start_cog[0])
         self._cycle_id = 0
         self._window: list[tuple] = []
         self._window_x0 = float(self._start_cog[0])
@@ -409,7 +409,7 @@ class IrregularTerrainEnv(HexapodEnv):
         self._tipped = self._tipped or tipped
         terms = self._reward_terms(touched, tipped)
         cycle_stats = self._update_cycle_window(touched)
-        self._prev_cog = self._cog.copy()
+        self._prev_cog_x = float(self._cog[0])
         self._last_obs = self._observation()
         reward = float(sum(terms.values()))
         return self._last_obs, reward, tipped, False, self._info(terms, False, cycle_stats)
@@ -447,7 +447,7 @@ class IrregularTerrainEnv(HexapodEnv):
     # --- measurements --------------------------------------------------------------------
     def _read_sensors(self) -> None:
         s = self.sensors
-        self._joints = s.joint_positions().copy()
+        self._joints = s.joint_positions()  # fancy indexing: already a copy
         self._forces = s.foot_forces()
         self._loaded = (self._forces * self._forces).sum(axis=1) > self._contact_force_sq
         self._height = float(self.data.sensordata[self._height_adr])
@@ -508,7 +508,7 @@ class IrregularTerrainEnv(HexapodEnv):
             m["cycle_roll_rate_rms"].append(stats["roll_rate_rms"])
             m["cycle_zmp_margin"].append(stats["zmp_margin_mean"])
             self._window = []
-            self._window_x0 = float(self._prev_cog[0])
+            self._window_x0 = self._prev_cog_x
         self._cycle_id = cid
         self._window.append(
             (
@@ -561,7 +561,7 @@ class IrregularTerrainEnv(HexapodEnv):
 
     def _reward_terms(self, touched: bool, tipped: bool) -> dict[str, float]:
         w = self.weights
-        speed = (self._cog[0] - self._prev_cog[0]) / self.control_dt
+        speed = (self._cog[0] - self._prev_cog_x) / self.control_dt
         rates = float(self._gyro[0] ** 2 + self._gyro[1] ** 2)
         dz = min(abs(self._height_deviation()), 0.1) / 0.01
         return {
@@ -590,7 +590,7 @@ class IrregularTerrainEnv(HexapodEnv):
                 np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
             ),
             time=self._step_count * self.control_dt,
-            cog=self._cog.copy(),
+            cog=self._cog,  # a fresh copy every step
             distance=float(self._cog[0] - self._start_cog[0]),
             zmp=self._zmp.copy(),
             zmp_margin=self._zmp_margin,
