@@ -87,6 +87,7 @@ from agents.tipping.trajectory import (
     time_budget,
     zero_crossing_time,
 )
+from hexapod_envs.checks import check_number
 from hexapod_envs.robots.heavy_duty.kinematics import joints_for_foot
 from hexapod_envs.robots.heavy_duty.params import LEG_NAMES, HeavyDutyParams
 from hexapod_envs.stability import fasm_from_feet
@@ -170,8 +171,7 @@ class RecoveryConfig:
                 f"{self.contact_fraction}, {self.min_normal_fraction}"
             )
         for name in ("touchdown_speed", "max_search_depth", "rate_window", "accel_filter_time"):
-            if not getattr(self, name) > 0.0:
-                raise ValueError(f"{name} must be > 0, got {getattr(self, name)}")
+            check_number(name, getattr(self, name), strict=True)
 
 
 @dataclass

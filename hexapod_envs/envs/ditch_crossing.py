@@ -75,6 +75,7 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
+from ..checks import check_number
 from ..robots.upu.gait_plan import (
     Ditch,
     GaitPlan,
@@ -191,14 +192,12 @@ class DitchCrossingEnv(HexapodEnv):
             ("residual_leg_m", residual_leg_m),
             ("residual_filter_tau", residual_filter_tau),
         ):
-            if not (math.isfinite(value) and value >= 0):
-                raise ValueError(f"{name} must be a finite number >= 0, got {value}")
+            check_number(name, value)
         if not 0 < contact_threshold < 1:
             raise ValueError(f"contact_threshold must be in (0, 1), got {contact_threshold}")
         if not 0 < tip_over_angle_deg < 90:
             raise ValueError(f"tip_over_angle_deg must be in (0, 90), got {tip_over_angle_deg}")
-        if not (math.isfinite(reset_noise_scale) and reset_noise_scale >= 0):
-            raise ValueError(f"reset_noise_scale must be >= 0 m, got {reset_noise_scale}")
+        check_number("reset_noise_scale", reset_noise_scale)
         self.terrain = terrain
         self.action_mode = action_mode
         self.residual_gain = np.array([residual_limb_m] * 3 + [residual_leg_m] * 6)

@@ -96,6 +96,7 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
+from ..checks import check_number
 from ..robots.athena.gait import AthenaPostureController, AthenaSensors
 from ..robots.athena.kinematics import standing_foot_positions
 from ..robots.athena.model import add_athena
@@ -219,8 +220,7 @@ class IrregularTerrainEnv(HexapodEnv):
                 f"{_CONTACT_CHECKS} (torso contact is checked {_CONTACT_CHECKS} times per step)"
             )
         for label, value in (("servo_kp", servo_kp), ("servo_damping", servo_damping)):
-            if not value > 0:
-                raise ValueError(f"{label} must be > 0, got {value}")
+            check_number(label, value, strict=True)
         if terrain == "ramp" and -0.3 < ramp_start_x < 0.3:
             raise ValueError(
                 f"ramp_start_x={ramp_start_x} m puts the foot of the slope under the robot; use "

@@ -11,6 +11,7 @@ import math
 
 import mujoco
 
+from ..checks import check_number
 from .flat import ground_geom_kwargs
 
 DITCH_GEOMS: tuple[str, ...] = ("ground", "ditch_floor", "ground_far")
@@ -47,8 +48,7 @@ def add_ditch(
         "friction": friction,
     }
     for name, value in values.items():
-        if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"ditch {name} must be a finite number > 0, got {value}")
+        check_number(f"ditch {name}", value, strict=True)
     if not math.isfinite(start_x):
         raise ValueError(f"ditch start_x must be finite, got {start_x}")
     if length <= width:

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from ..checks import check_number
 from .flat import ground_geom_kwargs
 
 PAPER_FRICTION = 0.9
@@ -117,10 +118,8 @@ def add_ramp(
     if not 0.0 < slope_deg <= 45.0:
         raise ValueError(f"slope_deg must be in (0, 45] degrees, got {slope_deg}")
     for label, value in (("length", length), ("width", width), ("thickness", thickness)):
-        if value <= 0:
-            raise ValueError(f"{label} must be positive, got {value}")
-    if top_length < 0:
-        raise ValueError(f"top_length must be >= 0, got {top_length}")
+        check_number(label, value, strict=True)
+    check_number("top_length", top_length)
     slope = math.radians(slope_deg)
     kwargs = ground_geom_kwargs(friction)
     names = []

@@ -55,6 +55,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...checks import check_number
 from ...stability.plane_fit import fit_plane
 from .kinematics import foot_position_closed_form, forward_kinematics_all, leg_ik
 from .params import ATHENA, LEG_NAMES, TRIPODS, AthenaParams
@@ -269,8 +270,7 @@ class AthenaPostureController:
             ("extend_step", extend_step),
             ("max_extension", max_extension),
         ):
-            if not value >= 0:
-                raise ValueError(f"{label} must be >= 0, got {value}")
+            check_number(label, value)
         if rng is not None and not isinstance(rng, np.random.Generator):
             raise ValueError(f"rng must be a numpy.random.Generator or None, got {type(rng)}")
         self.params = params

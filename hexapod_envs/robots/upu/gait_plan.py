@@ -30,6 +30,7 @@ from functools import cache, lru_cache
 
 import numpy as np
 
+from ...checks import check_number
 from ...stability import static_stability_margin
 from .kinematics import inside_limits, inverse_kinematics
 from .params import PLATFORM_LEGS, UpuParams, check_platform
@@ -196,11 +197,8 @@ class GaitSettings:
             "edge_clearance",
             "min_margin",
         ):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value >= 0):
-                raise ValueError(f"GaitSettings.{name} must be a finite number >= 0, got {value}")
-        if not (math.isfinite(self.grid) and self.grid > 0):
-            raise ValueError(f"GaitSettings.grid must be > 0 m, got {self.grid}")
+            check_number(f"GaitSettings.{name}", getattr(self, name))
+        check_number("GaitSettings.grid", self.grid, strict=True)
         if self.lift is not None and not (math.isfinite(self.lift) and self.lift >= 0):
             raise ValueError(
                 f"GaitSettings.lift must be a finite number >= 0 m or None, got {self.lift}"
@@ -224,9 +222,7 @@ class Ditch:
         if not math.isfinite(self.start_x):
             raise ValueError(f"ditch start_x must be finite, got {self.start_x}")
         for name in ("width", "depth"):
-            value = getattr(self, name)
-            if not (math.isfinite(value) and value > 0):
-                raise ValueError(f"ditch {name} must be a finite number > 0 m, got {value}")
+            check_number(f"ditch {name}", getattr(self, name), strict=True)
 
     @property
     def end_x(self) -> float:

@@ -33,6 +33,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ...checks import check_number
 from .gait_plan import GaitPlan
 from .kinematics import inverse_kinematics
 from .params import LEG_NAMES, LIMB_NAMES, PLATFORM_LEGS, UpuParams
@@ -73,12 +74,7 @@ class GaitTiming:
 
     def __post_init__(self) -> None:
         for f in fields(self):
-            value = getattr(self, f.name)
-            if not (math.isfinite(value) and value > 0):
-                unit = "m" if f.name == "unload_retract" else "s"
-                raise ValueError(
-                    f"GaitTiming.{f.name} must be a finite number > 0 {unit}, got {value}"
-                )
+            check_number(f"GaitTiming.{f.name}", getattr(self, f.name), strict=True)
 
     @property
     def durations(self) -> tuple[float, ...]:

@@ -32,6 +32,8 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
+from ...checks import check_number
+
 UPPER_LEGS: tuple[str, ...] = ("U1", "U2", "U3")
 """Legs on the upper (smaller, r = 125 mm) platform: the paper's legs 2, 4, 6."""
 LOWER_LEGS: tuple[str, ...] = ("L1", "L2", "L3")
@@ -184,14 +186,8 @@ class UpuParams:
 
     def __post_init__(self) -> None:
         for f in fields(self):
-            value = getattr(self, f.name)
-            if f.name in _NON_NEGATIVE:
-                if not (math.isfinite(value) and value >= 0):
-                    raise ValueError(
-                        f"UpuParams.{f.name} must be a finite number >= 0, got {value}"
-                    )
-            elif not (math.isfinite(value) and value > 0):
-                raise ValueError(f"UpuParams.{f.name} must be a finite number > 0, got {value}")
+            strict = f.name not in _NON_NEGATIVE
+            check_number(f"UpuParams.{f.name}", getattr(self, f.name), strict=strict)
         if self.upper_radius == self.lower_radius:
             raise ValueError(
                 "UpuParams needs upper_radius != lower_radius: with equal circumradii "
