@@ -5,26 +5,20 @@
 resolved ``config.yaml`` saved next to it) and that the observation and action shapes match,
 and raises `agents.pipeline.errors.UserError` (a ValueError) with a clear message otherwise.
 Observations are normalised with the saved statistics (frozen) before the network sees them.
+Nothing in the model files is unpickled unless the caller passes ``trust_pickle=True``.
 """
 
 from __future__ import annotations
 
-import pickle
 from pathlib import Path
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
 
-from .pipeline.artifacts import ModelFiles, find_model
+from .pipeline.artifacts import ModelFiles, find_model, read_meta
 from .pipeline.errors import UserError
-
-# Schedules are only needed to keep training; replacing them makes loading independent of them.
-_INFERENCE_OBJECTS = {
-    "learning_rate": 0.0,
-    "lr_schedule": lambda _: 0.0,
-    "clip_range": lambda _: 0.0,
-}
+from .pipeline.model_files import NormalizationStats, load_ppo, load_stats, ppo_custom_objects
 
 
 class PPOPolicy:
@@ -33,20 +27,27 @@ class PPOPolicy:
     def __init__(
         self,
         model: Any,
-        vec_normalize: Any | None,
+        stats: NormalizationStats | None,
         files: ModelFiles | None = None,
         deterministic: bool = True,
         train_env_kwargs: dict[str, Any] | None = None,
     ):
-        self.model, self.vec_normalize, self.files = model, vec_normalize, files
+        self.model, self.stats, self.files = model, stats, files
         self.deterministic = deterministic
         self.train_env_kwargs = dict(train_env_kwargs or {})
 
     @classmethod
     def load(
-        cls, path: str | Path, env: gym.Env, deterministic: bool = True, device: str = "cpu"
+        cls,
+        path: str | Path,
+        env: gym.Env,
+        deterministic: bool = True,
+        device: str = "cpu",
+        trust_pickle: bool = False,
     ) -> PPOPolicy:
-        from stable_baselines3 import PPO
+        """Load without unpickling anything (see `agents.pipeline.model_files`); pickled files
+        of older runs only with ``trust_pickle``."""
+        from .pipeline.train_config import load_train_config
 
         files = find_model(path)
         config = files.training_config()
@@ -61,33 +62,33 @@ class PPOPolicy:
             raise UserError(
                 f"the model at {files.model} was trained for {trained_for}, not {env_id}"
             )
-        try:
-            model = PPO.load(files.model, device=device, custom_objects=_INFERENCE_OBJECTS)
-        except (ValueError, KeyError, OSError, RuntimeError) as exc:
-            raise UserError(f"cannot load the PPO model {files.model}: {exc}") from None
-        for what, model_space, env_space in (
-            ("observation", model.observation_space, env.observation_space),
-            ("action", model.action_space, env.action_space),
+        meta = read_meta(files.directory)
+        for what, key, env_space in (
+            ("observation", "observation_shape", env.observation_space),
+            ("action", "action_shape", env.action_space),
         ):
-            if model_space.shape != env_space.shape:
+            if key in meta and tuple(meta[key]) != env_space.shape:
                 raise UserError(
-                    f"the model at {files.model} expects {what} shape {model_space.shape}, "
+                    f"the model at {files.model} expects {what} shape {tuple(meta[key])}, "
                     f"but {env_id} (with these kwargs) has {env_space.shape}"
                 )
-        vec_normalize = None
-        if files.vec_normalize is not None:
-            with open(files.vec_normalize, "rb") as fh:
-                vec_normalize = pickle.load(fh)  # VecNormalize without its venv: stats only
-            vec_normalize.training = False
+        policy_kwargs = load_train_config(data=config).policy.policy_kwargs()
+        objects = ppo_custom_objects(policy_kwargs, env.observation_space, env.action_space)
+        model = load_ppo(files.model, objects, trust_pickle, device=device)
+        stats = load_stats(files.directory, trust_pickle)
         train_kwargs = (config.get("env") or {}).get("kwargs") or {}
-        return cls(model, vec_normalize, files, deterministic, train_kwargs)
+        return cls(model, stats, files, deterministic, train_kwargs)
 
     def reset(self) -> None:
         pass
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:
         obs = np.asarray(observation)
-        if self.vec_normalize is not None:
-            obs = self.vec_normalize.normalize_obs(obs)
+        if obs.dtype.kind not in "fiu":
+            raise UserError(
+                f"observation of dtype {obs.dtype} given to a PPO policy; expected real numbers"
+            )
+        if self.stats is not None:
+            obs = self.stats.normalize_obs(obs)
         action, _ = self.model.predict(obs, deterministic=self.deterministic)
         return action

@@ -63,7 +63,7 @@ def test_run_dir_holds_model_config_command_vecnormalize_and_tensorboard(run):
     run_dir, first = run
     assert first["final_steps"] == 1024 and first["events"]
     for model_dir in (run_dir / "final", run_dir / "best", *(run_dir / "checkpoints").iterdir()):
-        for name in ("model.zip", "vecnormalize.pkl", "config.yaml", "command.txt", "meta.json"):
+        for name in ("model.zip", "vecnormalize.npz", "config.yaml", "command.txt", "meta.json"):
             assert (model_dir / name).is_file(), model_dir / name
     config = yaml.safe_load((run_dir / "final" / "config.yaml").read_text())
     assert config["env"]["id"] == "HexapodCliffWalk-v0" and config["ppo"]["n_steps"] == 256
@@ -205,7 +205,7 @@ def test_model_for_another_env_is_refused(run, tmp_path, capsys):
     fake = tmp_path / "other"
     fake.mkdir()
     final = run[0] / "final"
-    for name in ("model.zip", "vecnormalize.pkl"):
+    for name in ("model.zip", "vecnormalize.npz"):
         (fake / name).write_bytes((final / name).read_bytes())
     config = yaml.safe_load((final / "config.yaml").read_text())
     config["env"]["id"] = "HexapodStewartTilt-v0"

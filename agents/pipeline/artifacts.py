@@ -3,7 +3,8 @@
 A **model directory** holds everything needed to use or resume one saved model::
 
     model.zip          SB3 PPO model (weights, optimiser, num_timesteps)
-    vecnormalize.pkl   VecNormalize statistics (absent when normalisation is off)
+    vecnormalize.npz   VecNormalize statistics as plain arrays (absent when normalisation is
+                       off; older runs have a pickled vecnormalize.pkl, see `model_files`)
     config.yaml        the resolved training config (env id and kwargs included)
     command.txt        the command line that produced it
     meta.json          num_timesteps, observation/action shapes, kind, eval reward (if best)
@@ -17,7 +18,8 @@ A **run directory** (``runs/{env}__ppo__{seed}__{time}``)::
     final/                      model at the end of training (model directory)
     evaluations.npz             EvalCallback's log
 
-Shipped models (``models/<env_id>/``) are model directories.
+Shipped models (``models/<env_id>/``) are model directories. Every file is written atomically
+and ``meta.json`` last, so a model directory with a ``meta.json`` was completely written.
 """
 
 from __future__ import annotations
@@ -34,9 +36,15 @@ from typing import Any
 
 from .configtools import dump_yaml, load_yaml
 from .errors import UserError
+from .model_files import (
+    LEGACY_STATS_FILE,
+    STATS_FILE,
+    NormalizationStats,
+    atomic_path,
+    atomic_write_text,
+)
 
 MODEL_FILE = "model.zip"
-VECNORM_FILE = "vecnormalize.pkl"
 CONFIG_FILE = "config.yaml"
 COMMAND_FILE = "command.txt"
 META_FILE = "meta.json"
@@ -78,16 +86,19 @@ def save_model_dir(
     kind: str,
     extra_meta: dict[str, Any] | None = None,
 ) -> Path:
-    """Write a model directory (see module docstring); files are replaced atomically-ish."""
+    """Write a model directory (see module docstring): each file atomically, meta.json last."""
     path = Path(path)
     path.mkdir(parents=True, exist_ok=True)
-    model.save(path / MODEL_FILE)
+    with atomic_path(path / MODEL_FILE) as tmp:
+        model.save(tmp)  # the temporary name ends in .tmp, so SB3 adds no .zip
     if vec_normalize is not None:
-        vec_normalize.save(str(path / VECNORM_FILE))
-    elif (path / VECNORM_FILE).exists():
-        (path / VECNORM_FILE).unlink()
-    (path / CONFIG_FILE).write_text(dump_yaml(config))
-    (path / COMMAND_FILE).write_text(command + "\n")
+        NormalizationStats.from_vec_normalize(vec_normalize).save(path / STATS_FILE)
+    elif (path / STATS_FILE).exists():
+        (path / STATS_FILE).unlink()
+    if (path / LEGACY_STATS_FILE).exists():  # superseded by the .npz just written
+        (path / LEGACY_STATS_FILE).unlink()
+    atomic_write_text(path / CONFIG_FILE, dump_yaml(config))
+    atomic_write_text(path / COMMAND_FILE, command + "\n")
     meta = {
         "kind": kind,
         "num_timesteps": int(model.num_timesteps),
@@ -96,7 +107,7 @@ def save_model_dir(
         "saved_at": time.strftime("%Y-%m-%dT%H:%M:%S"),
         **(extra_meta or {}),
     }
-    (path / META_FILE).write_text(json.dumps(meta, indent=2) + "\n")
+    atomic_write_text(path / META_FILE, json.dumps(meta, indent=2) + "\n")
     return path
 
 
@@ -117,14 +128,18 @@ def _timesteps(model_dir: Path) -> int:
     return int(match.group(1)) if match else -1
 
 
-def latest_model_dir(run_dir: Path) -> Path | None:
-    """The saved model with the most timesteps among checkpoints/* and final/ (None if none)."""
+def saved_model_dirs(run_dir: Path) -> list[Path]:
+    """checkpoints/* and final/ of a run, newest (most timesteps) first."""
     run_dir = Path(run_dir)
     candidates = sorted((run_dir / CHECKPOINTS).glob("step_*")) + [run_dir / FINAL]
     candidates = [c for c in candidates if (c / MODEL_FILE).is_file()]
-    if not candidates:
-        return None
-    return max(candidates, key=lambda c: (_timesteps(c), c.name == FINAL))
+    return sorted(candidates, key=lambda c: (_timesteps(c), c.name == FINAL), reverse=True)
+
+
+def latest_model_dir(run_dir: Path) -> Path | None:
+    """The saved model with the most timesteps among checkpoints/* and final/ (None if none)."""
+    dirs = saved_model_dirs(run_dir)
+    return dirs[0] if dirs else None
 
 
 def is_run_dir(path: Path) -> bool:
@@ -138,7 +153,7 @@ class ModelFiles:
 
     directory: Path
     model: Path
-    vec_normalize: Path | None
+    vec_normalize: Path | None  # vecnormalize.npz, or a legacy vecnormalize.pkl
     config: Path | None
 
     def training_config(self) -> dict[str, Any] | None:
@@ -172,7 +187,9 @@ def find_model(path: str | Path) -> ModelFiles:
             f"no PPO model at {path}: expected a .zip file, a directory with {MODEL_FILE}, "
             f"or a run directory with {BEST}/, {FINAL}/ or {CHECKPOINTS}/"
         )
-    vecnorm = directory / VECNORM_FILE
+    vecnorm = directory / STATS_FILE
+    if not vecnorm.is_file():
+        vecnorm = directory / LEGACY_STATS_FILE
     config = directory / CONFIG_FILE
     return ModelFiles(
         directory=directory,

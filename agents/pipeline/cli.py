@@ -31,6 +31,15 @@ def _add_set_option(p: argparse.ArgumentParser, what: str) -> None:
     )
 
 
+def _add_trust_pickle_option(p: argparse.ArgumentParser) -> None:
+    p.add_argument(
+        "--trust-pickle",
+        action="store_true",
+        help="load pickled model files (vecnormalize.pkl, unknown pickled entries in model.zip) "
+        "of older runs; a pickle can run code when loaded: only for files you trust",
+    )
+
+
 def _run(prog: str, body: Callable[[], int]) -> int:
     try:
         return body()
@@ -61,6 +70,7 @@ def train_parser() -> argparse.ArgumentParser:
     p.add_argument("--output-dir", type=Path, default=Path("runs"), help="parent of run dirs")
     p.add_argument("--run-name", help="run directory name (default {env}__ppo__{seed}__{time})")
     p.add_argument("--force", action="store_true", help="overwrite an existing run directory")
+    _add_trust_pickle_option(p)
     return p
 
 
@@ -75,7 +85,9 @@ def train_main(argv: Sequence[str] | None = None) -> int:
         if args.resume is not None:
             if args.run_name or args.force:
                 raise UserError("--run-name and --force do not apply to --resume")
-            result = resume_training(args.resume, args.overrides, command=command)
+            result = resume_training(
+                args.resume, args.overrides, command=command, trust_pickle=args.trust_pickle
+            )
         else:
             config = load_train_config(args.config, args.overrides)
             result = start_training(
@@ -134,6 +146,7 @@ def evaluate_parser() -> argparse.ArgumentParser:
     p.add_argument("--output-dir", type=Path, help="report directory")
     p.add_argument("--frames", action="store_true", help="add a frame strip per policy (EGL)")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    _add_trust_pickle_option(p)
     _add_set_option(p, "suite")
     p.add_argument("--force", action="store_true", help="overwrite an existing report directory")
     return p
@@ -162,6 +175,8 @@ def evaluate_main(argv: Sequence[str] | None = None) -> int:
                 overrides.append(f"{key}={json.dumps(value)}")  # JSON is YAML
         if args.frames:
             overrides.append("frames=true")
+        if args.trust_pickle:
+            overrides.append("trust_pickle=true")
         suite = load_suite(args.config or DEFAULT_SUITE, overrides)
         out = _prepare_report_dir(Path(suite.output_dir), args.force)
         result = run_suite(suite, progress=not args.no_progress)

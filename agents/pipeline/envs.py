@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import difflib
 import importlib
+import signal
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
@@ -75,14 +76,20 @@ class EnvSpec:
 
 
 class EnvFactory:
-    """Picklable env constructor for SB3 vec envs (runs in subprocess workers too)."""
+    """Picklable env constructor for SB3 vec envs (runs in subprocess workers too).
 
-    def __init__(self, spec: EnvSpec):
-        self.spec = spec
+    With `worker` set (SubprocVecEnv), the worker process ignores SIGINT: a Ctrl-C is for the
+    parent, which saves a checkpoint and then closes the workers itself. A worker that died of
+    the same Ctrl-C mid-step would leave the parent waiting for its reply."""
+
+    def __init__(self, spec: EnvSpec, worker: bool = False):
+        self.spec, self.worker = spec, worker
 
     def __call__(self) -> gym.Env:
         from stable_baselines3.common.monitor import Monitor
 
+        if self.worker:
+            signal.signal(signal.SIGINT, signal.SIG_IGN)
         return Monitor(self.spec.make())
 
 
@@ -97,7 +104,7 @@ def make_vec_env(
     from stable_baselines3.common.vec_env import DummyVecEnv, SubprocVecEnv
 
     spec.make().close()  # fail here, in the main process, with a clear error
-    factories = [EnvFactory(spec) for _ in range(n_envs)]
+    factories = [EnvFactory(spec, worker=subprocess) for _ in range(n_envs)]
     if subprocess:
         venv = SubprocVecEnv(factories, start_method=start_method)
     else:

@@ -71,6 +71,7 @@ class EvaluationSuite:
     # skip: a ppo:<path> that does not exist, or an env without an analytical controller in
     # agents/registry.py, is left out with a warning line in the report (error: exit with it)
     deterministic: bool = True  # PPO actions: the mean (true) or sampled
+    trust_pickle: bool = False  # load pickled model files of older runs (runs code from them)
     frames: bool = False  # frame strip per policy (rendered with MUJOCO_GL=egl)
     frame_count: int = 6
     frame_size: list[int] = field(default_factory=lambda: [320, 240])

@@ -114,7 +114,9 @@ def build_policy(
     from ..ppo import PPOPolicy
 
     path = _ppo_path(name, env_id)
-    policy = PPOPolicy.load(path, env, deterministic=suite.deterministic)
+    policy = PPOPolicy.load(
+        path, env, deterministic=suite.deterministic, trust_pickle=suite.trust_pickle
+    )
     return policy, str(policy.files.model)
 
 

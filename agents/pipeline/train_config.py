@@ -2,10 +2,31 @@
 
 Every level rejects unknown keys (listing the valid ones); see `configtools`. Frequencies are in
 environment steps summed over all parallel envs (the unit of ``total_timesteps``).
+
+Numeric ranges, checked when the config is loaded (a value outside names its key; NaN and
+infinities are outside every range):
+
+| key | valid |
+|---|---|
+| ``ppo.learning_rate``, ``ppo.clip_range``, ``ppo.clip_range_vf`` | > 0 at start, >= 0 at end |
+| ``ppo.n_steps``, ``ppo.n_epochs`` | >= 1 |
+| ``ppo.batch_size`` | 1 .. ``ppo.n_steps`` x ``vec_env.n_envs`` |
+| ``ppo.gamma`` | (0, 1] |
+| ``ppo.gae_lambda`` | [0, 1] |
+| ``ppo.ent_coef``, ``ppo.vf_coef`` | >= 0 |
+| ``ppo.max_grad_norm``, ``ppo.target_kl`` (unless null) | > 0 |
+| ``ppo.sde_sample_freq`` | >= -1 (-1: only at the start of a rollout) |
+| ``normalize.clip_observation``, ``normalize.clip_reward`` | > 0 |
+| ``policy.pi``, ``policy.vf`` | layer sizes >= 1 |
+| ``policy.log_std_init`` | finite |
+| ``train.total_timesteps``, ``train.num_threads``, ``vec_env.n_envs``, ``eval.n_episodes`` | >= 1 |
+| ``train.seed``, ``eval.freq``, ``checkpoint.freq`` | >= 0 (a frequency of 0 disables it) |
+| ``logging.verbose`` | 0, 1 or 2 |
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -15,6 +36,24 @@ from .errors import ConfigError
 from .schedules import Schedule, parse_optional_schedule, parse_schedule
 
 DEFAULT_GYM_PACKAGES = ["hexapod_envs"]
+
+
+def _require(key: str, value: Any, valid: str, ok: bool) -> None:
+    """ValueError naming `key` and its valid range unless `ok`."""
+    if not ok:
+        raise ValueError(f"{key} must be {valid}, got {value!r}")
+
+
+def _finite(value: Any) -> bool:
+    return isinstance(value, int | float) and math.isfinite(value)
+
+
+def _require_schedule(key: str, schedule: Schedule) -> None:
+    """A learning-rate-like schedule: positive at the start, never negative."""
+    values = (schedule.initial, schedule.final)
+    ok = all(_finite(v) for v in values) and schedule.initial > 0 and schedule.final >= 0
+    shown = schedule.initial if schedule.is_constant else values
+    _require(key, shown, "> 0 (a linear schedule may end at 0)", ok)
 
 
 @dataclass
@@ -35,8 +74,7 @@ class VecEnvConfig:
     start_method: Literal["forkserver", "spawn", "fork"] | None = None  # None: SB3's default
 
     def __post_init__(self):
-        if self.n_envs < 1:
-            raise ValueError(f"vec_env.n_envs must be >= 1, got {self.n_envs}")
+        _require("vec_env.n_envs", self.n_envs, ">= 1", self.n_envs >= 1)
 
     @property
     def use_subprocess(self) -> bool:
@@ -52,6 +90,11 @@ class NormalizeConfig:
     clip_observation: float = 10.0
     clip_reward: float = 10.0
 
+    def __post_init__(self):
+        for name in ("clip_observation", "clip_reward"):
+            value = getattr(self, name)
+            _require(f"normalize.{name}", value, "> 0", _finite(value) and value > 0)
+
 
 ACTIVATIONS = ("tanh", "relu", "elu", "leaky_relu", "gelu", "silu")
 
@@ -65,6 +108,14 @@ class PolicyConfig:
     activation: Literal["tanh", "relu", "elu", "leaky_relu", "gelu", "silu"] = "tanh"
     log_std_init: float = 0.0
     ortho_init: bool = True
+
+    def __post_init__(self):
+        for name in ("pi", "vf"):
+            sizes = getattr(self, name)
+            _require(
+                f"policy.{name}", sizes, "a list of layer sizes >= 1", all(n >= 1 for n in sizes)
+            )
+        _require("policy.log_std_init", self.log_std_init, "finite", _finite(self.log_std_init))
 
     def policy_kwargs(self) -> dict[str, Any]:
         from torch import nn
@@ -111,6 +162,27 @@ class PPOConfig:
     sde_sample_freq: int = -1
     target_kl: float | None = None
 
+    def __post_init__(self):
+        _require_schedule("ppo.learning_rate", self.learning_rate)
+        _require_schedule("ppo.clip_range", self.clip_range)
+        if self.clip_range_vf is not None:
+            _require_schedule("ppo.clip_range_vf", self.clip_range_vf)
+        for name in ("n_steps", "batch_size", "n_epochs"):
+            _require(f"ppo.{name}", getattr(self, name), ">= 1", getattr(self, name) >= 1)
+        g, lam = self.gamma, self.gae_lambda
+        _require("ppo.gamma", g, "in (0, 1]", _finite(g) and 0 < g <= 1)
+        _require("ppo.gae_lambda", lam, "in [0, 1]", _finite(lam) and 0 <= lam <= 1)
+        for name in ("ent_coef", "vf_coef"):
+            value = getattr(self, name)
+            _require(f"ppo.{name}", value, ">= 0", _finite(value) and value >= 0)
+        mgn = self.max_grad_norm
+        _require("ppo.max_grad_norm", mgn, "> 0", _finite(mgn) and mgn > 0)
+        freq = self.sde_sample_freq
+        _require("ppo.sde_sample_freq", freq, ">= -1", freq >= -1)
+        if self.target_kl is not None:
+            kl = self.target_kl
+            _require("ppo.target_kl", kl, "> 0 or null", _finite(kl) and kl > 0)
+
     def sb3_kwargs(self) -> dict[str, Any]:
         return {
             "learning_rate": self.learning_rate,
@@ -141,10 +213,9 @@ class TrainingConfig:
     threads oversubscribe the cores (three runs on 2 cores fell from ~290 to ~30 steps/s)."""
 
     def __post_init__(self):
-        if self.num_threads < 1:
-            raise ValueError(f"train.num_threads must be >= 1, got {self.num_threads}")
-        if self.total_timesteps < 1:
-            raise ValueError(f"train.total_timesteps must be >= 1, got {self.total_timesteps}")
+        for name in ("num_threads", "total_timesteps"):
+            _require(f"train.{name}", getattr(self, name), ">= 1", getattr(self, name) >= 1)
+        _require("train.seed", self.seed, ">= 0", self.seed >= 0)
 
 
 @dataclass
@@ -155,6 +226,10 @@ class EvalConfig:
     n_episodes: int = 5
     deterministic: bool = True
 
+    def __post_init__(self):
+        _require("eval.freq", self.freq, ">= 0 (0 disables evaluation)", self.freq >= 0)
+        _require("eval.n_episodes", self.n_episodes, ">= 1", self.n_episodes >= 1)
+
 
 @dataclass
 class CheckpointConfig:
@@ -162,12 +237,18 @@ class CheckpointConfig:
 
     freq: int = 50_000
 
+    def __post_init__(self):
+        _require("checkpoint.freq", self.freq, ">= 0 (0: only final/interrupt)", self.freq >= 0)
+
 
 @dataclass
 class LoggingConfig:
     tensorboard: bool = True
     progress_bar: bool = True
     verbose: int = 0  # 1: also print SB3's log table to stdout
+
+    def __post_init__(self):
+        _require("logging.verbose", self.verbose, "0, 1 or 2", self.verbose in (0, 1, 2))
 
 
 @dataclass

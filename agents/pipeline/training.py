@@ -6,6 +6,11 @@ See `artifacts` for the run directory layout and `callbacks` for what goes to Te
 from __future__ import annotations
 
 import contextlib
+import os
+import shutil
+import signal
+import sys
+import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,17 +23,24 @@ from .artifacts import (
     COMMAND_FILE,
     CONFIG_FILE,
     FINAL,
-    VECNORM_FILE,
+    MODEL_FILE,
     command_line,
-    latest_model_dir,
     prepare_new_dir,
     read_meta,
     run_name,
+    saved_model_dirs,
 )
 from .configtools import dump_yaml, load_yaml, parse_override
 from .envs import EnvSpec, env_time_step, make_vec_env
 from .episode import metric_specs
 from .errors import UserError
+from .model_files import (
+    NormalizationStats,
+    atomic_write_text,
+    load_ppo,
+    load_stats,
+    ppo_custom_objects,
+)
 from .train_config import TrainConfig, load_train_config
 
 EVAL_SEED_OFFSET = 10_000
@@ -36,6 +48,9 @@ EVAL_SEED_OFFSET = 10_000
 
 RESUME_FIXED_SECTIONS = ("env", "policy", "normalize")
 """Config sections a resumed run cannot change (the model and its statistics depend on them)."""
+
+WORKER_CLOSE_TIMEOUT_S = 10.0
+"""How long closing the vec env waits for subprocess workers before terminating them."""
 
 
 @dataclass
@@ -66,7 +81,7 @@ def _probe(spec: EnvSpec) -> tuple[float | None, list]:
         env.close()
 
 
-def _vec_envs(config: TrainConfig, seed: int, vecnormalize_path: Path | None = None):
+def _vec_envs(config: TrainConfig, seed: int, stats: NormalizationStats | None = None):
     """Training vec env (VecNormalize on top when configured) and a 1-env evaluation vec env."""
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
 
@@ -85,18 +100,16 @@ def _vec_envs(config: TrainConfig, seed: int, vecnormalize_path: Path | None = N
         eval_env.seed(seed + EVAL_SEED_OFFSET)
     norm = config.normalize
     if norm.observation or norm.reward:
-        if vecnormalize_path is not None:
-            venv = VecNormalize.load(str(vecnormalize_path), venv)
-            venv.training = True
-        else:
-            venv = VecNormalize(
-                venv,
-                norm_obs=norm.observation,
-                norm_reward=norm.reward,
-                clip_obs=norm.clip_observation,
-                clip_reward=norm.clip_reward,
-                gamma=config.ppo.gamma,
-            )
+        venv = VecNormalize(
+            venv,
+            norm_obs=norm.observation,
+            norm_reward=norm.reward,
+            clip_obs=norm.clip_observation,
+            clip_reward=norm.clip_reward,
+            gamma=config.ppo.gamma,
+        )
+        if stats is not None:
+            stats.apply_to(venv)
         if eval_env is not None:
             eval_env = VecNormalize(
                 eval_env,
@@ -115,39 +128,49 @@ def start_training(
     force: bool = False,
     command: str | None = None,
 ) -> TrainResult:
-    """Create ``output_dir/name`` (default ``{env}__ppo__{seed}__{time}``) and train PPO in it."""
+    """Create ``output_dir/name`` (default ``{env}__ppo__{seed}__{time}``) and train PPO in it.
+
+    A run that fails before its first training step removes the directory it created, so the
+    same command can simply be run again."""
     from stable_baselines3 import PPO
 
     spec = env_spec(config)
     dt, specs = _probe(spec)
     name = name or run_name(config.env.id, config.train.seed)
     run_dir = prepare_new_dir(Path(output_dir) / name, force, "run directory")
-    command = command or command_line()
-    (run_dir / CONFIG_FILE).write_text(dump_yaml(config))
-    (run_dir / COMMAND_FILE).write_text(command + "\n")
-    venv, eval_env = _vec_envs(config, config.train.seed)
-    model = PPO(
-        "MlpPolicy",
-        venv,
-        policy_kwargs=config.policy.policy_kwargs(),
-        seed=config.train.seed,
-        device=config.train.device,
-        verbose=config.logging.verbose,
-        **config.ppo.sb3_kwargs(),
-    )
+    try:
+        command = command or command_line()
+        atomic_write_text(run_dir / CONFIG_FILE, dump_yaml(config))
+        atomic_write_text(run_dir / COMMAND_FILE, command + "\n")
+        venv, eval_env = _vec_envs(config, config.train.seed)
+        model = PPO(
+            "MlpPolicy",
+            venv,
+            policy_kwargs=config.policy.policy_kwargs(),
+            seed=config.train.seed,
+            device=config.train.device,
+            verbose=config.logging.verbose,
+            **config.ppo.sb3_kwargs(),
+        )
+    except BaseException:
+        shutil.rmtree(run_dir, ignore_errors=True)
+        raise
     return _learn(model, config, run_dir, command, eval_env, dt, specs, resumed=False)
 
 
 def resume_training(
-    run_dir: str | Path, overrides: list[str] | tuple[str, ...] = (), command: str | None = None
+    run_dir: str | Path,
+    overrides: list[str] | tuple[str, ...] = (),
+    command: str | None = None,
+    trust_pickle: bool = False,
 ) -> TrainResult:
-    """Continue a run from its latest checkpoint (model, VecNormalize, timestep count) in place.
+    """Continue a run from its newest loadable checkpoint (model, statistics, timestep count).
 
     Overrides may change the budget, PPO hyperparameters, evaluation/checkpoint frequencies and
-    the number of envs, but not the env, the policy network or the normalisation.
+    the number of envs, but not the env, the policy network or the normalisation. A damaged
+    newest checkpoint is reported and the next newest is used; no file of the run is written
+    before a checkpoint has loaded.
     """
-    from stable_baselines3 import PPO
-
     run_dir = Path(run_dir)
     if not (run_dir / CONFIG_FILE).is_file():
         raise UserError(f"{run_dir} is not a training run directory (no {CONFIG_FILE})")
@@ -159,35 +182,71 @@ def resume_training(
                 f"{list(RESUME_FIXED_SECTIONS)} are fixed by the saved model"
             )
     config = load_train_config(data=load_yaml(run_dir / CONFIG_FILE), overrides=overrides)
-    latest = latest_model_dir(run_dir)
-    if latest is None:
+    candidates = saved_model_dirs(run_dir)
+    if not candidates:
         raise UserError(f"{run_dir} holds no checkpoint to resume from")
-    done = int(read_meta(latest).get("num_timesteps", 0))
-    if done >= config.train.total_timesteps:
-        raise UserError(
-            f"{run_dir} is already trained to {done} steps >= train.total_timesteps="
-            f"{config.train.total_timesteps}; raise it, e.g. "
-            f"--set train.total_timesteps={2 * config.train.total_timesteps}"
-        )
     spec = env_spec(config)
     dt, specs = _probe(spec)
+    model = eval_env = None
+    problems = []
+    for checkpoint in candidates:
+        done = int(read_meta(checkpoint).get("num_timesteps", 0))
+        if done >= config.train.total_timesteps:
+            raise UserError(
+                f"{run_dir} is already trained to {done} steps >= train.total_timesteps="
+                f"{config.train.total_timesteps}; raise it, e.g. "
+                f"--set train.total_timesteps={2 * config.train.total_timesteps}"
+            )
+        try:
+            model, eval_env = _load_checkpoint(checkpoint, config, done, trust_pickle)
+            break
+        except UserError as exc:
+            problems.append(f"{checkpoint.name}: {exc}")
+            print(f"warning: cannot resume from {checkpoint}: {exc}", file=sys.stderr)
+    if model is None:
+        raise UserError(f"no loadable checkpoint in {run_dir}:\n  " + "\n  ".join(problems))
+    if problems:
+        print(f"falling back to {checkpoint.name} ({done} steps)", file=sys.stderr)
     command = command or command_line()
-    (run_dir / CONFIG_FILE).write_text(dump_yaml(config))
+    atomic_write_text(run_dir / CONFIG_FILE, dump_yaml(config))
     with open(run_dir / COMMAND_FILE, "a") as fh:
         fh.write(command + "\n")
-    vecnorm = latest / VECNORM_FILE
-    seed = config.train.seed + done
-    venv, eval_env = _vec_envs(config, seed, vecnorm if vecnorm.is_file() else None)
-    model = PPO.load(
-        latest / "model.zip",
-        env=venv,
-        device=config.train.device,
-        verbose=config.logging.verbose,
-        **config.ppo.sb3_kwargs(),
-    )
-    model.set_random_seed(seed)
-    print(f"resuming {run_dir} from {latest.name} at {model.num_timesteps} steps")
+    print(f"resuming {run_dir} from {checkpoint.name} at {model.num_timesteps} steps")
     return _learn(model, config, run_dir, command, eval_env, dt, specs, resumed=True)
+
+
+def _load_checkpoint(
+    checkpoint: Path, config: TrainConfig, done: int, trust_pickle: bool
+) -> tuple[Any, Any]:
+    """The PPO model of a checkpoint on fresh vec envs; UserError (envs closed) if damaged."""
+    stats = load_stats(checkpoint, trust_pickle)
+    seed = config.train.seed + done
+    venv, eval_env = _vec_envs(config, seed, stats)
+    ppo = config.ppo
+    objects = ppo_custom_objects(
+        config.policy.policy_kwargs(),
+        venv.observation_space,
+        venv.action_space,
+        learning_rate=ppo.learning_rate,
+        clip_range=ppo.clip_range,
+        clip_range_vf=ppo.clip_range_vf,
+    )
+    try:
+        model = load_ppo(
+            checkpoint / MODEL_FILE,
+            objects,
+            trust_pickle,
+            env=venv,
+            device=config.train.device,
+            verbose=config.logging.verbose,
+            **ppo.sb3_kwargs(),
+        )
+    except BaseException:
+        for env in (venv, eval_env):
+            close_vec_env(env)
+        raise
+    model.set_random_seed(seed)
+    return model, eval_env
 
 
 def _learn(
@@ -257,13 +316,20 @@ def _learn(
         )
     except KeyboardInterrupt:
         interrupted = True
+    except BaseException as exc:
+        with _exit_on_second_interrupt():
+            _save_after_crash(saver, model, exc)
+            for env in (model.get_env(), eval_env):
+                close_vec_env(env)
+        raise
     seconds = time.perf_counter() - start
-    if interrupted:
-        saved = saver.save(model, "interrupt")
-    else:
-        saved = saver.save(model, "final", run_dir / FINAL)
-    for env in (model.get_env(), eval_env):
-        _close_quietly(env)
+    with _exit_on_second_interrupt():
+        if interrupted:
+            saved = saver.save(model, "interrupt")
+        else:
+            saved = saver.save(model, "final", run_dir / FINAL)
+        for env in (model.get_env(), eval_env):
+            close_vec_env(env)
     return TrainResult(
         run_dir=run_dir,
         num_timesteps=int(model.num_timesteps),
@@ -274,24 +340,98 @@ def _learn(
     )
 
 
+def _save_after_crash(saver: Any, model: Any, exc: BaseException) -> None:
+    """Keep the training done so far when learn() raised; the original error is re-raised."""
+    try:
+        path = saver.save(model, "crash")
+    except Exception as save_exc:  # the model itself may be what broke
+        print(
+            f"error: training failed ({exc!r}) and no checkpoint could be saved ({save_exc!r})",
+            file=sys.stderr,
+        )
+        return
+    print(
+        f"error: training failed at {model.num_timesteps} steps; checkpoint saved to {path}\n"
+        f"resume with: python train.py --resume {saver.run_dir}",
+        file=sys.stderr,
+    )
+
+
+@contextlib.contextmanager
+def _exit_on_second_interrupt():
+    """While saving and closing after a Ctrl-C, a second Ctrl-C exits at once (code 130).
+
+    Files are written atomically, so the newest complete checkpoint stays valid."""
+    if threading.current_thread() is not threading.main_thread():
+        yield  # signal handlers can only be set from the main thread (e.g. not in Ray trials)
+        return
+
+    def exit_now(signum, frame):
+        print("\nsecond interrupt: exiting without waiting for the workers", file=sys.stderr)
+        os._exit(130)
+
+    previous = signal.signal(signal.SIGINT, exit_now)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
+def close_vec_env(venv: Any, timeout: float = WORKER_CLOSE_TIMEOUT_S) -> None:
+    """Close a vec env without ever hanging on its subprocess workers.
+
+    SB3's ``SubprocVecEnv.close()`` waits for the reply to a step that a Ctrl-C may have cut
+    in half, which can block forever. Here the workers are told to close (a worker busy with
+    a step finishes it first), given `timeout` seconds, and then terminated."""
+    from stable_baselines3.common.vec_env import SubprocVecEnv, VecEnvWrapper
+
+    inner = venv
+    while isinstance(inner, VecEnvWrapper):
+        inner = inner.venv
+    if inner is None:
+        return
+    if not isinstance(inner, SubprocVecEnv):
+        with contextlib.suppress(Exception):
+            inner.close()
+        return
+    if inner.closed:
+        return
+    for remote in inner.remotes:
+        with contextlib.suppress(OSError, ValueError):
+            remote.send(("close", None))
+    deadline = time.monotonic() + timeout
+    for process in inner.processes:
+        process.join(max(deadline - time.monotonic(), 0.0))
+    for process in inner.processes:
+        if process.is_alive():
+            process.terminate()
+            process.join(1.0)
+        if process.is_alive():
+            process.kill()
+            process.join(1.0)
+    for remote in inner.remotes:
+        with contextlib.suppress(OSError):
+            remote.close()
+    inner.closed = True
+
+
 def _restore_eval_history(eval_cb: Any, run_dir: Path) -> None:
     """Keep the best reward and the evaluation log of the earlier part of a resumed run."""
     best = read_meta(run_dir / BEST)
     if "eval_mean_reward" in best:
         eval_cb.best_mean_reward = float(best["eval_mean_reward"])
     log = run_dir / "evaluations.npz"
-    if log.is_file():
-        with np.load(log) as data:
+    if not log.is_file():
+        return
+    try:
+        with np.load(log, allow_pickle=False) as data:
             eval_cb.evaluations_timesteps = list(data["timesteps"])
             eval_cb.evaluations_results = [list(r) for r in data["results"]]
             eval_cb.evaluations_length = [list(r) for r in data["ep_lengths"]]
             if "successes" in data:
                 eval_cb.evaluations_successes = [list(r) for r in data["successes"]]
-
-
-def _close_quietly(env: Any) -> None:
-    """Close a vec env; after Ctrl-C its subprocess workers may already be gone."""
-    if env is None:
-        return
-    with contextlib.suppress(BrokenPipeError, EOFError, ConnectionResetError, OSError):
-        env.close()
+    except (OSError, ValueError, KeyError, EOFError) as exc:
+        print(
+            f"warning: the evaluation log {log} is unreadable ({exc}); it starts anew",
+            file=sys.stderr,
+        )
