@@ -202,6 +202,10 @@ def load_stats(model_dir: str | Path, trust_pickle: bool = False) -> Normalizati
             vec_normalize = pickle.load(fh)  # the user opted in with --trust-pickle
     except Exception as exc:  # a damaged pickle can raise nearly anything
         raise UserError(f"cannot read the normalisation statistics {legacy}: {exc!r}") from None
+    if not hasattr(vec_normalize, "obs_rms") or not hasattr(vec_normalize, "ret_rms"):
+        raise UserError(
+            f"{legacy} holds a {type(vec_normalize).__name__}, not SB3 VecNormalize statistics"
+        )
     return NormalizationStats.from_vec_normalize(vec_normalize)
 
 
