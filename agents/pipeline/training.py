@@ -308,12 +308,13 @@ def _learn(
     start = time.perf_counter()
     interrupted = False
     try:
-        model.learn(
-            remaining,
-            callback=CallbackList(callbacks),
-            reset_num_timesteps=not resumed,
-            progress_bar=config.logging.progress_bar,
-        )
+        with _interruptible():
+            model.learn(
+                remaining,
+                callback=CallbackList(callbacks),
+                reset_num_timesteps=not resumed,
+                progress_bar=config.logging.progress_bar,
+            )
     except KeyboardInterrupt:
         interrupted = True
     except BaseException as exc:
@@ -355,6 +356,28 @@ def _save_after_crash(saver: Any, model: Any, exc: BaseException) -> None:
         f"resume with: python train.py --resume {saver.run_dir}",
         file=sys.stderr,
     )
+
+
+@contextlib.contextmanager
+def _interruptible():
+    """During learning, SIGINT and SIGTERM raise KeyboardInterrupt (checkpoint, exit 130).
+
+    Also when the process started with SIGINT ignored (a background job of a non-interactive
+    shell, some schedulers): a training run must stop when asked, and SIGTERM is how job
+    schedulers ask."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    previous = {sig: signal.signal(sig, interrupt) for sig in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
 
 
 @contextlib.contextmanager
