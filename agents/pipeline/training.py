@@ -114,8 +114,13 @@ def start_training(
     name: str | None = None,
     force: bool = False,
     command: str | None = None,
+    after_eval: Any = None,
 ) -> TrainResult:
-    """Create ``output_dir/name`` (default ``{env}__ppo__{seed}__{time}``) and train PPO in it."""
+    """Create ``output_dir/name`` (default ``{env}__ppo__{seed}__{time}``) and train PPO in it.
+
+    `after_eval`: an optional SB3 callback run after each evaluation (its ``parent`` is the
+    EvalCallback); sweeps use it to report the evaluation metrics to Ray Tune.
+    """
     from stable_baselines3 import PPO
 
     spec = env_spec(config)
@@ -135,11 +140,14 @@ def start_training(
         verbose=config.logging.verbose,
         **config.ppo.sb3_kwargs(),
     )
-    return _learn(model, config, run_dir, command, eval_env, dt, specs, resumed=False)
+    return _learn(model, config, run_dir, command, eval_env, dt, specs, False, after_eval)
 
 
 def resume_training(
-    run_dir: str | Path, overrides: list[str] | tuple[str, ...] = (), command: str | None = None
+    run_dir: str | Path,
+    overrides: list[str] | tuple[str, ...] = (),
+    command: str | None = None,
+    after_eval: Any = None,
 ) -> TrainResult:
     """Continue a run from its latest checkpoint (model, VecNormalize, timestep count) in place.
 
@@ -187,7 +195,7 @@ def resume_training(
     )
     model.set_random_seed(seed)
     print(f"resuming {run_dir} from {latest.name} at {model.num_timesteps} steps")
-    return _learn(model, config, run_dir, command, eval_env, dt, specs, resumed=True)
+    return _learn(model, config, run_dir, command, eval_env, dt, specs, True, after_eval)
 
 
 def _learn(
@@ -199,6 +207,7 @@ def _learn(
     dt: float | None,
     specs: list,
     resumed: bool,
+    after_eval: Any = None,
 ) -> TrainResult:
     import torch
     from stable_baselines3.common.callbacks import CallbackList
@@ -226,6 +235,7 @@ def _learn(
             log_path=str(run_dir),
             deterministic=config.eval.deterministic,
             callback_on_new_best=SaveBest(saver),
+            callback_after_eval=after_eval,
             warn=False,
             verbose=config.logging.verbose,
             dt=dt,
