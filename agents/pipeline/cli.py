@@ -153,7 +153,8 @@ def evaluate_parser() -> argparse.ArgumentParser:
         "--policies",
         nargs="+",
         metavar="POLICY",
-        help="analytical | ppo:<model file, model dir or run dir> | zero | random",
+        help="analytical | ppo:<model file, model dir, run dir or sweep dir> | zero | random "
+        "(a sweep dir is a multi-seed study: every trial, aggregated with CIs)",
     )
     p.add_argument("--episodes", type=int, help="episodes per policy and env")
     p.add_argument("--seed", type=int, help="seed of the first episode (episode k: seed + k)")
@@ -190,15 +191,28 @@ def evaluate_main(argv: Sequence[str] | None = None) -> int:
         if args.frames:
             overrides.append("frames=true")
         suite = load_suite(args.config or DEFAULT_SUITE, overrides)
+        suite, studies, study_warnings = _expand_studies(suite)
         out = _prepare_report_dir(Path(suite.output_dir), args.force)
         result = run_suite(suite, progress=not args.no_progress)
+        result.warnings[:0] = study_warnings
         paths = write_report(result, out)
+        if studies:
+            from .study import write_study_section
+
+            paths += write_study_section(result, studies, out)
         for line in result.warnings:
             print(f"warning: {line}", file=sys.stderr)
         print("wrote " + ", ".join(str(p) for p in paths))
         return 0
 
     return _run("evaluate.py", body)
+
+
+def _expand_studies(suite):
+    """``ppo:<sweep dir>`` policies -> one policy per trial, aggregated by `study` afterwards."""
+    from .study import expand_studies
+
+    return expand_studies(suite)
 
 
 def _prepare_report_dir(path: Path, force: bool) -> Path:

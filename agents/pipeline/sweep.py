@@ -106,8 +106,9 @@ def _eval_rows(run_dir: Path) -> list[dict[str, float]]:
     return rows
 
 
-def _make_reporter(node: dict[str, Any]) -> Any:
-    """SB3 callback run after each evaluation: reports the evaluation's means to Ray Tune."""
+def _make_reporter(node: dict[str, Any], on_eval: Any) -> Any:
+    """SB3 callback run after each evaluation: calls `on_eval()`, then reports the evaluation's
+    means to Ray Tune."""
     from ray import tune
     from stable_baselines3.common.callbacks import BaseCallback
 
@@ -115,6 +116,7 @@ def _make_reporter(node: dict[str, Any]) -> Any:
         reported = 0
 
         def _on_step(self) -> bool:
+            on_eval()
             evaluation = self.parent
             buffer = evaluation._is_success_buffer
             tune.report(
@@ -152,8 +154,18 @@ def run_trial(params: dict[str, Any], sweep: LoadedSweep, sweep_dir: str, comman
     info["budget"] = config.train.total_timesteps
     attempts = info.setdefault("attempts", [])
     attempts.append({**node, "started": time.strftime("%Y-%m-%dT%H:%M:%S"), "seconds": None})
-    reporter = _make_reporter({"node_id": node["node_id"], "hostname": node["hostname"]})
     start = time.perf_counter()
+
+    def save_info(interrupted: bool | None = None) -> None:
+        """trial.json in the run directory: at the start, after every evaluation, at the end."""
+        attempts[-1]["seconds"] = time.perf_counter() - start
+        if interrupted is not None:
+            attempts[-1]["interrupted"] = interrupted
+        info["wall_seconds"] = sum(a["seconds"] or 0.0 for a in attempts)
+        if run_dir.is_dir():
+            info_path.write_text(json.dumps(info, indent=1) + "\n")
+
+    reporter = _make_reporter({"node_id": node["node_id"], "hostname": node["hostname"]}, save_info)
     latest = latest_model_dir(run_dir) if (run_dir / CONFIG_FILE).is_file() else None
     done = int(read_meta(latest).get("num_timesteps", 0)) if latest else 0
     result = None
@@ -163,12 +175,9 @@ def run_trial(params: dict[str, Any], sweep: LoadedSweep, sweep_dir: str, comman
             shutil.rmtree(run_dir)
         result = start_training(config, sweep_dir, name, command=command, after_eval=reporter)
     elif done < config.train.total_timesteps:
+        save_info()
         result = resume_training(run_dir, command=command, after_eval=reporter)
-    attempts[-1]["seconds"] = time.perf_counter() - start
-    attempts[-1]["interrupted"] = bool(result and result.interrupted)
-    info["wall_seconds"] = sum(a["seconds"] or 0.0 for a in attempts)
-    run_dir.mkdir(parents=True, exist_ok=True)
-    info_path.write_text(json.dumps(info, indent=1) + "\n")
+    save_info(interrupted=bool(result and result.interrupted))
     if reporter.reported == 0:  # nothing evaluated in this attempt: report the run's last eval
         rows = _eval_rows(run_dir)
         last = rows[-1] if rows else {"timesteps": done, "eval_mean_reward": float("nan")}
@@ -372,7 +381,7 @@ def trial_row(run_dir: Path, metric: str, mode: str) -> dict[str, Any]:
     last = attempts[-1]
     return {
         "trial": run_dir.name,
-        "status": "finished" if final else ("stopped" if info else "running"),
+        "status": "finished" if final else "incomplete",
         "overrides": " ".join(info.get("overrides", [])),
         "budget": budget,
         "steps": steps,
