@@ -91,7 +91,8 @@ def _interval(matrix: np.ndarray, aggregate: Any, point: str) -> dict[str, float
     from rliable import library as rly
 
     # rliable's StratifiedBootstrap draws its resampling indices from NumPy's global generator
-    # (its random_state only reaches arch); seed that for reproducible CIs, then restore it.
+    # (its random_state argument only reaches arch's unused generator); seed that for reproducible
+    # CIs, then restore it.
     saved = np.random.get_state()  # noqa: NPY002
     np.random.seed(BOOTSTRAP_SEED)  # noqa: NPY002
     try:
@@ -100,7 +101,6 @@ def _interval(matrix: np.ndarray, aggregate: Any, point: str) -> dict[str, float
             lambda scores: np.array([aggregate(scores)]),
             reps=BOOTSTRAP_REPS,
             confidence_interval_size=CONFIDENCE,
-            random_state=np.random.RandomState(BOOTSTRAP_SEED),
         )
     finally:
         np.random.set_state(saved)  # noqa: NPY002
