@@ -150,6 +150,32 @@ def test_evaluate_aggregates_a_sweep_over_its_training_seeds(local_sweep, tmp_pa
     assert "Multi-seed studies" in (out / "report.html").read_text()
 
 
+def test_optuna_searcher_with_asha_samples_the_ranges(tmp_path):
+    path = tiny_sweep(tmp_path, [0])
+    data = yaml.safe_load(path.read_text())
+    data["space"] = {
+        "ppo.learning_rate": {"loguniform": [1.0e-5, 1.0e-3]},
+        "ppo.n_epochs": {"choice": [1, 2]},
+        "ppo.gae_lambda": {"uniform": [0.9, 0.99]},
+        "ppo.batch_size": {"randint": [16, 64]},
+    }
+    data.update(num_samples=3, searcher="optuna", metric="eval_mean_reward")
+    data["scheduler"] = {"grace_period": 64, "reduction_factor": 2}
+    data["fixed"]["train.total_timesteps"] = 256
+    path.write_text(yaml.safe_dump(data))
+    result = _train("--sweep", str(path), "--output-dir", str(tmp_path), "--run-name", "o")
+    assert result.returncode == 0, result.stderr[-3000:]
+    rows = _summary(tmp_path / "o")
+    assert len(rows) == 3
+    for row in rows:
+        assert row["status"] in ("finished", "stopped early")
+        config = load_train_config(tmp_path / "o" / row["trial"] / "config.yaml")
+        assert 1e-5 <= config.ppo.learning_rate.initial <= 1e-3
+        assert config.ppo.n_epochs in (1, 2) and 0.9 <= config.ppo.gae_lambda <= 0.99
+        assert 16 <= config.ppo.batch_size < 64
+        assert f"ppo.batch_size={config.ppo.batch_size}" in row["overrides"]
+
+
 def test_study_interval_is_the_rliable_stratified_bootstrap():
     from rliable import metrics
 
@@ -159,13 +185,16 @@ def test_study_interval_is_the_rliable_stratified_bootstrap():
     assert _interval(ones, metrics.aggregate_mean, "mean") == {
         "mean": 1.0, "ci_low": 1.0, "ci_high": 1.0,
     }  # fmt: skip
-    scores = np.array([[0.0, 1.0, 1.0], [1.0, 1.0, 1.0], [0.0, 0.0, 1.0]])
-    a = _interval(scores, metrics.aggregate_mean, "mean")
-    assert a == _interval(scores, metrics.aggregate_mean, "mean")  # reproducible
-    assert a["mean"] == pytest.approx(6 / 9)
-    assert 0.0 <= a["ci_low"] < a["mean"] < a["ci_high"] <= 1.0
-    # The last episode succeeds for every seed: resampling seeds within strata cannot drop it.
-    assert a["ci_low"] >= 1 / 3
+    per_seed = np.array([[0.0], [0.6], [1.0], [0.8], [0.6]])  # success rates of 5 seeds
+    a = _interval(per_seed, metrics.aggregate_mean, "mean")
+    assert a == _interval(per_seed, metrics.aggregate_mean, "mean")  # reproducible
+    assert a["mean"] == pytest.approx(0.6)
+    # The percentile bootstrap's CI: quantiles of the means of all 5^5 equally likely resamples.
+    resamples = np.array(np.meshgrid(*[per_seed[:, 0]] * 5)).reshape(5, -1).mean(axis=0)
+    low, high = np.percentile(resamples, [2.5, 97.5])
+    assert a["ci_low"] == pytest.approx(low, abs=0.02)
+    assert a["ci_high"] == pytest.approx(high, abs=0.02)
+    assert a["ci_low"] < 0.6 < a["ci_high"]
 
 
 def test_sweep_flags_are_checked(tmp_path):
@@ -208,7 +237,7 @@ def test_sigint_stops_every_trial_within_30_s_and_resume_finishes(tmp_path):
     assert stopped < 30
     assert len(trial_pids) == 2 and all(is_gone(pid) for pid in trial_pids)
     rows = _summary(sweep_dir)
-    assert rows and all(r["status"] == "incomplete" for r in rows)
+    assert rows and all(r["status"] == "interrupted" for r in rows)
 
     result = _train("--resume", str(sweep_dir), timeout=300)
     assert result.returncode == 0, result.stderr[-3000:]

@@ -2,15 +2,17 @@
 
 ``python evaluate.py --policies ppo:<sweep dir>`` evaluates every trial's model (best/ > final/ >
 latest checkpoint, as for a run directory) on the suite's episode seeds, then reports the policy
-over its training seeds. Evaluation episode ``k`` uses the same seed (terrain, start) for every
-trial, so the scores form a matrix of training seeds (runs) x evaluation episodes (tasks, in
-rliable's terms), and the confidence intervals come from rliable's stratified bootstrap: the
-training seeds are resampled independently for every evaluation episode.
+over its training seeds. Each training seed is one independent sample of the training procedure,
+so it is the unit of the statistics: per env, every seed scores its success rate and its mean
+return over the (identical) evaluation episodes, and the confidence intervals come from rliable's
+stratified bootstrap over these per-seed scores (a score matrix of seeds x 1 task; the
+episodes of one model are not independent samples, so they are averaged, not resampled).
 
 Reported per study and env: per-seed success rates and mean returns, the mean success rate with
-its 95 % stratified-bootstrap CI, and the interquartile mean (IQM) of the episode returns with
-its CI. Written as a "Multi-seed studies" section appended to report.md/report.html and as
-``study.json``.
+its 95 % stratified-bootstrap CI, and the interquartile mean (IQM) of the per-seed mean returns
+with its CI (the IQM drops the lowest and highest quarter of the seeds; with fewer than 4 seeds
+it drops none and equals the mean). Written as a "Multi-seed studies" section appended to
+report.md/report.html and as ``study.json``.
 """
 
 from __future__ import annotations
@@ -140,9 +142,12 @@ def study_statistics(result: Any, studies: list[Study]) -> dict[str, dict[str, A
                 "seeds": seeds,
                 "mean_return": float(returns.mean()),
             }
+            # One column: the env is the only task; rows are the training seeds.
             if success is not None:
-                stats["success_rate"] = _interval(success, metrics.aggregate_mean, "mean")
-            stats["iqm_return"] = _interval(returns, metrics.aggregate_iqm, "iqm")
+                per_seed = success.mean(axis=1, keepdims=True)
+                stats["success_rate"] = _interval(per_seed, metrics.aggregate_mean, "mean")
+            per_seed_return = returns.mean(axis=1, keepdims=True)
+            stats["iqm_return"] = _interval(per_seed_return, metrics.aggregate_iqm, "iqm")
             out.setdefault(env.env_id, {})[study.name] = stats
     return out
 
@@ -154,8 +159,8 @@ def _pct(x: float) -> str:
 INTRO = (
     "Each study is one policy trained with several training seeds (a sweep directory); every "
     "seed's model ran the same evaluation episodes. CI: 95 % stratified-bootstrap confidence "
-    "interval over the training seeds (rliable), episodes as strata. IQM: interquartile mean of "
-    "the episode returns."
+    "interval over the training seeds (rliable), each seed scored by its success rate and mean "
+    "return over the episodes. IQM: interquartile mean of the seeds' mean returns."
 )
 HEADERS = ["trial", "overrides", "success rate", "mean return"]
 

@@ -38,7 +38,6 @@ import numpy as np
 
 from .artifacts import (
     CONFIG_FILE,
-    FINAL,
     command_line,
     latest_model_dir,
     prepare_new_dir,
@@ -223,7 +222,8 @@ def _tune_config(sweep: LoadedSweep, max_concurrent: int | None) -> Any:
 
         scheduler = ASHAScheduler(
             time_attr="timesteps",
-            max_t=cfg.scheduler.max_t or sweep.base_config.train.total_timesteps,
+            # Past the budget: a trial that reaches it finishes (saves final/) before ASHA acts.
+            max_t=cfg.scheduler.max_t or sweep.base_config.train.total_timesteps + 1,
             grace_period=cfg.scheduler.grace_period,
             reduction_factor=cfg.scheduler.reduction_factor,
         )
@@ -330,15 +330,21 @@ def _fit(tuner: Any, sweep: LoadedSweep, sweep_dir: Path) -> SweepResult:
     grid = tuner.fit()
     seconds = time.perf_counter() - start
     errors = [f"{r.path}: {type(r.error).__name__}: {r.error}" for r in grid if r.error]
-    rows = write_summary(sweep_dir, sweep)
+    # Tune returns normally after Ctrl-C, leaving the trials it stopped RUNNING or PENDING.
+    statuses = {trial_name(t.trial_id): t.status for t in _tune_trials(grid)}
+    rows = write_summary(sweep_dir, sweep, statuses)
     finished = sum(row["status"] == "finished" for row in rows)
-    # Tune returns normally after Ctrl-C; trials neither finished nor failed were interrupted.
-    stopped_by_scheduler = sweep.config.scheduler is not None
-    interrupted = any(row["status"] in ("running", "pending") for row in rows) or (
-        not stopped_by_scheduler and finished + len(errors) < len(grid)
-    )
+    interrupted = any(s in ("RUNNING", "PENDING", "PAUSED") for s in statuses.values())
+    num_trials = max(len(statuses), sweep.config.num_trials)
     best = next((r["trial"] for r in rows if r.get("best")), None)
-    return SweepResult(sweep_dir, len(grid), finished, errors, interrupted, seconds, best)
+    return SweepResult(sweep_dir, num_trials, finished, errors, interrupted, seconds, best)
+
+
+def _tune_trials(grid: Any) -> list[Any]:
+    """Every trial of the experiment with its status (the ResultGrid lists results only)."""
+    from ray.tune import ExperimentAnalysis
+
+    return ExperimentAnalysis(grid.experiment_path).trials
 
 
 # --- summaries ------------------------------------------------------------------------------
@@ -366,22 +372,31 @@ def _best_row(rows: list[dict], metric: str, mode: str) -> dict[str, float] | No
     return max(rows, key=key) if rows else None
 
 
-def trial_row(run_dir: Path, metric: str, mode: str) -> dict[str, Any]:
-    """One summary row of a trial, from its run directory alone."""
+TUNE_STATUS = {
+    "TERMINATED": "stopped early",  # without final/: stopped by the scheduler
+    "ERROR": "error",
+    "RUNNING": "interrupted",
+    "PENDING": "interrupted",
+    "PAUSED": "interrupted",
+}
+
+
+def trial_row(run_dir: Path, metric: str, mode: str, tune_status: str | None = None) -> dict:
+    """One summary row of a trial, from its run directory (and Tune's status of the trial)."""
     info_path = run_dir / TRIAL_FILE
     info = json.loads(info_path.read_text()) if info_path.is_file() else {}
     config = load_yaml(run_dir / CONFIG_FILE)
     budget = int(info.get("budget") or config.get("train", {}).get("total_timesteps", 0))
     latest = latest_model_dir(run_dir)
     steps = int(read_meta(latest).get("num_timesteps", 0)) if latest else 0
-    final = (run_dir / FINAL / "model.zip").is_file() and steps >= budget
+    final = steps >= budget  # final/, or a checkpoint at the budget when ASHA stopped it there
     rows = _eval_rows(run_dir)
     best = _best_row(rows, metric, mode)
     attempts = info.get("attempts") or [{}]
     last = attempts[-1]
     return {
         "trial": run_dir.name,
-        "status": "finished" if final else "incomplete",
+        "status": "finished" if final else TUNE_STATUS.get(tune_status or "", "incomplete"),
         "overrides": " ".join(info.get("overrides", [])),
         "budget": budget,
         "steps": steps,
@@ -398,11 +413,15 @@ def trial_row(run_dir: Path, metric: str, mode: str) -> dict[str, Any]:
     }
 
 
-def write_summary(sweep_dir: str | Path, sweep: LoadedSweep) -> list[dict[str, Any]]:
-    """Write summary.csv, summary.md and best_config.yaml from the trials' run directories."""
+def write_summary(
+    sweep_dir: str | Path, sweep: LoadedSweep, statuses: dict[str, str] | None = None
+) -> list[dict[str, Any]]:
+    """Write summary.csv, summary.md and best_config.yaml from the trials' run directories;
+    `statuses`: Ray Tune's status per trial name (tells early-stopped from interrupted)."""
     sweep_dir = Path(sweep_dir)
     cfg = sweep.config
-    rows = [trial_row(d, cfg.metric, cfg.mode) for d in trial_dirs(sweep_dir)]
+    statuses = statuses or {}
+    rows = [trial_row(d, cfg.metric, cfg.mode, statuses.get(d.name)) for d in trial_dirs(sweep_dir)]
     best = _best_row(
         [
             {
@@ -449,7 +468,8 @@ def summary_markdown(rows: list[dict[str, Any]], sweep: LoadedSweep) -> str:
         f"from each run's evaluation callback; scheduler: "
         f"{'ASHA' if cfg.scheduler else 'none'}; searcher: {cfg.searcher}. Best eval: the best "
         "evaluation of the run (ties broken by the mean return). Wall time: the trial's training "
-        "time summed over its attempts [s].",
+        "time summed over its attempts [s]. Status: finished, stopped early (by the scheduler), "
+        "interrupted (continue with `train.py --resume <sweep dir>`) or error.",
         "",
         f"| trial | status | overrides | budget [steps] | steps | best {cfg.metric} "
         "| at step | best eval return | wall time [s] | node id | host |",
