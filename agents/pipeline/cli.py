@@ -191,28 +191,20 @@ def evaluate_main(argv: Sequence[str] | None = None) -> int:
         if args.frames:
             overrides.append("frames=true")
         suite = load_suite(args.config or DEFAULT_SUITE, overrides)
-        suite, studies, study_warnings = _expand_studies(suite)
+        from .study import expand_studies, write_study_section
+
+        suite, studies, study_warnings = expand_studies(suite)  # ppo:<sweep dir> -> trials
         out = _prepare_report_dir(Path(suite.output_dir), args.force)
         result = run_suite(suite, progress=not args.no_progress)
         result.warnings[:0] = study_warnings
         paths = write_report(result, out)
-        if studies:
-            from .study import write_study_section
-
-            paths += write_study_section(result, studies, out)
+        paths += write_study_section(result, studies, out)  # nothing without sweep dirs
         for line in result.warnings:
             print(f"warning: {line}", file=sys.stderr)
         print("wrote " + ", ".join(str(p) for p in paths))
         return 0
 
     return _run("evaluate.py", body)
-
-
-def _expand_studies(suite):
-    """``ppo:<sweep dir>`` policies -> one policy per trial, aggregated by `study` afterwards."""
-    from .study import expand_studies
-
-    return expand_studies(suite)
 
 
 def _prepare_report_dir(path: Path, force: bool) -> Path:

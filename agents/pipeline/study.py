@@ -20,6 +20,7 @@ from __future__ import annotations
 import dataclasses
 import html
 import json
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -195,12 +196,23 @@ def study_blocks(stats: dict[str, dict[str, Any]]) -> list[tuple[str, str, list[
     return blocks
 
 
+def _markdown_table(rows: list[list[str]]) -> list[str]:
+    lines = ["| " + " | ".join(HEADERS) + " |", "|" + "---|" * len(HEADERS)]
+    return lines + ["| " + " | ".join(c.replace("|", "\\|") for c in row) + " |" for row in rows]
+
+
+def _html_table(rows: list[list[str]]) -> str:
+    head = "".join(f"<th>{html.escape(h)}</th>" for h in HEADERS)
+    body = "".join(
+        "<tr>" + "".join(f"<td>{html.escape(c)}</td>" for c in row) + "</tr>" for row in rows
+    )
+    return f"<table><thead><tr>{head}</tr></thead><tbody>{body}</tbody></table>"
+
+
 def write_study_section(result: Any, studies: list[Study], out_dir: str | Path) -> list[Path]:
     """Append the study section to report.md and report.html; write study.json."""
     if not studies:
         return []
-    from .report import Table, _inline_html
-
     out = Path(out_dir)
     stats = study_statistics(result, studies)
     (out / STUDY_FILE).write_text(json.dumps(stats, indent=1) + "\n")
@@ -208,9 +220,9 @@ def write_study_section(result: Any, studies: list[Study], out_dir: str | Path) 
     md = ["## Multi-seed studies", "", INTRO, ""]
     hx = [f"<h2>Multi-seed studies</h2><p>{html.escape(INTRO)}</p>"]
     for heading, sentence, rows in blocks:
-        table = Table(HEADERS, rows)
-        md += [f"### {heading}", "", sentence, "", table.markdown(), ""]
-        hx.append(f"<h3>{html.escape(heading)}</h3><p>{_inline_html(sentence)}</p>{table.html()}")
+        md += [f"### {heading}", "", sentence, "", *_markdown_table(rows), ""]
+        bold = re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", html.escape(sentence))
+        hx.append(f"<h3>{html.escape(heading)}</h3><p>{bold}</p>{_html_table(rows)}")
     report_md = out / "report.md"
     if report_md.is_file():
         report_md.write_text(report_md.read_text().rstrip("\n") + "\n\n" + "\n".join(md))
