@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from sweep_helpers import REPO, is_gone, loopback_cluster, tiny_sweep
+from sweep_helpers import REPO, free_port, is_gone, loopback_cluster, tiny_sweep
 
 from agents.pipeline.errors import ConfigError
 from agents.pipeline.sweep_config import load_sweep
@@ -202,6 +202,11 @@ def test_sweep_flags_are_checked(tmp_path):
     assert result.returncode == 2 and "apply to sweeps only" in result.stderr
     result = _train("--sweep", str(tmp_path / "missing.yaml"))
     assert result.returncode == 2 and "config file not found" in result.stderr
+    address = f"127.0.0.1:{free_port()}"  # nobody listens there
+    result = _train("--sweep", str(tiny_sweep(tmp_path, [0])), "--address", address,
+                    "--output-dir", str(tmp_path), "--run-name", "x")  # fmt: skip
+    assert result.returncode == 2 and f"no Ray cluster answers at {address}" in result.stderr
+    assert not (tmp_path / "x").exists()
 
 
 # --- Ctrl-C and --resume ---------------------------------------------------------------------

@@ -191,6 +191,7 @@ def _init_ray(address: str | None, max_concurrent: int | None, cpus_per_trial: f
     if ray.is_initialized():
         return
     if address is not None:
+        _check_reachable(address)
         try:
             ray.init(address=address, log_to_driver=True)
         except (ConnectionError, RuntimeError, ValueError) as exc:
@@ -199,6 +200,21 @@ def _init_ray(address: str | None, max_concurrent: int | None, cpus_per_trial: f
     cores = os.cpu_count() or 1
     wanted = (max_concurrent or cores) * cpus_per_trial
     ray.init(num_cpus=max(cores, int(np.ceil(wanted))), include_dashboard=False)
+
+
+def _check_reachable(address: str, timeout_s: float = 5.0) -> None:
+    """Fail fast on a ``host:port`` nobody listens on (Ray itself retries for minutes)."""
+    if address in ("auto", "local") or "://" in address:
+        return
+    host, sep, port = address.rpartition(":")
+    if not sep or not port.isdigit():
+        raise UserError(f"--address must be auto or host:port, got {address!r}")
+    try:
+        socket.create_connection((host, int(port)), timeout=timeout_s).close()
+    except OSError as exc:
+        raise UserError(
+            f"no Ray cluster answers at {address} ({exc}); start one with `ray start --head`"
+        ) from None
 
 
 def _tuner_parts(sweep: LoadedSweep, sweep_dir: Path, command: str) -> tuple[Any, dict]:
@@ -263,6 +279,8 @@ def run_sweep(
     from ray import tune
 
     max_concurrent = _default_concurrency(address, max_concurrent)
+    if address is not None:
+        _check_reachable(address)  # before the sweep directory exists
     stem = sweep.config.name or (sweep.path.stem if sweep.path else "sweep")
     name = name or f"{stem}__{time.strftime('%Y%m%d-%H%M%S')}"
     sweep_dir = prepare_new_dir(Path(output_dir) / name, force, "sweep directory").resolve()
