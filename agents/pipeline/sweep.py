@@ -199,7 +199,8 @@ def _init_ray(address: str | None, max_concurrent: int | None, cpus_per_trial: f
         return
     cores = os.cpu_count() or 1
     wanted = (max_concurrent or cores) * cpus_per_trial
-    ray.init(num_cpus=max(cores, int(np.ceil(wanted))), include_dashboard=False)
+    # address="local": a new instance even when `ray start` runs a cluster on this machine.
+    ray.init(address="local", num_cpus=max(cores, int(np.ceil(wanted))), include_dashboard=False)
 
 
 def _check_reachable(address: str, timeout_s: float = 5.0) -> None:
