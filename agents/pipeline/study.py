@@ -60,7 +60,7 @@ def expand_studies(suite: EvaluationSuite) -> tuple[EvaluationSuite, list[Study]
     Returns the expanded suite, the studies and warning lines (trials without a saved model).
     """
     from .artifacts import latest_model_dir, read_meta
-    from .sweep import TRIAL_FILE, trial_dirs
+    from .sweep_summary import TRIAL_FILE, trial_dirs
 
     policies: list[str] = []
     studies: list[Study] = []
