@@ -10,6 +10,7 @@ from __future__ import annotations
 import contextlib
 import os
 import secrets
+import shutil
 import signal
 import socket
 import subprocess
@@ -126,3 +127,4 @@ def loopback_cluster(nodes: int = 2, cpus_per_node: int = 1) -> Iterator[tuple[s
         yield address, env
     finally:
         stop_processes([temp_dir, f":{port}"])
+        shutil.rmtree(temp_dir, ignore_errors=True)
