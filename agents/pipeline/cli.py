@@ -58,15 +58,30 @@ def train_parser() -> argparse.ArgumentParser:
         "  python train.py --config configs/cliff_walk_ppo.yaml --set ppo.learning_rate=1e-4 "
         "--set vec_env.n_envs=2\n"
         "  python train.py --resume runs/HexapodCliffWalk-v0__ppo__0__20250101-120000 "
-        "--set train.total_timesteps=2000000",
+        "--set train.total_timesteps=2000000\n"
+        "  python train.py --sweep configs/sweep_irregular_terrain_seeds.yaml "
+        "[--address auto] [--max-concurrent 2]",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--config", type=Path, help="training config (YAML)")
     source.add_argument(
-        "--resume", type=Path, metavar="RUN_DIR", help="continue a run from its last checkpoint"
+        "--resume",
+        type=Path,
+        metavar="RUN_DIR",
+        help="continue a run (or a sweep directory) from its last checkpoint",
     )
-    _add_set_option(p, "config")
+    source.add_argument(
+        "--sweep", type=Path, metavar="SWEEP", help="run a sweep/study on Ray Tune (YAML)"
+    )
+    _add_set_option(p, "config (with --sweep: sweep file)")
+    sweep = p.add_argument_group("sweeps (--sweep, --resume <sweep dir>; pip install .[sweep])")
+    sweep.add_argument(
+        "--address", metavar="auto|HOST:PORT", help="join this Ray cluster (default: local Ray)"
+    )
+    sweep.add_argument(
+        "--max-concurrent", type=int, metavar="N", help="trials at once (default: CPU cores)"
+    )
     p.add_argument("--output-dir", type=Path, default=Path("runs"), help="parent of run dirs")
     p.add_argument("--run-name", help="run directory name (default {env}__ppo__{seed}__{time})")
     p.add_argument("--force", action="store_true", help="overwrite an existing run directory")
@@ -82,6 +97,12 @@ def train_main(argv: Sequence[str] | None = None) -> int:
         from .train_config import load_train_config
         from .training import resume_training, start_training
 
+        if args.sweep is not None or (args.resume is not None and _is_sweep_dir(args.resume)):
+            from .sweep import sweep_main
+
+            return sweep_main(args, command)
+        if args.address is not None or args.max_concurrent is not None:
+            raise UserError("--address and --max-concurrent apply to sweeps only")
         if args.resume is not None:
             if args.run_name or args.force:
                 raise UserError("--run-name and --force do not apply to --resume")
@@ -111,6 +132,12 @@ def train_main(argv: Sequence[str] | None = None) -> int:
     return _run("train.py", body)
 
 
+def _is_sweep_dir(path: Path) -> bool:
+    from .sweep_config import SWEEP_FILE
+
+    return (Path(path) / SWEEP_FILE).is_file()
+
+
 def _command(script: str, argv: Sequence[str] | None) -> str:
     from .artifacts import command_line
 
@@ -138,7 +165,8 @@ def evaluate_parser() -> argparse.ArgumentParser:
         "--policies",
         nargs="+",
         metavar="POLICY",
-        help="analytical | ppo:<model file, model dir or run dir> | zero | random",
+        help="analytical | ppo:<model file, model dir, run dir or sweep dir> | zero | random "
+        "(a sweep dir is a multi-seed study: every trial, aggregated with CIs)",
     )
     p.add_argument("--episodes", type=int, help="episodes per policy and env")
     p.add_argument("--seed", type=int, help="seed of the first episode (episode k: seed + k)")
@@ -178,9 +206,14 @@ def evaluate_main(argv: Sequence[str] | None = None) -> int:
         if args.trust_pickle:
             overrides.append("trust_pickle=true")
         suite = load_suite(args.config or DEFAULT_SUITE, overrides)
+        from .study import expand_studies, write_study_section
+
+        suite, studies, study_warnings = expand_studies(suite)  # ppo:<sweep dir> -> trials
         out = _prepare_report_dir(Path(suite.output_dir), args.force)
         result = run_suite(suite, progress=not args.no_progress)
+        result.warnings[:0] = study_warnings
         paths = write_report(result, out)
+        paths += write_study_section(result, studies, out)  # nothing without sweep dirs
         for line in result.warnings:
             print(f"warning: {line}", file=sys.stderr)
         print("wrote " + ", ".join(str(p) for p in paths))

@@ -127,11 +127,15 @@ def start_training(
     name: str | None = None,
     force: bool = False,
     command: str | None = None,
+    after_eval: Any = None,
 ) -> TrainResult:
     """Create ``output_dir/name`` (default ``{env}__ppo__{seed}__{time}``) and train PPO in it.
 
     A run that fails before its first training step removes the directory it created, so the
-    same command can simply be run again."""
+    same command can simply be run again. `after_eval`: an optional SB3 callback run after each
+    evaluation (its ``parent`` is the EvalCallback); sweeps use it to report the evaluation
+    metrics to Ray Tune.
+    """
     from stable_baselines3 import PPO
 
     spec = env_spec(config)
@@ -155,7 +159,7 @@ def start_training(
     except BaseException:
         shutil.rmtree(run_dir, ignore_errors=True)
         raise
-    return _learn(model, config, run_dir, command, eval_env, dt, specs, resumed=False)
+    return _learn(model, config, run_dir, command, eval_env, dt, specs, False, after_eval)
 
 
 def resume_training(
@@ -163,6 +167,7 @@ def resume_training(
     overrides: list[str] | tuple[str, ...] = (),
     command: str | None = None,
     trust_pickle: bool = False,
+    after_eval: Any = None,
 ) -> TrainResult:
     """Continue a run from its newest loadable checkpoint (model, statistics, timestep count).
 
@@ -212,7 +217,7 @@ def resume_training(
     with open(run_dir / COMMAND_FILE, "a") as fh:
         fh.write(command + "\n")
     print(f"resuming {run_dir} from {checkpoint.name} at {model.num_timesteps} steps")
-    return _learn(model, config, run_dir, command, eval_env, dt, specs, resumed=True)
+    return _learn(model, config, run_dir, command, eval_env, dt, specs, True, after_eval)
 
 
 def _load_checkpoint(
@@ -258,6 +263,7 @@ def _learn(
     dt: float | None,
     specs: list,
     resumed: bool,
+    after_eval: Any = None,
 ) -> TrainResult:
     import torch
     from stable_baselines3.common.callbacks import CallbackList
@@ -285,6 +291,7 @@ def _learn(
             log_path=str(run_dir),
             deterministic=config.eval.deterministic,
             callback_on_new_best=SaveBest(saver),
+            callback_after_eval=after_eval,
             warn=False,
             verbose=config.logging.verbose,
             dt=dt,
