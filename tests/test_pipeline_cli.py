@@ -183,7 +183,7 @@ def test_evaluate_smoke_writes_json_markdown_and_html_rows(run, tmp_path, capsys
     md, page = (out / "report.md").read_text(), (out / "report.html").read_text()
     for name in ("analytical", "zero", "random", ppo):
         assert f"| {name} |" in md and f"<td>{name}</td>" in page
-    assert "PPO beats the analytical controller on:" in md
+    assert f"- `{ppo}` vs the analytical controller (`analytical`): success" in md
     assert "data:image/png;base64," in page and "<img" in page
     assert metrics["envs"]["HexapodCliffWalk-v0"]["comparisons"]
 

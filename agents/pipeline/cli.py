@@ -173,6 +173,11 @@ def evaluate_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-episode-steps", type=int, help="override every env's time limit")
     p.add_argument("--output-dir", type=Path, help="report directory")
     p.add_argument("--frames", action="store_true", help="add a frame strip per policy (EGL)")
+    p.add_argument(
+        "--video",
+        action="store_true",
+        help="write an MP4 per policy and env (first seed, tracking camera) into videos/",
+    )
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     _add_trust_pickle_option(p)
     _add_set_option(p, "suite")
@@ -191,8 +196,9 @@ def evaluate_main(argv: Sequence[str] | None = None) -> int:
         # Models named on the command line must exist (the suite may say skip for shipped ones).
         overrides = ["missing_models=error"] if args.policies else []
         overrides += args.overrides
+        if args.envs:
+            overrides.append(f"envs={json.dumps(_suite_envs(args.config, args.envs))}")
         for key, value in (
-            ("envs", args.envs),
             ("policies", args.policies),
             ("episodes", args.episodes),
             ("seed", args.seed),
@@ -205,12 +211,15 @@ def evaluate_main(argv: Sequence[str] | None = None) -> int:
             overrides.append("frames=true")
         if args.trust_pickle:
             overrides.append("trust_pickle=true")
+        if args.video:
+            overrides.append("frames=true")  # the strip comes from the same rendered episode
         suite = load_suite(args.config or DEFAULT_SUITE, overrides)
         from .study import expand_studies, write_study_section
 
         suite, studies, study_warnings = expand_studies(suite)  # ppo:<sweep dir> -> trials
         out = _prepare_report_dir(Path(suite.output_dir), args.force)
-        result = run_suite(suite, progress=not args.no_progress)
+        video_dir = out / "videos" if args.video else None
+        result = run_suite(suite, progress=not args.no_progress, video_dir=video_dir)
         result.warnings[:0] = study_warnings
         paths = write_report(result, out)
         paths += write_study_section(result, studies, out)  # nothing without sweep dirs
@@ -220,6 +229,19 @@ def evaluate_main(argv: Sequence[str] | None = None) -> int:
         return 0
 
     return _run("evaluate.py", body)
+
+
+def _suite_envs(config: Path | None, ids: list[str]) -> list[dict]:
+    """`--envs` entries with the suite's kwargs and time limit for ids the suite names (so the
+    shipped agents are evaluated in the env they were trained in); other ids bare."""
+    from .configtools import load_yaml
+
+    listed = load_yaml(config or DEFAULT_SUITE).get("envs") or []
+    known = {}
+    for item in listed:
+        entry = {"id": item} if isinstance(item, str) else dict(item)
+        known[entry.get("id")] = entry
+    return [known.get(env_id, {"id": env_id}) for env_id in ids]
 
 
 def _prepare_report_dir(path: Path, force: bool) -> Path:

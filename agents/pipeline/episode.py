@@ -189,9 +189,18 @@ class EpisodeRecord:
             "duration_s": self.duration_s,
             "episode_return": self.episode_return,
             "energy_j": self.energy_j,
+            "speed_m_s": _per_second(self.distance_m, self.duration_s),
+            "mean_power_w": _per_second(self.energy_j, self.duration_s),
         }
         out.update({f"return_{k}": v for k, v in self.reward_terms.items()})
         return out
+
+
+def _per_second(total: float | None, duration_s: float | None) -> float | None:
+    """A time-integrated total divided by the episode's duration (None when either is unknown)."""
+    if total is None or not duration_s:
+        return None
+    return total / duration_s
 
 
 class EpisodeAccumulator:
@@ -206,7 +215,7 @@ class EpisodeAccumulator:
         dt: float | None,
         specs: list[MetricSpec] | tuple[MetricSpec, ...] = (),
         keep_trace: bool = False,
-        xi_f_deg: float = XI_F_DEG,
+        xi_f_deg: float | None = XI_F_DEG,
     ):
         self.dt, self.specs, self.keep_trace, self.xi = dt, list(specs), keep_trace, xi_f_deg
         self._step_specs = [s for s in self.specs if s.reduce != "episode"]
@@ -241,7 +250,7 @@ class EpisodeAccumulator:
             self.fasm_min = min(self.fasm_min, m)
             self.fasm_sum += m
             self.fasm_count += 1
-            self.below += m < self.xi
+            self.below += self.xi is not None and m < self.xi
             if self.keep_trace:
                 self.trace.append(m)
         power = info.get(POWER_KEY)
@@ -279,8 +288,10 @@ class EpisodeAccumulator:
             truncated=bool(truncated),
             fasm_min_deg=self.fasm_min if n else None,
             fasm_mean_deg=self.fasm_sum / n if n else None,
-            time_below_xi_s=self.below * self.dt if n and self.dt is not None else None,
-            fraction_below_xi=self.below / n if n else None,
+            time_below_xi_s=(
+                self.below * self.dt if n and self.dt is not None and self.xi is not None else None
+            ),
+            fraction_below_xi=self.below / n if n and self.xi is not None else None,
             distance_m=None if distance is None else float(distance),
             energy_j=self.energy if self.has_power else None,
             specifics=specifics,

@@ -38,6 +38,7 @@ class PolicyRun:
     episodes: list[EpisodeRecord] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     frames: list[np.ndarray] | None = None
+    video: Path | None = None  # MP4 of the first seed (with --video)
 
 
 @dataclass
@@ -48,6 +49,27 @@ class EnvResult:
     dt: float | None
     specs: list[MetricSpec]
     runs: dict[str, PolicyRun] = field(default_factory=dict)
+    xi_deg: float | None = None  # the robot's FASM threshold ξ; None: FASM is not its criterion
+    criterion: str = ""  # the robot's stability criterion, in words
+
+    def label(self, name: str) -> str:
+        """The policy name with ``{env_id}`` expanded (what a reader of this env sees)."""
+        return name.replace("{env_id}", self.env_id)
+
+
+def stability_threshold(env: gym.Env, default_deg: float) -> tuple[float | None, str]:
+    """(ξ [deg] or None, criterion in words) as the env declares them (``tipping_threshold_deg``,
+    ``stability_criterion``); envs that declare nothing get the suite's `default_deg`."""
+    unwrapped = env.unwrapped
+    criterion = getattr(unwrapped, "stability_criterion", None)
+    if hasattr(unwrapped, "tipping_threshold_deg"):
+        xi = unwrapped.tipping_threshold_deg
+        xi = None if xi is None else float(xi)
+    else:
+        xi = float(default_deg)
+    if criterion is None:
+        criterion = f"FASM >= {xi:g} deg" if xi is not None else "(not declared by the env)"
+    return xi, str(criterion)
 
 
 @dataclass
@@ -202,6 +224,7 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, gym.Env, dict
             dt=env_time_step(env),
             specs=metric_specs(env),
         )
+        result.xi_deg, result.criterion = stability_threshold(env, suite.xi_f_deg)
         policies = {}
         for name in suite.policies:
             missing = _missing_reason(name, suite_env.id)
@@ -220,52 +243,70 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, gym.Env, dict
     return prepared, warnings
 
 
-def run_suite(suite: EvaluationSuite, progress: bool = True) -> SuiteResult:
+def run_suite(
+    suite: EvaluationSuite, progress: bool = True, video_dir: Path | None = None
+) -> SuiteResult:
+    """Run every policy on every env; `video_dir`: write an MP4 per policy and env there."""
     from tqdm.auto import tqdm
 
     start = time.perf_counter()
     prepared, warnings = prepare(suite)
-    total = sum(len(policies) for _, _, policies in prepared) * suite.episodes
-    bar = tqdm(total=total, disable=not progress, unit="episode", dynamic_ncols=True)
-    try:
-        for result, env, policies in prepared:
-            for name, policy in policies.items():
-                bar.set_description(f"{result.env_id} {name}")
-                run = result.runs[name]
+    for result, env, policies in prepared:
+        for name, policy in policies.items():
+            run = result.runs[name]
+            # one bar (with its ETA) per env x policy; it stays on screen when done
+            with tqdm(
+                total=suite.episodes,
+                desc=f"{result.env_id} {result.label(name)}",
+                unit="episode",
+                disable=not progress,
+                dynamic_ncols=True,
+            ) as bar:
                 for k, seed in enumerate(suite.seeds):
                     acc = EpisodeAccumulator(
-                        result.dt, result.specs, keep_trace=k == 0, xi_f_deg=suite.xi_f_deg
+                        result.dt, result.specs, keep_trace=k == 0, xi_f_deg=result.xi_deg
                     )
                     run.episodes.append(run_episode(env, policy, seed, acc))
                     bar.update(1)
-            env.close()
-            if suite.frames:
-                warnings.extend(_render_frames(suite, result, policies))
-    finally:
-        bar.close()
+        env.close()
+        if suite.frames or video_dir is not None:
+            warnings.extend(_render(suite, result, policies, video_dir))
     return SuiteResult(suite, [r for r, _, _ in prepared], warnings, time.perf_counter() - start)
 
 
-def _render_frames(suite: EvaluationSuite, result: EnvResult, policies: dict) -> list[str]:
-    """Re-run the first seed of each policy with rendering; keep `frame_count` frames."""
+CAMERA = "track"
+"""Every robot model has a camera of this name that tracks the body and keeps it in frame."""
+
+
+def _render(suite: EvaluationSuite, result: EnvResult, policies: dict, video_dir: Path | None):
+    """Re-run the first seed of each policy with rendering: keep `frame_count` frames for the
+    strip and, with `video_dir`, write every `video_stride`-th frame to an MP4."""
     width, height = suite.frame_size
     suite_env = next(e for e in suite.envs if e.id == result.env_id)
+    render_kwargs = {"render_mode": "rgb_array", "width": width, "height": height}
     try:
-        sized = _env_spec(suite, suite_env, render_mode="rgb_array", width=width, height=height)
-        env = sized.make()
-    except UserError:  # envs without width/height keywords
+        env = _env_spec(suite, suite_env, **render_kwargs, camera_name=CAMERA).make()
+    except UserError:  # envs of other packages: no size or camera keywords
         env = _env_spec(suite, suite_env, render_mode="rgb_array").make()
     warnings = []
+    slug = result.env_id.replace("/", "_")
     try:
         for name, policy in policies.items():
             run = result.runs[name]
             length = run.episodes[0].length
             wanted = set(np.linspace(0, length, suite.frame_count).round().astype(int).tolist())
             frames: list[np.ndarray] = []
+            movie: list[np.ndarray] = []
 
-            def grab(step: int, wanted=wanted, frames=frames) -> None:
-                if step in wanted:
-                    frames.append(np.asarray(env.render()))
+            def grab(step: int, wanted=wanted, frames=frames, movie=movie) -> None:
+                keep_frame = suite.frames and step in wanted
+                keep_movie = video_dir is not None and step % suite.video_stride == 0
+                if keep_frame or keep_movie:
+                    image = np.asarray(env.render())
+                    if keep_frame:
+                        frames.append(image)
+                    if keep_movie:
+                        movie.append(image)
 
             acc = EpisodeAccumulator(result.dt, result.specs)
             try:
@@ -273,7 +314,23 @@ def _render_frames(suite: EvaluationSuite, result: EnvResult, policies: dict) ->
             except Exception as exc:  # rendering back ends fail in many ways (no EGL, ...)
                 warnings.append(f"{result.env_id} {name}: no frames ({type(exc).__name__}: {exc})")
                 return warnings
-            run.frames = frames
+            if suite.frames:
+                run.frames = frames
+            if video_dir is not None and movie:
+                safe = "".join(c if c.isalnum() else "_" for c in name)
+                run.video = video_dir / f"{slug}_{safe}.mp4"
+                fps = (1.0 / result.dt if result.dt else 50.0) / suite.video_stride
+                _write_mp4(run.video, movie, fps)
     finally:
         env.close()
     return warnings
+
+
+def _write_mp4(path: Path, frames: list[np.ndarray], fps: float) -> None:
+    """H.264 MP4 through imageio's ffmpeg plugin (the ffmpeg binary ships in imageio-ffmpeg)."""
+    import imageio.v2 as imageio
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with imageio.get_writer(path, fps=fps, codec="libx264", quality=7, macro_block_size=8) as w:
+        for frame in frames:
+            w.append_data(frame)

@@ -16,7 +16,7 @@ from .evaluation import EnvResult, SuiteResult  # noqa: E402
 BOX_METRICS = (
     ("fasm_min_deg", "min FASM [deg]"),
     ("fasm_mean_deg", "mean FASM [deg]"),
-    ("time_below_xi_s", "time below ξ_f [s]"),
+    ("fraction_below_xi", "share of time below ξ"),
     ("distance_m", "distance [m]"),
 )
 
@@ -28,9 +28,12 @@ def _png(fig) -> bytes:
     return buf.getvalue()
 
 
-def fasm_over_time(result: EnvResult, xi_f_deg: float, seed: int) -> bytes | None:
-    """FASM over time of every policy on the first seed (same terrain and start)."""
-    traces = {n: r.episodes[0].fasm_trace_deg for n, r in result.runs.items() if r.episodes}
+def fasm_over_time(result: EnvResult, xi_deg: float | None, seed: int) -> bytes | None:
+    """FASM over time of every policy on the first seed (same terrain and start), with the
+    robot's threshold ξ drawn when it has one."""
+    traces = {
+        result.label(n): r.episodes[0].fasm_trace_deg for n, r in result.runs.items() if r.episodes
+    }
     traces = {n: t for n, t in traces.items() if t}
     if not traces:
         return None
@@ -39,11 +42,13 @@ def fasm_over_time(result: EnvResult, xi_f_deg: float, seed: int) -> bytes | Non
     for name, trace in traces.items():
         t = (np.arange(len(trace)) + 1) * dt
         ax.plot(t, trace, lw=1.0, label=name)
-    ax.axhline(xi_f_deg, color="k", ls="--", lw=0.8, label=f"ξ_f = {xi_f_deg:g}°")
+    if xi_deg is not None:
+        ax.axhline(xi_deg, color="k", ls="--", lw=1.0, label=f"ξ = {xi_deg:g}°")
+    ax.axhline(0.0, color="0.5", lw=0.6)
     ax.set_xlabel("time [s]" if result.dt else "step")
     ax.set_ylabel("FASM [deg]")
     ax.set_title(f"{result.env_id}: FASM over time, seed {seed}")
-    ax.legend(fontsize=7, loc="best")
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     ax.grid(alpha=0.3)
     return _png(fig)
 
@@ -68,7 +73,7 @@ def metric_boxes(result: EnvResult) -> bytes | None:
     panels = []
     for key, title in BOX_METRICS:
         data = {
-            n: [v for e in r.episodes if (v := e.scalar_metrics()[key]) is not None]
+            result.label(n): [v for e in r.episodes if (v := e.scalar_metrics()[key]) is not None]
             for n, r in result.runs.items()
         }
         if any(data.values()):
@@ -90,7 +95,7 @@ def specific_boxes(result: EnvResult) -> bytes | None:
                     values.extend(x for x in v if isinstance(x, int | float))
                 elif isinstance(v, int | float) and not isinstance(v, bool):
                     values.append(float(v))
-            data[policy] = values
+            data[result.label(policy)] = values
         if any(data.values()):
             panels.append((data, name))
     return _panels(panels, f"{result.env_id}: env-specific metrics")
@@ -112,26 +117,40 @@ def _panels(panels: Sequence[tuple[dict, str]], title: str) -> bytes | None:
 
 
 def success_bars(result: SuiteResult) -> bytes | None:
-    """Success rate of every policy on every env (grouped bars)."""
+    """Success and tip-over rates per policy, one panel per env (horizontal bars, every rate
+    written beside its bar so that 0 % is visible)."""
     envs = [r for r in result.envs if r.runs]
-    policies = list(dict.fromkeys(n for r in envs for n in r.runs))
-    if not envs or not policies:
+    if not envs:
         return None
-    fig, ax = plt.subplots(figsize=(max(5.0, 1.8 * len(envs)), 3.2))
-    width = 0.8 / len(policies)
-    x = np.arange(len(envs))
-    for i, name in enumerate(policies):
-        rates = []
-        for r in envs:
-            run = r.runs.get(name)
-            flags = [e.success for e in run.episodes if e.success is not None] if run else []
-            rates.append(np.mean(flags) if flags else np.nan)
-        ax.bar(x + (i - (len(policies) - 1) / 2) * width, rates, width, label=_short(name, 30))
-    ax.set_xticks(x, [r.env_id for r in envs], fontsize=8)
-    ax.set_ylim(0, 1.05)
-    ax.set_ylabel("success rate")
-    ax.legend(fontsize=7)
-    ax.grid(alpha=0.3, axis="y")
+    rows = max(len(r.runs) for r in envs)
+    fig, axes = plt.subplots(
+        1, len(envs), figsize=(3.6 * len(envs), 0.55 * rows + 1.4), squeeze=False, sharex=True
+    )
+    for ax, r in zip(axes[0], envs, strict=True):
+        names = list(r.runs)
+        y = np.arange(len(names))
+        for offset, key, color, label in (
+            (-0.2, "success", "tab:green", "success"),
+            (0.2, "tipped_over", "tab:red", "tip-over"),
+        ):
+            rates = []
+            for name in names:
+                flags = [getattr(e, key) for e in r.runs[name].episodes]
+                flags = [f for f in flags if f is not None]
+                rates.append(float(np.mean(flags)) if flags else np.nan)
+            ax.barh(y + offset, rates, 0.38, color=color, label=label)
+            for yi, v in zip(y + offset, rates, strict=True):
+                text = "n/a" if np.isnan(v) else f"{100 * v:.0f} %"
+                ax.text(0.01 if np.isnan(v) else v + 0.02, yi, text, va="center", fontsize=7)
+        ax.set_yticks(y, [_short(r.label(n), 34) for n in names], fontsize=7)
+        ax.invert_yaxis()
+        ax.set_xlim(0, 1.25)
+        ax.set_xticks([0, 0.5, 1.0], ["0", "50 %", "100 %"], fontsize=7)
+        ax.set_title(r.env_id, fontsize=8)
+        ax.grid(alpha=0.3, axis="x")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=2, fontsize=8, frameon=False)
+    fig.tight_layout(rect=(0, 0.08, 1, 1))
     return _png(fig)
 
 

@@ -1,7 +1,9 @@
-"""Write an evaluation's ``metrics.json``, ``report.md`` (+ ``figures/*.png``) and a
-self-contained ``report.html`` (figures embedded as base64 PNG).
+"""Write an evaluation's ``metrics.json``, ``report.md`` (+ ``figures/*.png``, videos) and a
+self-contained ``report.html`` (figures embedded as base64 PNG; videos linked beside it).
 
-The PPO-vs-analytical statements are computed from the aggregates (`summary.compare`).
+Each env section opens with a **Verdict:** computed from the metrics, then the table and the
+like-with-like comparison bullets (`summary.compare`) against the analytical controller and the
+reference motion. Policy names are shown with ``{env_id}`` expanded.
 """
 
 from __future__ import annotations
@@ -149,37 +151,174 @@ def specifics_table(result: EnvResult, aggs: dict[str, dict]) -> Table | None:
 
 
 # --- verdicts -------------------------------------------------------------------------------
+REFERENCES = ("analytical", "zero")
+"""Every policy is compared with the analytical controller and with the reference motion."""
+
+REFERENCE_WORDS = {"analytical": "the analytical controller", "zero": "the reference motion"}
+
+
+def _count(a: dict, key: str) -> tuple[int, int] | None:
+    s = a.get(key)
+    if not s:
+        return None
+    return round(s["mean"] * s["n"]), s["n"]
+
+
+def _fraction(c: tuple[int, int] | None) -> str:
+    return "n/a" if c is None else f"{c[0]}/{c[1]}"
+
+
+def verdict_paragraph(result: EnvResult, aggs: dict[str, dict]) -> str:
+    """One paragraph from the metrics: who succeeds most, and at what stability cost.
+
+    Ranking: success rate, then fewer tip-overs, then the higher median per-episode minimum
+    FASM (the stability cost)."""
+    if not aggs:
+        return f"**Verdict:** no policy ran on {result.env_id}."
+
+    def rank(name: str) -> tuple[float, float, float]:
+        a = aggs[name]
+        success = a["success"]["mean"] if a.get("success") else -1.0
+        tips = a["tipped_over"]["mean"] if a.get("tipped_over") else 1.0
+        return (-success, tips, -_median_min_fasm(a))
+
+    ranked = sorted(aggs, key=rank)
+    leaders = [n for n in ranked if rank(n)[:2] == rank(ranked[0])[:2]]
+    best = aggs[leaders[0]]
+    outcome = (
+        f"{_fraction(_count(best, 'success'))} successes, "
+        f"{_fraction(_count(best, 'tipped_over'))} tip-overs"
+    )
+    names = ", ".join(f"`{n}`" for n in leaders)
+    if not best.get("success") or best["success"]["mean"] == 0:
+        head = f"no policy succeeds; the fewest tip-overs: {names} ({outcome})."
+    elif len(leaders) == len(aggs) and len(aggs) > 1:
+        head = f"every policy succeeds equally often ({outcome} each)."
+    else:
+        verb = "succeed" if len(leaders) > 1 else "succeeds"
+        head = f"{names} {verb} most often ({outcome})."
+    parts = [f"**Verdict:** {head}"]
+    with_fasm = [n for n in leaders if math.isfinite(_median_min_fasm(aggs[n]))]
+    if len(with_fasm) > 1:
+        most, least = with_fasm[0], with_fasm[-1]
+        parts.append(
+            f"Among them the stability cost differs: median minimum FASM "
+            f"{_num(_median_min_fasm(aggs[most]))}° for `{most}` down to "
+            f"{_num(_median_min_fasm(aggs[least]))}° for `{least}`."
+        )
+    elif with_fasm:
+        parts.append(f"Median minimum FASM {_num(_median_min_fasm(best))}°.")
+    others = [
+        f"`{n}` {_fraction(_count(aggs[n], 'success'))} successes, "
+        f"{_fraction(_count(aggs[n], 'tipped_over'))} tip-overs"
+        for n in ranked
+        if n not in leaders
+    ]
+    if others:
+        parts.append("Then: " + "; ".join(others) + ".")
+    return " ".join(parts)
+
+
+def _median_min_fasm(a: dict) -> float:
+    s = a.get("fasm_min_deg")
+    return s["median"] if s else -math.inf
+
+
 def verdict_lines(result: EnvResult, aggs: dict[str, dict]) -> tuple[list[str], list[Verdict]]:
-    """Plain sentences: where each PPO policy beats / loses to the analytical controller."""
-    ppo = [n for n in aggs if n.startswith(PPO_PREFIX)]
-    if "analytical" not in aggs or not ppo:
-        missing = "an analytical controller" if "analytical" not in aggs else "a PPO policy"
-        line = f"No PPO-vs-analytical comparison on {result.env_id}: no results for {missing}."
-        return [line], []
-    lines, all_verdicts = [], []
-    for name in ppo:
-        verdicts = compare(name, "analytical", aggs, result.specs)
-        all_verdicts += verdicts
+    """Bullets comparing every policy with the analytical controller and the reference motion.
 
-        def fmt(vs: list[Verdict]) -> str:
-            return (
-                "; ".join(
-                    f"{v.label} ({_num(v.challenger_value)} vs {_num(v.baseline_value)}"
-                    f"{', within spread' if v.within_spread else ''})"
-                    for v in vs
-                )
-                or "nothing"
-            )
-
-        better = [v for v in verdicts if v.outcome == "better"]
-        worse = [v for v in verdicts if v.outcome == "worse"]
-        tie = [v for v in verdicts if v.outcome == "tie"]
-        lines.append(f"**{name}** vs **analytical** on {result.env_id} (PPO value vs analytical):")
-        lines.append(f"- PPO beats the analytical controller on: {fmt(better)}.")
-        lines.append(f"- PPO loses to the analytical controller on: {fmt(worse)}.")
-        if tie:
-            lines.append(f"- Equal on: {fmt(tie)}.")
+    Rates are per episode and time-integrated metrics per second of episode (see `summary`);
+    a policy that tips over more often than its reference is said to, first."""
+    lines: list[str] = []
+    all_verdicts: list[Verdict] = []
+    for reference in REFERENCES:
+        if reference not in aggs:
+            continue
+        for name in aggs:
+            if name == reference or (reference == "zero" and name == "analytical"):
+                continue  # analytical vs zero is already said (as zero vs analytical)
+            verdicts = compare(name, reference, aggs, result.specs)
+            all_verdicts += verdicts
+            lines.append(_bullet(name, reference, aggs, verdicts))
+    if not lines:
+        lines.append(
+            f"- No comparison on {result.env_id}: neither the analytical controller nor the "
+            "reference motion (`zero`) ran here."
+        )
     return lines, all_verdicts
+
+
+def _bullet(name: str, reference: str, aggs: dict[str, dict], verdicts: list[Verdict]) -> str:
+    def fmt(vs: list[Verdict]) -> str:
+        return "; ".join(
+            f"{v.label} {_num(v.challenger_value)} vs {_num(v.baseline_value)}"
+            + (" (within spread)" if v.within_spread else "")
+            for v in vs
+        )
+
+    rates = [v for v in verdicts if v.metric in ("success", "tipped_over")]
+    rest = [v for v in verdicts if v not in rates]
+    better = [v for v in rest if v.outcome == "better"]
+    worse = [v for v in rest if v.outcome == "worse"]
+    a, b = aggs[name], aggs[reference]
+    text = (
+        f"- `{name}` vs {REFERENCE_WORDS[reference]} (`{reference}`): success "
+        f"{_fraction(_count(a, 'success'))} vs {_fraction(_count(b, 'success'))}, tip-overs "
+        f"{_fraction(_count(a, 'tipped_over'))} vs {_fraction(_count(b, 'tipped_over'))}."
+    )
+    if a["tip_overs"] > b["tip_overs"]:
+        text += " It tips over more often, so its episodes are shorter; the figures below are"
+        text += " per second of episode."
+    if better:
+        text += f" Better on {fmt(better)}."
+    if worse:
+        text += f" Worse on {fmt(worse)}."
+    if not better and not worse:
+        text += " Equal on every other compared metric."
+    return text
+
+
+HOW_TO_READ = [
+    "- **FASM** (force-angle stability measure, Papadopoulos & Rey): the smallest angle between "
+    "the net force on the centre of mass and the tipping axes of the support polygon [deg]. "
+    "Large is stable; it falls as the robot leans towards a tipping edge.",
+    "- **0** means fewer than three feet are loaded (no support polygon, e.g. during a tripod "
+    "switch or in the air) or the force points at a tipping edge; **negative** values mean the "
+    "net force points outside the polygon: the robot is rotating about an edge. A short negative "
+    "spike while a foot lands is not a tip-over; a tip-over is the body tilting past the env's "
+    "tip-over angle, counted in the tip-over column.",
+    "- **ξ** is the robot's FASM threshold (below it the robot is judged to be tipping); it "
+    "differs per robot and is listed per env below. Where the paper judges a robot by another "
+    "criterion (the 3-UPU robot: the static margin), no ξ applies and the FASM is shown for "
+    "comparison only.",
+    "- **Success** is the env's `is_success` at the episode's end: the cliff walk and the "
+    "Stewart tilt: no tip-over to the time limit; the irregular terrain: no tip-over and no torso "
+    "contact; the ditch crossing: across the ditch with the static margin above 0.",
+    "- **Comparisons** use rates per episode and, for time-integrated quantities (time below ξ, "
+    "distance, energy), values per second of episode (share of time below ξ, speed, mean "
+    "power), so a policy whose episodes end early cannot look better on a total. Every policy is "
+    "compared with the analytical controller (`analytical`) and with the env's reference motion "
+    "(`zero`: the zero action, the paper's gait without feedback).",
+]
+
+
+def policy_kind(name: str) -> str:
+    if name == "analytical":
+        return "analytical controllers"
+    if name == "zero":
+        return "reference motion"
+    if name == "random":
+        return "random actions"
+    path = name[len(PPO_PREFIX) :]
+    if path.startswith("models/{env_id}"):
+        rest = path[len("models/{env_id}") :].strip("/")
+        return f"shipped PPO ({rest})" if rest else "shipped PPO"
+    return f"PPO {path}"
+
+
+def report_title(suite: Any) -> str:
+    kinds = list(dict.fromkeys(policy_kind(n) for n in suite.policies))
+    return f"{suite.title}: " + " vs ".join(kinds)
 
 
 # --- assembling -----------------------------------------------------------------------------
@@ -198,11 +337,14 @@ def build_metrics(result: SuiteResult) -> dict[str, Any]:
         _, verdicts = verdict_lines(r, aggs)
         envs[r.env_id] = {
             "kwargs": r.kwargs,
+            "xi_deg": r.xi_deg,
+            "stability_criterion": r.criterion,
             "max_episode_steps": r.max_episode_steps,
             "dt_s": r.dt,
             "metric_specs": [s.__dict__ for s in r.specs],
             "policies": {
                 n: {
+                    "label": r.label(n),
                     "source": run.source,
                     "notes": run.notes,
                     "aggregate": aggs[n],
@@ -216,7 +358,7 @@ def build_metrics(result: SuiteResult) -> dict[str, Any]:
             "comparisons": [v.to_json() for v in verdicts],
         }
     return {
-        "title": suite.title,
+        "title": report_title(suite),
         "created": time.strftime("%Y-%m-%dT%H:%M:%S"),
         "seconds": result.seconds,
         "seeds": suite.seeds,
@@ -264,12 +406,19 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
         json.dumps(_clean(metrics), indent=1, default=_json_default) + "\n"
     )
 
-    md: list[str] = [f"# {suite.title}", ""]
-    hx: list[str] = [f"<h1>{html.escape(suite.title)}</h1>"]
+    title = report_title(suite)
+    md: list[str] = [f"# {title}", ""]
+    hx: list[str] = [f"<h1>{html.escape(title)}</h1>"]
 
     def para(text: str) -> None:
         md.extend([text, ""])
         hx.append(f"<p>{_inline_html(text)}</p>")
+
+    def bullets(lines: list[str]) -> None:
+        md.extend(lines + [""])
+        hx.append(
+            "<ul>" + "".join(f"<li>{_inline_html(x.lstrip('- '))}</li>" for x in lines) + "</ul>"
+        )
 
     def heading(text: str, level: int) -> None:
         md.extend(["#" * level + " " + text, ""])
@@ -291,13 +440,32 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
             f"<figcaption>{html.escape(caption)}</figcaption></figure>"
         )
 
+    def video(path: Path, caption: str) -> None:
+        rel = path.relative_to(out).as_posix()
+        md.extend([f"[{caption}]({rel})", ""])
+        hx.append(
+            f'<figure><video controls muted loop width="480" src="{html.escape(rel)}"></video>'
+            f"<figcaption>{html.escape(caption)}</figcaption></figure>"
+        )
+
+    shown = []
+    for p in suite.policies:  # a per-env template is listed expanded for every env
+        names = [e.label(p) for e in result.envs] if "{env_id}" in p else [p]
+        shown.append(", ".join(f"`{n}`" for n in dict.fromkeys(names)) + f" ({policy_kind(p)})")
     para(
-        f"Policies: {', '.join(f'`{p}`' for p in suite.policies)}. Envs: "
+        f"Policies: {'; '.join(shown)}. Envs: "
         f"{', '.join(f'`{e.id}`' for e in suite.envs)}. {suite.episodes} episode(s) per policy "
         f"and env on seeds {suite.seeds} (identical seeds, terrain and start for every policy). "
-        f"ξ_f = {suite.xi_f_deg:g}°. Cells: mean ± std over episodes; the spread table gives "
-        f"median [min, max]. Run time {result.seconds:.1f} s."
+        f"Cells: mean ± std over episodes; the spread table gives median [min, max]. "
+        f"Run time {result.seconds:.1f} s."
     )
+    heading("How to read this report", 2)
+    bullets(HOW_TO_READ)
+    thresholds = Table(["env", "stability criterion", "ξ [deg]"])
+    for r in result.envs:
+        xi = "none (FASM for comparison)" if r.xi_deg is None else f"{r.xi_deg:g}"
+        thresholds.rows.append([r.env_id, r.criterion, xi])
+    table(thresholds)
     if result.warnings:
         heading("Warnings", 2)
         md.extend([f"- **warning:** {w}" for w in result.warnings] + [""])
@@ -307,30 +475,35 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
             + "</ul></div>"
         )
 
-    heading("PPO vs analytical", 2)
+    heading("Verdicts", 2)
     for r in result.envs:
-        aggs = {n: aggregate(run.episodes) for n, run in r.runs.items()}
-        lines, _ = verdict_lines(r, aggs)
-        md.extend(lines + [""])
-        hx.append(
-            "<ul>" + "".join(f"<li>{_inline_html(x.lstrip('- '))}</li>" for x in lines) + "</ul>"
-        )
-    figure("success_rates.png", figures.success_bars(result), "Success rate per env and policy")
+        aggs = {r.label(n): aggregate(run.episodes) for n, run in r.runs.items()}
+        para(f"{r.env_id}: " + verdict_paragraph(r, aggs))
+    figure(
+        "success_rates.png",
+        figures.success_bars(result),
+        "Success and tip-over rate per env and policy (share of episodes)",
+    )
 
     for r in result.envs:
         slug = r.env_id.replace("/", "_")
         heading(r.env_id, 2)
+        aggs = {r.label(n): aggregate(run.episodes) for n, run in r.runs.items()}
+        para(verdict_paragraph(r, aggs))
         limit = r.max_episode_steps
-        sources = "; ".join(f"`{n}`: {run.source}" for n, run in r.runs.items())
+        sources = "; ".join(f"`{r.label(n)}`: {run.source}" for n, run in r.runs.items())
+        xi = "no ξ" if r.xi_deg is None else f"ξ = {r.xi_deg:g}°"
         para(
             f"Env kwargs: `{r.kwargs or {}}`; time limit {limit} steps"
             + (f" × {r.dt:g} s" if r.dt else "")
+            + f"; stability criterion: {r.criterion} ({xi})"
             + (f". Sources: {sources}." if sources else ". No policy ran on this env.")
         )
         if not r.runs:
             continue
-        aggs = {n: aggregate(run.episodes) for n, run in r.runs.items()}
         table(main_table(aggs))
+        heading("Comparisons (like with like)", 3)
+        bullets(verdict_lines(r, aggs)[0])
         if all(a["energy_j"] is None for a in aggs.values()):
             para(f"Energy: n/a, this env reports no `{POWER_KEY}` in info.")
         heading("Spread (median [min, max])", 3)
@@ -343,7 +516,7 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
             table(spec_table)
         figure(
             f"{slug}_fasm.png",
-            figures.fasm_over_time(r, suite.xi_f_deg, suite.seeds[0]),
+            figures.fasm_over_time(r, r.xi_deg, suite.seeds[0]),
             f"{r.env_id}: FASM over time on seed {suite.seeds[0]}",
         )
         figure(f"{slug}_boxes.png", figures.metric_boxes(r), f"{r.env_id}: per-episode metrics")
@@ -351,17 +524,20 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
             f"{slug}_specific.png", figures.specific_boxes(r), f"{r.env_id}: env-specific metrics"
         )
         for name, run in r.runs.items():
+            label = r.label(name)
+            safe = "".join(c if c.isalnum() else "_" for c in name)
             if run.frames:
-                safe = "".join(c if c.isalnum() else "_" for c in name)
                 figure(
                     f"{slug}_{safe}_frames.png",
                     figures.frame_strip(run.frames),
-                    f"{r.env_id}, {name}: frames over the episode on seed {suite.seeds[0]}",
+                    f"{r.env_id}, {label}: frames over the episode on seed {suite.seeds[0]}",
                 )
+            if run.video is not None:
+                video(run.video, f"{r.env_id}, {label}: video of seed {suite.seeds[0]}")
 
     (out / "report.md").write_text("\n".join(md))
     page = (
-        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(suite.title)}"
+        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}"
         f"</title><style>{CSS}</style></head><body>{''.join(hx)}</body></html>\n"
     )
     (out / "report.html").write_text(page)

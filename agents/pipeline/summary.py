@@ -1,4 +1,9 @@
-"""Aggregates over episodes (mean ± std, median, min/max) and PPO-vs-analytical verdicts."""
+"""Aggregates over episodes (mean ± std, median, min/max) and policy-vs-policy verdicts.
+
+Verdicts compare like with like: rates per episode (success, tip-over), per-episode extremes
+(min FASM), and time-integrated quantities only per second of episode (share of time below ξ,
+speed, mean power), so a policy whose episodes end early cannot look better on a total that is
+small only because its episode was short. The totals stay in the tables, with no verdict."""
 
 from __future__ import annotations
 
@@ -18,9 +23,12 @@ STANDARD_METRICS: dict[str, tuple[str, str, str | None]] = {
     "tipped_over": ("tip-over rate", "", "lower"),
     "fasm_min_deg": ("min FASM", "deg", "higher"),
     "fasm_mean_deg": ("mean FASM", "deg", "higher"),
-    "time_below_xi_s": ("time below ξ_f", "s", "lower"),
-    "distance_m": ("distance", "m", "higher"),
-    "energy_j": ("energy", "J", "lower"),
+    "time_below_xi_s": ("time below ξ", "s", None),  # a total: compared per second below
+    "fraction_below_xi": ("share of time below ξ", "", "lower"),
+    "distance_m": ("distance", "m", None),
+    "speed_m_s": ("distance per second", "m/s", "higher"),
+    "energy_j": ("energy", "J", None),
+    "mean_power_w": ("mean power", "W", "lower"),
     "episode_length": ("episode length", "steps", None),
     "episode_return": ("return", "", "higher"),
 }

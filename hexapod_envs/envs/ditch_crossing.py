@@ -145,6 +145,12 @@ class DitchCrossingEnv(HexapodEnv):
     ``schedule`` (the reference gait), ``gait_settings``, ``gait_timing``.
     """
 
+    tipping_threshold_deg = None
+    """No FASM threshold: the paper judges this robot by its static margin (observation
+    ``static_margin_m``); the FASM is observed and reported for comparison only."""
+    stability_criterion = "static margin > 0 mm (CoG projection inside the support triangle)"
+
+
     def __init__(
         self,
         *,

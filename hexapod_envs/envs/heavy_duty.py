@@ -36,6 +36,10 @@ class HeavyDutyEnv(HexapodEnv):
     walks: bool = True
     """Walking scenarios follow the reference tripod gait and observe its phase."""
 
+    tipping_threshold_deg: float = XI_F_DEG
+    """ξ_f [deg]: FASM below it means the robot is tipping (the paper's judgment threshold)."""
+    stability_criterion = "FASM >= ξ_f = 20 deg (tipping judgment threshold of the paper)"
+
     def __init__(
         self,
         *,

@@ -1,0 +1,108 @@
+"""The evaluation report: verdicts from the metrics, like-with-like comparisons, expanded labels,
+the how-to-read block, per-robot thresholds, videos."""
+
+import json
+import re
+
+import pytest
+
+from agents.pipeline.cli import evaluate_main
+from agents.pipeline.episode import EpisodeRecord
+from agents.pipeline.evaluation import EnvResult, PolicyRun
+from agents.pipeline.report import verdict_lines, verdict_paragraph
+from agents.pipeline.summary import aggregate
+
+ENVS = ["HexapodStewartTilt-v0", "HexapodDitchCrossing-v0"]
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory):
+    out = tmp_path_factory.mktemp("report") / "rep"
+    argv = ["--envs", *ENVS, "--policies", "analytical", "zero", "ppo:models/{env_id}"]
+    argv += ["--episodes", "2", "--max-episode-steps", "40", "--output-dir", str(out)]
+    assert evaluate_main([*argv, "--no-progress"]) == 0
+    return out
+
+
+def test_report_has_no_placeholder_a_verdict_per_env_and_the_reading_guide(report):
+    md = (report / "report.md").read_text()
+    page = (report / "report.html").read_text()
+    for text in (md, page):
+        assert not re.search(r"\{[a-z_]+\}", text), "unexpanded placeholder"
+        assert "How to read this report" in text
+    for env_id in ENVS:
+        section = md.split(f"## {env_id}\n", 1)[1].split("\n## ", 1)[0]
+        assert section.count("**Verdict:**") == 1
+        assert f"| ppo:models/{env_id} |" in section
+        assert "\n| zero |" in section  # the reference-motion row
+        assert "vs the reference motion (`zero`)" in section
+    assert "static margin > 0 mm" in md and "none (FASM for comparison)" in md
+    metrics = json.loads((report / "metrics.json").read_text())
+    assert metrics["envs"]["HexapodStewartTilt-v0"]["xi_deg"] == 20.0
+    assert metrics["envs"]["HexapodDitchCrossing-v0"]["xi_deg"] is None
+
+
+def _record(length, time_below, distance, tipped, dt=0.02):
+    return EpisodeRecord(
+        length=length,
+        duration_s=length * dt,
+        episode_return=float(length),
+        reward_terms={},
+        success=not tipped,
+        tipped_over=tipped,
+        terminated=tipped,
+        truncated=not tipped,
+        fasm_min_deg=5.0 if tipped else 30.0,
+        fasm_mean_deg=30.0,
+        time_below_xi_s=time_below,
+        fraction_below_xi=time_below / (length * dt),
+        distance_m=distance,
+        energy_j=None,
+    )
+
+
+def test_a_policy_that_tips_early_does_not_beat_on_shorter_totals():
+    """Early tip-over: less total time below ξ (0.1 vs 0.5 s) only because the episode is 0.2 s
+    long; per second it is worse (50 % vs 25 % of the time), and so is its speed."""
+    result = EnvResult("Env-v0", {}, 100, 0.02, [])
+    result.runs = {
+        "zero": PolicyRun("zero", "zero", [_record(100, 0.5, 1.0, False)] * 3),
+        "ppo:x": PolicyRun("ppo:x", "x", [_record(10, 0.1, 0.05, True)] * 3),
+    }
+    aggs = {n: aggregate(r.episodes) for n, r in result.runs.items()}
+    lines, verdicts = verdict_lines(result, aggs)
+    (bullet,) = lines
+    assert "tips over more often" in bullet
+    better = bullet.split("Better on", 1)[1] if "Better on" in bullet else ""
+    assert "time below" not in better and "distance" not in better
+    outcome = {v.metric: v.outcome for v in verdicts}
+    assert outcome["fraction_below_xi"] == "worse" and outcome["speed_m_s"] == "worse"
+    assert "time_below_xi_s" not in outcome and "distance_m" not in outcome
+    paragraph = verdict_paragraph(result, aggs)
+    assert paragraph.startswith("**Verdict:** `zero` succeeds most often (3/3 successes")
+
+
+def test_video_is_written_linked_and_embedded(tmp_path):
+    pytest.importorskip("imageio_ffmpeg")
+    out = tmp_path / "rep"
+    argv = ["--envs", "HexapodIrregularTerrain-v0", "--policies", "zero", "--episodes", "1"]
+    argv += ["--max-episode-steps", "20", "--output-dir", str(out), "--no-progress", "--video"]
+    assert evaluate_main(argv) == 0
+    videos = sorted((out / "videos").glob("*.mp4"))
+    assert [v.name for v in videos] == ["HexapodIrregularTerrain-v0_zero.mp4"]
+    assert videos[0].stat().st_size > 1000
+    assert "(videos/HexapodIrregularTerrain-v0_zero.mp4)" in (out / "report.md").read_text()
+    assert (
+        '<video controls muted loop width="480" src="videos/' in (out / "report.html").read_text()
+    )
+
+
+def test_envs_option_keeps_the_suite_kwargs(tmp_path):
+    out = tmp_path / "rep"
+    argv = ["--envs", "HexapodIrregularTerrain-v0", "--policies", "zero", "--episodes", "1"]
+    argv += ["--max-episode-steps", "5", "--output-dir", str(out), "--no-progress"]
+    assert evaluate_main(argv) == 0
+    metrics = json.loads((out / "metrics.json").read_text())
+    assert metrics["envs"]["HexapodIrregularTerrain-v0"]["kwargs"] == {
+        "gait_ground_search": "always"
+    }
