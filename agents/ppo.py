@@ -18,6 +18,7 @@ import numpy as np
 
 from .pipeline.artifacts import ModelFiles, find_model
 from .pipeline.errors import UserError
+from .policy import Policy
 
 # Schedules are only needed to keep training; replacing them makes loading independent of them.
 _INFERENCE_OBJECTS = {
@@ -45,7 +46,9 @@ class PPOPolicy:
     @classmethod
     def load(
         cls, path: str | Path, env: gym.Env, deterministic: bool = True, device: str = "cpu"
-    ) -> PPOPolicy:
+    ) -> Policy:
+        """The model at `path` as a policy for `env`; a hybrid run's model comes back combined
+        with `env`'s analytical controller as in training (`agents.hybrid.HybridPolicy`)."""
         from stable_baselines3 import PPO
 
         files = find_model(path)
@@ -80,7 +83,8 @@ class PPOPolicy:
                 vec_normalize = pickle.load(fh)  # VecNormalize without its venv: stats only
             vec_normalize.training = False
         train_kwargs = (config.get("env") or {}).get("kwargs") or {}
-        return cls(model, vec_normalize, files, deterministic, train_kwargs)
+        policy = cls(model, vec_normalize, files, deterministic, train_kwargs)
+        return _as_trained(policy, env, config)
 
     def reset(self) -> None:
         pass
@@ -91,3 +95,14 @@ class PPOPolicy:
             obs = self.vec_normalize.normalize_obs(obs)
         action, _ = self.model.predict(obs, deterministic=self.deterministic)
         return action
+
+
+def _as_trained(policy: PPOPolicy, env: gym.Env, config: dict[str, Any]) -> Any:
+    """The policy as its run used it: a hybrid run's ``hybrid`` config section re-creates the
+    combination with the env's analytical controller (`agents.hybrid.from_run_config`)."""
+    from .hybrid import from_run_config
+
+    try:
+        return from_run_config(policy, env, config)
+    except ValueError as exc:
+        raise UserError(f"cannot use the model at {policy.files.model}: {exc}") from None

@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
+from ..hybrid import HybridSettings
 from .configtools import apply_overrides, from_mapping, load_yaml
 from .errors import ConfigError
 from .schedules import Schedule, parse_optional_schedule, parse_schedule
@@ -171,6 +172,18 @@ class LoggingConfig:
 
 
 @dataclass
+class HybridConfig(HybridSettings):
+    """``hybrid:`` section: train the policy on top of the env's analytical controller.
+
+    The fields of `agents.hybrid.HybridSettings` (mode, scale, safety_filter, threshold_deg,
+    release_margin_deg) plus how the network starts. Absent (null): plain PPO on the env.
+    """
+
+    zero_init_action_net: bool = True
+    """Zero the action mean's last layer so that training starts from the analytical controller."""
+
+
+@dataclass
 class TrainConfig:
     env: EnvConfig
     vec_env: VecEnvConfig = field(default_factory=VecEnvConfig)
@@ -181,6 +194,7 @@ class TrainConfig:
     eval: EvalConfig = field(default_factory=EvalConfig)
     checkpoint: CheckpointConfig = field(default_factory=CheckpointConfig)
     logging: LoggingConfig = field(default_factory=LoggingConfig)
+    hybrid: HybridConfig | None = None  # None: plain PPO; see agents/hybrid.py
 
     def __post_init__(self):
         rollout = self.ppo.n_steps * self.vec_env.n_envs
