@@ -115,3 +115,13 @@ def test_training_writes_a_learning_curve(runs):
 def test_missing_learning_curve_is_a_clear_error(tmp_path):
     with pytest.raises(ValueError, match="has no evaluations.npz"):
         load_learning_curve(tmp_path)
+
+
+def test_resume_keeps_the_hybrid_and_refuses_to_change_it(tmp_path, capsys):
+    run = train(tmp_path, "resumed", "checkpoint.freq=128")
+    assert train_main(["--resume", str(run), "--set", "hybrid.scale=0.2"]) == 2
+    assert "cannot change 'hybrid' when resuming" in capsys.readouterr().err
+    assert train_main(["--resume", str(run), "--set", "train.total_timesteps=384"]) == 0
+    config = yaml.safe_load((run / "final" / "config.yaml").read_text())
+    assert config["hybrid"]["scale"] == 0.05
+    assert isinstance(PPOPolicy.load(run, gym.make("HexapodStewartTilt-v0")), HybridPolicy)
