@@ -180,7 +180,8 @@ class HybridConfig(HybridSettings):
     """
 
     zero_init_action_net: bool = True
-    """Zero the action mean's last layer so that training starts from the analytical controller."""
+    """Zero the action mean's last layer so that training starts from the analytical controller
+    (SB3's policy_kwargs have no such option: ortho_init only scales that layer by 0.01)."""
 
 
 @dataclass
