@@ -19,6 +19,7 @@ import numpy as np
 from .pipeline.artifacts import ModelFiles, find_model, read_meta
 from .pipeline.errors import UserError
 from .pipeline.model_files import NormalizationStats, load_ppo, load_stats, ppo_custom_objects
+from .policy import Policy
 
 
 class PPOPolicy:
@@ -44,9 +45,11 @@ class PPOPolicy:
         deterministic: bool = True,
         device: str = "cpu",
         trust_pickle: bool = False,
-    ) -> PPOPolicy:
-        """Load without unpickling anything (see `agents.pipeline.model_files`); pickled files
-        of older runs only with ``trust_pickle``."""
+    ) -> Policy:
+        """The model at `path` as a policy for `env`, loaded without unpickling anything (see
+        `agents.pipeline.model_files`; pickled files of older runs only with ``trust_pickle``).
+        A hybrid run's model comes back combined with `env`'s analytical controller as in
+        training (`agents.hybrid.HybridPolicy`)."""
         from .pipeline.train_config import load_train_config
 
         files = find_model(path)
@@ -73,11 +76,16 @@ class PPOPolicy:
                     f"but {env_id} (with these kwargs) has {env_space.shape}"
                 )
         policy_kwargs = load_train_config(data=config).policy.policy_kwargs()
-        objects = ppo_custom_objects(policy_kwargs, env.observation_space, env.action_space)
+        action_space = env.action_space
+        if config.get("hybrid") is not None:  # the learned action of a hybrid lies in [-1, 1]
+            shape, dtype = env.action_space.shape, env.action_space.dtype
+            action_space = gym.spaces.Box(-1.0, 1.0, shape=shape, dtype=dtype)
+        objects = ppo_custom_objects(policy_kwargs, env.observation_space, action_space)
         model = load_ppo(files.model, objects, trust_pickle, device=device)
         stats = load_stats(files.directory, trust_pickle)
         train_kwargs = (config.get("env") or {}).get("kwargs") or {}
-        return cls(model, stats, files, deterministic, train_kwargs)
+        policy = cls(model, stats, files, deterministic, train_kwargs)
+        return _as_trained(policy, env, config)
 
     def reset(self) -> None:
         pass
@@ -92,3 +100,14 @@ class PPOPolicy:
             obs = self.stats.normalize_obs(obs)
         action, _ = self.model.predict(obs, deterministic=self.deterministic)
         return action
+
+
+def _as_trained(policy: PPOPolicy, env: gym.Env, config: dict[str, Any]) -> Any:
+    """The policy as its run used it: a hybrid run's ``hybrid`` config section re-creates the
+    combination with the env's analytical controller (`agents.hybrid.from_run_config`)."""
+    from .hybrid import from_run_config
+
+    try:
+        return from_run_config(policy, env, config)
+    except ValueError as exc:
+        raise UserError(f"cannot use the model at {policy.files.model}: {exc}") from None

@@ -1,4 +1,9 @@
-"""Env ids, env creation with clear errors, and SB3 vec-env building (Monitor, VecNormalize)."""
+"""Env ids, env creation with clear errors, and SB3 vec-env building (Monitor, VecNormalize).
+
+An `EnvSpec` with a ``hybrid`` section builds the env wrapped in `agents.hybrid.HybridWrapper`
+(the learned action on top of the env's analytical controller), so training, its evaluation
+callback and every subprocess worker see the same hybrid env.
+"""
 
 from __future__ import annotations
 
@@ -61,18 +66,31 @@ class EnvSpec:
     kwargs: dict[str, Any] = field(default_factory=dict)
     max_episode_steps: int | None = None
     gym_packages: list[str] = field(default_factory=list)
+    hybrid: Any = None
+    """`agents.hybrid.HybridSettings` (or the training config's ``hybrid`` section): wrap the env
+    so that actions are combined with its analytical controller; None: the env as it is."""
 
     def make(self, **extra: Any) -> gym.Env:
-        """gym.make with the env's own errors (bad kwargs) turned into a UserError."""
+        """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
+        turned into a UserError."""
         check_env_id(self.id, self.gym_packages)
         kwargs = {**self.kwargs, **extra}
         if self.max_episode_steps is not None:
             kwargs["max_episode_steps"] = self.max_episode_steps
         try:
-            return gym.make(self.id, **kwargs)
+            env = gym.make(self.id, **kwargs)
         except (TypeError, ValueError) as exc:
             message = str(exc).split(" was raised from the environment creator")[0]
             raise UserError(f"cannot create {self.id} with {self.kwargs}: {message}") from None
+        if self.hybrid is None:
+            return env
+        from ..hybrid import wrap
+
+        try:
+            return wrap(env, self.hybrid)
+        except ValueError as exc:
+            env.close()
+            raise UserError(f"cannot build the hybrid policy env on {self.id}: {exc}") from None
 
 
 class EnvFactory:

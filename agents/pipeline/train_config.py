@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
+from ..hybrid import HybridSettings
 from .configtools import apply_overrides, from_mapping, load_yaml
 from .errors import ConfigError
 from .schedules import Schedule, parse_optional_schedule, parse_schedule
@@ -252,6 +253,19 @@ class LoggingConfig:
 
 
 @dataclass
+class HybridConfig(HybridSettings):
+    """``hybrid:`` section: train the policy on top of the env's analytical controller.
+
+    The fields of `agents.hybrid.HybridSettings` (mode, scale, safety_filter, threshold_deg,
+    release_margin_deg) plus how the network starts. Absent (null): plain PPO on the env.
+    """
+
+    zero_init_action_net: bool = True
+    """Zero the action mean's last layer so that training starts from the analytical controller
+    (SB3's policy_kwargs have no such option: ortho_init only scales that layer by 0.01)."""
+
+
+@dataclass
 class TrainConfig:
     env: EnvConfig
     vec_env: VecEnvConfig = field(default_factory=VecEnvConfig)
@@ -262,6 +276,7 @@ class TrainConfig:
     eval: EvalConfig = field(default_factory=EvalConfig)
     checkpoint: CheckpointConfig = field(default_factory=CheckpointConfig)
     logging: LoggingConfig = field(default_factory=LoggingConfig)
+    hybrid: HybridConfig | None = None  # None: plain PPO; see agents/hybrid.py
 
     def __post_init__(self):
         rollout = self.ppo.n_steps * self.vec_env.n_envs

@@ -46,7 +46,7 @@ from .train_config import TrainConfig, load_train_config
 EVAL_SEED_OFFSET = 10_000
 """Evaluation envs are seeded apart from the training envs."""
 
-RESUME_FIXED_SECTIONS = ("env", "policy", "normalize")
+RESUME_FIXED_SECTIONS = ("env", "policy", "normalize", "hybrid")
 """Config sections a resumed run cannot change (the model and its statistics depend on them)."""
 
 WORKER_CLOSE_TIMEOUT_S = 10.0
@@ -69,7 +69,9 @@ class TrainResult:
 
 def env_spec(config: TrainConfig) -> EnvSpec:
     env = config.env
-    return EnvSpec(env.id, dict(env.kwargs), env.max_episode_steps, list(env.gym_packages))
+    return EnvSpec(
+        env.id, dict(env.kwargs), env.max_episode_steps, list(env.gym_packages), config.hybrid
+    )
 
 
 def _probe(spec: EnvSpec) -> tuple[float | None, list]:
@@ -156,6 +158,10 @@ def start_training(
             verbose=config.logging.verbose,
             **config.ppo.sb3_kwargs(),
         )
+        if config.hybrid is not None and config.hybrid.zero_init_action_net:
+            from ..hybrid import zero_init_action_net
+
+            zero_init_action_net(model)  # start exactly at the analytical controller
     except BaseException:
         shutil.rmtree(run_dir, ignore_errors=True)
         raise

@@ -1,0 +1,66 @@
+"""Learning curves of a training run: evaluation return and success rate against env steps.
+
+Every run with ``eval.freq > 0`` writes SB3's EvalCallback log ``<run dir>/evaluations.npz``
+(kept across resumes, see `training`): at each evaluation the env-step count, every episode's
+return and length, and, since the hexapod envs report ``info["is_success"]``, every episode's
+success. `load_learning_curve` reads it into arrays a report can plot or tabulate.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .errors import UserError
+
+EVALUATIONS_FILE = "evaluations.npz"
+
+
+@dataclass(frozen=True)
+class LearningCurve:
+    """One run's evaluations: row i is the evaluation after ``timesteps[i]`` env steps."""
+
+    timesteps: np.ndarray  # (n,) env steps summed over the parallel envs
+    returns: np.ndarray  # (n, episodes) undiscounted, unnormalised episode returns
+    lengths: np.ndarray  # (n, episodes) episode lengths [steps]
+    successes: np.ndarray | None  # (n, episodes) 0/1; None if the env reports no is_success
+
+    @property
+    def mean_return(self) -> np.ndarray:
+        return self.returns.mean(axis=1)
+
+    @property
+    def success_rate(self) -> np.ndarray | None:
+        return None if self.successes is None else self.successes.mean(axis=1)
+
+    def rows(self) -> list[dict[str, float]]:
+        """One plain dict per evaluation (steps, mean return, success rate) for tables/JSON."""
+        rates = self.success_rate
+        return [
+            {
+                "timesteps": int(t),
+                "mean_return": float(r),
+                "success_rate": None if rates is None else float(rates[i]),
+            }
+            for i, (t, r) in enumerate(zip(self.timesteps, self.mean_return, strict=True))
+        ]
+
+
+def load_learning_curve(run_dir: str | Path) -> LearningCurve:
+    """The evaluation log of `run_dir`; UserError if it has none (eval.freq 0, or too early)."""
+    path = Path(run_dir) / EVALUATIONS_FILE
+    if not path.is_file():
+        raise UserError(
+            f"{run_dir} has no {EVALUATIONS_FILE}: the run has not been evaluated yet "
+            "(eval.freq 0, or fewer than eval.freq steps trained)"
+        )
+    with np.load(path) as data:
+        successes = data["successes"] if "successes" in data and data["successes"].size else None
+        return LearningCurve(
+            timesteps=np.asarray(data["timesteps"], dtype=np.int64),
+            returns=np.asarray(data["results"], dtype=float),
+            lengths=np.asarray(data["ep_lengths"], dtype=np.int64),
+            successes=None if successes is None else np.asarray(successes, dtype=float),
+        )

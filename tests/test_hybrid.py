@@ -1,0 +1,218 @@
+"""Hybrid policies (agents/hybrid.py): a zero residual is the analytical controller, exactly, in
+the action modes the shipped configs use; the safety override and its hysteresis."""
+
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import hexapod_envs  # noqa: F401  (registers the env ids)
+from agents.hybrid import HybridCore, HybridPolicy, HybridSettings, HybridWrapper
+from agents.pipeline.train_config import load_train_config
+from agents.registry import analytical_policy
+
+CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+HYBRID_CONFIGS = [
+    "cliff_walk_hybrid.yaml",
+    "stewart_tilt_hybrid.yaml",
+    "irregular_terrain_hybrid.yaml",
+    "irregular_terrain_gains.yaml",
+    "ditch_crossing_hybrid.yaml",
+]
+
+
+def config_env(name: str) -> gym.Env:
+    config = load_train_config(CONFIGS / name)
+    return gym.make(config.env.id, **config.env.kwargs)
+
+
+def analytical_episode(env: gym.Env, seed: int) -> tuple[list[np.ndarray], list[np.ndarray]]:
+    """Observations and actions of one full episode of the analytical controller on its own."""
+    policy = analytical_policy(env)
+    obs, _ = env.reset(seed=seed)
+    policy.reset()
+    observations, actions = [obs], []
+    while True:
+        action = policy(obs)
+        obs, _, terminated, truncated, _ = env.step(action)
+        observations.append(obs)
+        actions.append(np.asarray(action))
+        if terminated or truncated:
+            return observations, actions
+
+
+@pytest.mark.parametrize("name", HYBRID_CONFIGS)
+def test_zero_residual_reproduces_the_analytical_controller(name):
+    """Full episode, same seed: identical observations at every step, and the analytical actions
+    lie inside the action space (the controller has full authority in the config's mode)."""
+    env = config_env(name)
+    expected, actions = analytical_episode(env, seed=1)
+    space = env.action_space
+    assert all(np.all(a >= space.low) and np.all(a <= space.high) for a in actions)
+
+    wrapped = HybridWrapper(config_env(name), load_train_config(CONFIGS / name).hybrid)
+    obs, _ = wrapped.reset(seed=1)
+    observed = [obs]
+    zero = np.zeros(wrapped.action_space.shape, dtype=wrapped.action_space.dtype)
+    for _ in range(len(expected) - 1):
+        obs, _, terminated, truncated, info = wrapped.step(zero)
+        observed.append(obs)
+        assert info["safety_override"] is False
+    assert terminated or truncated
+    assert len(observed) == len(expected)
+    for step, (a, b) in enumerate(zip(expected, observed, strict=True)):
+        np.testing.assert_array_equal(a, b, err_msg=f"{name}: step {step}")
+
+
+def test_controller_is_reset_at_every_env_reset():
+    """Two episodes in a row through the wrapper equal two fresh analytical episodes."""
+    env = config_env("stewart_tilt_hybrid.yaml")
+    wrapped = HybridWrapper(env, HybridSettings())
+    zero = np.zeros(wrapped.action_space.shape, dtype=np.float32)
+    for seed in (3, 4):
+        expected, _ = analytical_episode(config_env("stewart_tilt_hybrid.yaml"), seed)
+        obs, _ = wrapped.reset(seed=seed)
+        for _ in expected[1:]:
+            obs, *_ = wrapped.step(zero)
+        np.testing.assert_array_equal(obs, expected[-1])
+
+
+def test_residual_adds_scale_times_action_and_clips_to_the_space():
+    env = config_env("cliff_walk_hybrid.yaml")
+    core = HybridCore(env, HybridSettings(scale=0.05))
+    obs, _ = env.reset(seed=0)
+    core.reset()
+    learned = np.linspace(-1, 1, 18).astype(np.float32)
+    action, override = core(obs, learned)
+    reference = HybridCore(env, HybridSettings(scale=0.05))
+    reference.reset()
+    base = reference.base_action(obs)
+    np.testing.assert_allclose(action, np.clip(base + 0.05 * learned, -1, 1), atol=1e-6)
+    assert not override
+    big, _ = HybridCore(env, HybridSettings(scale=10.0))(obs, np.ones(18))
+    assert np.all(big <= env.action_space.high) and np.all(big >= env.action_space.low)
+
+
+class ScriptedBase:
+    """A stand-in analytical controller returning a constant action; counts its calls."""
+
+    def __init__(self, value: float, shape: tuple[int, ...]):
+        self.action = np.full(shape, value, dtype=np.float32)
+        self.calls = self.resets = 0
+
+    def reset(self):
+        self.resets += 1
+
+    def __call__(self, observation):
+        self.calls += 1
+        return self.action.copy()
+
+
+def fasm_obs(env: gym.Env, fasm: float) -> np.ndarray:
+    obs = np.zeros(env.observation_space.shape, dtype=np.float32)
+    obs[env.unwrapped.observation_structure["fasm_margin_deg"]] = fasm
+    return obs
+
+
+def test_safety_override_with_hysteresis():
+    """Below ξ the analytical action applies; it keeps control until FASM >= ξ + margin; the
+    controller is stepped every step, also while the learned policy acts."""
+    env = config_env("stewart_tilt_hybrid.yaml")
+    base = ScriptedBase(0.5, env.action_space.shape)
+    settings = HybridSettings(mode="safety", scale=1.0, release_margin_deg=5.0)
+    core = HybridCore(env, settings, base=base)
+    assert core.threshold_deg == getattr(env.unwrapped, "tipping_threshold_deg", 20.0)
+    learned = np.full(env.action_space.shape, -0.25, dtype=np.float32)
+    expected = []
+    for fasm in (30.0, 21.0, 19.9, 22.0, 24.9, 25.0, 19.0, 40.0):
+        action, override = core(fasm_obs(env, fasm), learned)
+        expected.append(override)
+        np.testing.assert_array_equal(action, base.action if override else learned)
+    assert expected == [False, False, True, True, True, False, True, False]
+    assert base.calls == 8
+
+
+def test_residual_mode_safety_filter_drops_the_residual_below_threshold():
+    env = config_env("stewart_tilt_hybrid.yaml")
+    base = ScriptedBase(0.1, env.action_space.shape)
+    core = HybridCore(env, HybridSettings(scale=0.5, safety_filter=True), base=base)
+    ones = np.ones(env.action_space.shape, dtype=np.float32)
+    high, override = core(fasm_obs(env, 35.0), ones)
+    np.testing.assert_allclose(high, 0.6)
+    assert not override
+    low, override = core(fasm_obs(env, 5.0), ones)
+    np.testing.assert_allclose(low, 0.1)
+    assert override
+    plain = HybridCore(env, HybridSettings(scale=0.5), base=ScriptedBase(0.1, ones.shape))
+    assert plain(fasm_obs(env, 5.0), ones)[1] is False  # no filter: never overrides
+
+
+def test_threshold_comes_from_the_env_or_the_settings():
+    env = gym.make("HexapodIrregularTerrain-v0", action_mode="joint")
+    assert HybridCore(env, HybridSettings()).threshold_deg == env.unwrapped.tipping_threshold_deg
+    assert HybridCore(env, HybridSettings(threshold_deg=12.5)).threshold_deg == 12.5
+
+
+def test_wrapper_records_the_override_in_info_on_a_real_tilt():
+    """Safety mode on the Stewart tilt with the reference hold as the learned action: the
+    recovery takes over when the margin falls below ξ, as info["safety_override"] shows."""
+    env = gym.make("HexapodStewartTilt-v0", scenario="side")
+    wrapped = HybridWrapper(env, HybridSettings(mode="safety", scale=1.0))
+    wrapped.reset(seed=0)
+    zero = np.zeros(wrapped.action_space.shape, dtype=np.float32)
+    overrides, tipped = [], False
+    while True:
+        _, _, terminated, truncated, info = wrapped.step(zero)
+        overrides.append(info["safety_override"])
+        tipped = tipped or bool(info.get("is_tipped_over"))
+        if terminated or truncated:
+            break
+    assert not overrides[0] and any(overrides)
+    assert not tipped
+
+    env.reset(seed=0)  # the same episode without the safety fallback tips over
+    while True:
+        _, _, terminated, truncated, info = env.step(zero)
+        if terminated or truncated:
+            break
+    assert info["is_tipped_over"]
+
+
+def test_policy_combines_a_learned_policy_like_the_wrapper():
+    env = config_env("stewart_tilt_hybrid.yaml")
+    learned = ScriptedBase(0.3, env.action_space.shape)
+    policy = HybridPolicy(learned, env, HybridSettings(scale=0.05))
+    obs, _ = env.reset(seed=2)
+    policy.reset()
+    reference = analytical_policy(env)
+    reference.reset()
+    np.testing.assert_allclose(policy(obs), np.clip(reference(obs) + 0.015, -1, 1), atol=1e-6)
+    assert learned.resets == 1 and policy.last_override is False
+
+
+@pytest.mark.parametrize(
+    ("settings", "message"),
+    [
+        ({"mode": "blend"}, "hybrid mode must be one of"),
+        ({"scale": 0.0}, "hybrid scale must be a finite number > 0"),
+        ({"scale": float("nan")}, "hybrid scale must be a finite number > 0"),
+        ({"release_margin_deg": -1.0}, "release_margin_deg must be a finite number >= 0"),
+        ({"threshold_deg": float("inf")}, "threshold_deg must be finite or None"),
+    ],
+)
+def test_bad_settings_are_clear_errors(settings, message):
+    with pytest.raises(ValueError, match=message):
+        HybridSettings(**settings)
+
+
+def test_env_without_analytical_controller_is_a_clear_error():
+    env = gym.make("HexapodStewartTilt-v0")
+    from agents import registry
+
+    saved = registry.ANALYTICAL_POLICIES.pop("HexapodStewartTilt-v0")
+    try:
+        with pytest.raises(ValueError, match="no analytical controller registered"):
+            HybridWrapper(env, HybridSettings())
+    finally:
+        registry.ANALYTICAL_POLICIES["HexapodStewartTilt-v0"] = saved

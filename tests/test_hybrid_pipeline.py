@@ -1,0 +1,127 @@
+"""Hybrid runs through train.py and evaluate.py: the resolved config records the hybrid, a run
+directory loads as a hybrid with no extra argument, training starts exactly at the analytical
+controller, and the run's evaluation log gives a learning curve."""
+
+import json
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import yaml
+
+from agents.hybrid import HybridPolicy
+from agents.pipeline.cli import evaluate_main, train_main
+from agents.pipeline.learning_curve import load_learning_curve
+from agents.ppo import PPOPolicy
+
+ROOT = Path(__file__).resolve().parents[1]
+STEWART = str(ROOT / "configs" / "stewart_tilt_hybrid.yaml")
+TINY = [
+    "vec_env.n_envs=1",
+    "ppo.n_steps=128",
+    "ppo.batch_size=64",
+    "ppo.n_epochs=1",
+    "policy.pi=[16, 16]",
+    "policy.vf=[16, 16]",
+    "train.total_timesteps=256",
+    "env.max_episode_steps=64",
+    "eval.freq=128",
+    "eval.n_episodes=2",
+    "checkpoint.freq=0",
+    "logging.progress_bar=false",
+    "logging.tensorboard=false",
+]
+
+
+def train(tmp: Path, name: str, *overrides: str, config: str = STEWART) -> Path:
+    argv = ["--config", config, "--output-dir", str(tmp), "--run-name", name]
+    for o in [*TINY, *overrides]:
+        argv += ["--set", o]
+    assert train_main(argv) == 0
+    return tmp / name
+
+
+def evaluate(out: Path, *policies: str, env_kwargs=None, env="HexapodStewartTilt-v0") -> int:
+    envs = json.dumps([{"id": env, "kwargs": env_kwargs or {}}])
+    argv = ["--episodes", "2", "--max-episode-steps", "250", "--output-dir", str(out)]
+    argv += ["--no-progress", "--set", f"envs={envs}", "--policies", *policies]
+    return evaluate_main(argv)
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("hybrid_runs")
+    return {
+        "learning": train(tmp, "learning"),
+        "frozen": train(tmp, "frozen", "ppo.learning_rate=0.0"),
+    }
+
+
+def test_resolved_config_records_the_hybrid(runs):
+    for sub in ("", "best", "final"):
+        config = yaml.safe_load((runs["learning"] / sub / "config.yaml").read_text())
+        assert config["hybrid"]["mode"] == "residual"
+        assert config["hybrid"]["scale"] == 0.05
+
+
+def test_run_dir_loads_as_a_hybrid_policy(runs):
+    env = gym.make("HexapodStewartTilt-v0")
+    policy = PPOPolicy.load(runs["learning"], env)
+    assert isinstance(policy, HybridPolicy)
+    assert policy.core.settings.scale == 0.05
+    obs, _ = env.reset(seed=0)
+    policy.reset()
+    action = policy(obs)
+    assert action.shape == env.action_space.shape and env.action_space.contains(action)
+
+
+def test_untrained_hybrid_is_the_analytical_controller_in_evaluate(runs, tmp_path):
+    """Zero-initialised action mean, learning rate 0: evaluate.py's ppo:<run dir> gives exactly
+    the analytical controller's episodes (same seeds), with no extra argument."""
+    assert evaluate(tmp_path / "rep", "analytical", f"ppo:{runs['frozen']}") == 0
+    metrics = json.loads((tmp_path / "rep" / "metrics.json").read_text())
+    policies = metrics["envs"]["HexapodStewartTilt-v0"]["policies"]
+    hybrid = policies[f"ppo:{runs['frozen']}"]["episodes"]
+    assert hybrid == policies["analytical"]["episodes"]
+    assert len(hybrid) == 2
+
+
+def test_hybrid_in_another_action_mode_is_refused(tmp_path, capsys):
+    run = train(tmp_path, "cliff", config=str(ROOT / "configs" / "cliff_walk_hybrid.yaml"))
+    code = evaluate(tmp_path / "rep", f"ppo:{run}", env="HexapodCliffWalk-v0")
+    assert code == 2
+    err = capsys.readouterr().err
+    assert "trained with action_mode='joint' but the env has action_mode='residual'" in err
+    ok = evaluate(
+        tmp_path / "rep2",
+        f"ppo:{run}",
+        env="HexapodCliffWalk-v0",
+        env_kwargs={"action_mode": "joint"},
+    )
+    assert ok == 0
+
+
+def test_training_writes_a_learning_curve(runs):
+    curve = load_learning_curve(runs["learning"])
+    np.testing.assert_array_equal(curve.timesteps, [128, 256])
+    assert curve.returns.shape == (2, 2) and curve.successes.shape == (2, 2)
+    assert set(np.unique(curve.successes)) <= {0.0, 1.0}
+    rows = curve.rows()
+    assert [r["timesteps"] for r in rows] == [128, 256]
+    assert all(0.0 <= r["success_rate"] <= 1.0 for r in rows)
+
+
+def test_missing_learning_curve_is_a_clear_error(tmp_path):
+    with pytest.raises(ValueError, match="has no evaluations.npz"):
+        load_learning_curve(tmp_path)
+
+
+def test_resume_keeps_the_hybrid_and_refuses_to_change_it(tmp_path, capsys):
+    run = train(tmp_path, "resumed", "checkpoint.freq=128")
+    assert train_main(["--resume", str(run), "--set", "hybrid.scale=0.2"]) == 2
+    assert "cannot change 'hybrid' when resuming" in capsys.readouterr().err
+    assert train_main(["--resume", str(run), "--set", "train.total_timesteps=384"]) == 0
+    config = yaml.safe_load((run / "final" / "config.yaml").read_text())
+    assert config["hybrid"]["scale"] == 0.05
+    assert isinstance(PPOPolicy.load(run, gym.make("HexapodStewartTilt-v0")), HybridPolicy)
