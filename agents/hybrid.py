@@ -59,7 +59,8 @@ class HybridSettings:
         mode: "residual" (analytical + scale x a) or "safety" (scale x a, analytical below ξ).
         scale: multiplier of the learned action, in env action units (> 0).
         safety_filter: residual mode: drop the residual while the FASM is below ξ.
-        threshold_deg: ξ [deg]; None: ``env.unwrapped.tipping_threshold_deg`` or 20.
+        threshold_deg: ξ [deg]; None: ``env.unwrapped.tipping_threshold_deg`` or 20 (an env
+            that declares None, judged by another criterion, needs it for the override).
         release_margin_deg: hysteresis [deg]: the override ends when FASM >= ξ + this.
     """
 
@@ -119,11 +120,16 @@ class HybridCore:
                 "(env.unwrapped.observation_structure); the hybrid policies need it"
             )
         self._fasm = structure["fasm_margin_deg"]
-        self.threshold_deg = float(
-            settings.threshold_deg
-            if settings.threshold_deg is not None
-            else getattr(env.unwrapped, "tipping_threshold_deg", DEFAULT_THRESHOLD_DEG)
-        )
+        threshold = settings.threshold_deg
+        if threshold is None:
+            threshold = getattr(env.unwrapped, "tipping_threshold_deg", DEFAULT_THRESHOLD_DEG)
+        if threshold is None and settings.overrides:
+            raise ValueError(
+                f"{type(env.unwrapped).__name__} declares no FASM threshold (its stability "
+                "criterion is another one); give the hybrid section a threshold_deg to use the "
+                "safety override"
+            )
+        self.threshold_deg = None if threshold is None else float(threshold)
         self.base = base if base is not None else analytical_policy(env)
         self.overriding = False
 
