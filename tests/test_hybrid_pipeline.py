@@ -49,13 +49,29 @@ def evaluate(out: Path, *policies: str, env_kwargs=None, env="HexapodStewartTilt
     return evaluate_main(argv)
 
 
+def reset_to_untrained(run: Path) -> None:
+    """Zero the action net of every saved model of `run` again (an untrained hybrid; the
+    learning rate must be > 0, so training cannot be frozen by the config)."""
+    from agents.hybrid import zero_init_action_net
+    from agents.pipeline.model_files import load_ppo, ppo_custom_objects
+    from agents.pipeline.train_config import load_train_config
+
+    config = load_train_config(data=yaml.safe_load((run / "config.yaml").read_text()))
+    env = gym.make("HexapodStewartTilt-v0")
+    box = gym.spaces.Box(-1.0, 1.0, env.action_space.shape, env.action_space.dtype)
+    objects = ppo_custom_objects(config.policy.policy_kwargs(), env.observation_space, box)
+    for model_zip in run.glob("**/model.zip"):
+        model = load_ppo(model_zip, objects)
+        zero_init_action_net(model)
+        model.save(model_zip)
+
+
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("hybrid_runs")
-    return {
-        "learning": train(tmp, "learning"),
-        "frozen": train(tmp, "frozen", "ppo.learning_rate=0.0"),
-    }
+    frozen = train(tmp, "frozen")
+    reset_to_untrained(frozen)
+    return {"learning": train(tmp, "learning"), "frozen": frozen}
 
 
 def test_resolved_config_records_the_hybrid(runs):
@@ -77,7 +93,7 @@ def test_run_dir_loads_as_a_hybrid_policy(runs):
 
 
 def test_untrained_hybrid_is_the_analytical_controller_in_evaluate(runs, tmp_path):
-    """Zero-initialised action mean, learning rate 0: evaluate.py's ppo:<run dir> gives exactly
+    """Zero action mean (an untrained hybrid): evaluate.py's ppo:<run dir> gives exactly
     the analytical controller's episodes (same seeds), with no extra argument."""
     assert evaluate(tmp_path / "rep", "analytical", f"ppo:{runs['frozen']}") == 0
     metrics = json.loads((tmp_path / "rep" / "metrics.json").read_text())

@@ -74,7 +74,7 @@ class EvaluationSuite:
     trust_pickle: bool = False  # load pickled model files of older runs (runs code from them)
     frames: bool = False  # frame strip per policy (rendered with MUJOCO_GL=egl)
     frame_count: int = 6
-    video_stride: int = 2  # --video: every n-th control step becomes a frame
+    video_fps: float = 12.5  # --video: frames per second of simulated time (played in real time)
     frame_size: list[int] = field(default_factory=lambda: [320, 240])
     xi_f_deg: float = 20.0
     gym_packages: list[str] = field(default_factory=lambda: list(DEFAULT_GYM_PACKAGES))
@@ -85,8 +85,8 @@ class EvaluationSuite:
             raise ValueError(f"episodes must be >= 1, got {self.episodes}")
         if self.frame_count < 1 or len(self.frame_size) != 2:
             raise ValueError("frame_count must be >= 1 and frame_size [width, height]")
-        if self.video_stride < 1:
-            raise ValueError(f"video_stride must be >= 1, got {self.video_stride}")
+        if not 0 < self.video_fps <= 100:
+            raise ValueError(f"video_fps must be in (0, 100], got {self.video_fps}")
 
     @property
     def seeds(self) -> list[int]:

@@ -280,7 +280,8 @@ CAMERA = "track"
 
 def _render(suite: EvaluationSuite, result: EnvResult, policies: dict, video_dir: Path | None):
     """Re-run the first seed of each policy with rendering: keep `frame_count` frames for the
-    strip and, with `video_dir`, write every `video_stride`-th frame to an MP4."""
+    strip and, with `video_dir`, write about `video_fps` frames per simulated second to an MP4
+    that plays in real time."""
     width, height = suite.frame_size
     suite_env = next(e for e in suite.envs if e.id == result.env_id)
     render_kwargs = {"render_mode": "rgb_array", "width": width, "height": height}
@@ -290,6 +291,8 @@ def _render(suite: EvaluationSuite, result: EnvResult, policies: dict, video_dir
         env = _env_spec(suite, suite_env, render_mode="rgb_array").make()
     warnings = []
     slug = result.env_id.replace("/", "_")
+    steps_per_s = 1.0 / result.dt if result.dt else 50.0
+    stride = max(1, round(steps_per_s / suite.video_fps))
     try:
         for name, policy in policies.items():
             run = result.runs[name]
@@ -300,7 +303,7 @@ def _render(suite: EvaluationSuite, result: EnvResult, policies: dict, video_dir
 
             def grab(step: int, wanted=wanted, frames=frames, movie=movie) -> None:
                 keep_frame = suite.frames and step in wanted
-                keep_movie = video_dir is not None and step % suite.video_stride == 0
+                keep_movie = video_dir is not None and step % stride == 0
                 if keep_frame or keep_movie:
                     image = np.asarray(env.render())
                     if keep_frame:
@@ -319,8 +322,7 @@ def _render(suite: EvaluationSuite, result: EnvResult, policies: dict, video_dir
             if video_dir is not None and movie:
                 safe = "".join(c if c.isalnum() else "_" for c in name)
                 run.video = video_dir / f"{slug}_{safe}.mp4"
-                fps = (1.0 / result.dt if result.dt else 50.0) / suite.video_stride
-                _write_mp4(run.video, movie, fps)
+                _write_mp4(run.video, movie, steps_per_s / stride)
     finally:
         env.close()
     return warnings
