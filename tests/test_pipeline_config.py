@@ -37,7 +37,7 @@ def test_shipped_training_configs_load_with_their_env_ids(name, env_id):
 def test_default_suite_names_all_four_envs_and_shipped_models():
     suite = load_suite(CONFIGS / "evaluate_default.yaml")
     assert [e.id for e in suite.envs] == list(TRAIN_CONFIGS.values())
-    assert suite.policies == ["analytical", "ppo:models/{env_id}"]
+    assert suite.policies == ["analytical", "zero", "ppo:models/{env_id}"]
     assert suite.output_dir == "reports/default" and suite.missing_models == "skip"
 
 
