@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import inspect
 import math
+import numbers
+import re
 from collections.abc import Mapping
 from typing import Any, ClassVar
 
@@ -36,6 +38,74 @@ def check_kwargs(cls: type, kwargs: Mapping[str, Any]) -> None:
         raise TypeError(
             f"{cls.__name__} got unknown keyword argument(s) {unknown}; valid: {sorted(valid)}"
         )
+
+
+TASK_DISTRIBUTIONS = ("paper", "train", "test")
+"""``task_distribution`` values: the paper's scenario (plus small reset noise), or task and
+physical parameters sampled at every reset from the env's training or held-out test ranges."""
+
+SIGNED_SETTINGS = frozenset(
+    {
+        "cliff_x",
+        "cliff_edge_y",
+        "ramp_start_x",
+        "block_region",
+        "ditch_start_x",
+        "ditch_start_x_range",
+        "max_tilt_deg",
+    }
+)
+"""Numeric settings for which a negative value is meaningful (positions, signed offsets)."""
+
+
+def _settings_signature(cls: type) -> dict[str, inspect.Parameter]:
+    """Keyword-only parameters of `cls.__init__` and of the bases it forwards **kwargs to."""
+    params: dict[str, inspect.Parameter] = {}
+    for klass in cls.__mro__:
+        init = klass.__dict__.get("__init__")
+        if init is None:
+            continue
+        sig = inspect.signature(init).parameters.values()
+        for p in sig:
+            if p.kind is p.KEYWORD_ONLY:
+                params.setdefault(p.name, p)
+        if not any(p.kind is p.VAR_KEYWORD for p in sig):
+            break
+    return params
+
+
+def _numbers_in(value: Any):
+    if isinstance(value, (tuple, list)):
+        for v in value:
+            yield from _numbers_in(v)
+    else:
+        yield value
+
+
+def check_settings(cls: type, kwargs: Mapping[str, Any]) -> None:
+    """Check every numeric setting passed to `cls` by name: a real number (not a string, bool
+    or complex), finite, and >= 0 unless the setting is signed (`SIGNED_SETTINGS`). Numeric
+    settings are those whose annotation is int/float or a tuple of them. Raises ValueError
+    naming the setting, so a bad value never reaches the physics (NaN gains, inf drops)."""
+    params = _settings_signature(cls)
+    for name, value in kwargs.items():
+        p = params.get(name)
+        if p is None or value is None:
+            continue
+        ann = str(p.annotation)
+        if not re.match(r"^(int|float|tuple\[[\w\[\], .]*\])( \| None)?$", ann):
+            continue
+        if ann.startswith("tuple") and not isinstance(value, (tuple, list)):
+            raise ValueError(f"{name} must be a tuple of numbers, got {value!r}")
+        for x in _numbers_in(value):
+            if isinstance(x, bool) or not isinstance(x, numbers.Real):
+                raise ValueError(f"{name} must be a real number, got {value!r} ({type(x).__name__})")
+            if not math.isfinite(float(x)):
+                raise ValueError(f"{name} must be finite, got {value!r}")
+            if name not in SIGNED_SETTINGS and x < 0:
+                raise ValueError(f"{name} must be >= 0, got {value!r}")
+    if "task_distribution" in kwargs:
+        check_choice("task_distribution", kwargs["task_distribution"], TASK_DISTRIBUTIONS)
 
 
 def check_choice(name: str, value: Any, choices) -> None:
@@ -112,6 +182,7 @@ class HexapodEnv(gym.Env):
 
     def __new__(cls, *args: Any, **kwargs: Any):
         check_kwargs(cls, kwargs)
+        check_settings(cls, kwargs)
         return super().__new__(cls)
 
     def __init__(
@@ -123,7 +194,13 @@ class HexapodEnv(gym.Env):
         width: int = 640,
         height: int = 480,
         camera_name: str | None = None,
+        task_distribution: str = "paper",
     ):
+        check_choice("task_distribution", task_distribution, TASK_DISTRIBUTIONS)
+        self.task_distribution = task_distribution
+        self.task: dict[str, Any] = {}
+        """The episode's task parameters (plain floats/ints/strings), also `info["task"]`."""
+        self._needs_reset = True
         if render_mode is not None:
             check_choice("render_mode", render_mode, self.metadata["render_modes"])
         self.control_dt = control_dt
@@ -170,11 +247,43 @@ class HexapodEnv(gym.Env):
         self.observation_layout.pack(self._observation_pieces(), self._obs_buffer)
         return self._obs_buffer.copy()
 
+    # --- episode ---------------------------------------------------------------------------
+    tipping_threshold_deg: float = 20.0
+    """The robot's tipping threshold ξ on the FASM [deg]: `info["is_tipping"]` below it."""
+    stability_criterion: str = "FASM >= 20 deg"
+    """The stability criterion in words, for reports."""
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        """Seed `np_random` and draw the episode's task (`sample_task`); subclasses extend it."""
+        super().reset(seed=seed, options=options)
+        self._needs_reset = False
+        if self.task_distribution == "paper":
+            self.task = self.paper_task()
+        else:
+            self.task = self.sample_task(self.np_random, self.task_distribution)
+        return None
+
+    def paper_task(self) -> dict[str, Any]:
+        """The task parameters of the paper's scenario (from the constructor's settings)."""
+        return {}
+
+    def sample_task(self, rng: np.random.Generator, distribution: str) -> dict[str, Any]:
+        """Task parameters drawn from the `distribution` ("train" or "test") ranges."""
+        return self.paper_task()
+
     # --- stepping ------------------------------------------------------------------------
-    @staticmethod
-    def _validate_action(action: Any, space: spaces.Box) -> np.ndarray:
-        """Check shape and finiteness (clear errors), then clip into the action space."""
-        a = np.asarray(action, dtype=np.float64)
+    def _validate_action(self, action: Any, space: spaces.Box) -> np.ndarray:
+        """Check that an episode is running, the dtype is real, shape and finiteness (clear
+        errors), then clip into the action space."""
+        if self._needs_reset:
+            raise RuntimeError(f"{type(self).__name__}: call reset() first, before step()")
+        a = np.asarray(action)
+        if a.dtype.kind not in "fiu":
+            raise ValueError(
+                f"action must be real numbers (float or int), got dtype {a.dtype}; "
+                "complex, bool, string and object actions are refused"
+            )
+        a = a.astype(np.float64, copy=False)
         if a.shape != space.shape:
             raise ValueError(f"action has shape {a.shape}; this env expects {space.shape}")
         if not math.isfinite(a.sum()):  # one reduction instead of an element-wise test
@@ -187,7 +296,9 @@ class HexapodEnv(gym.Env):
         int(mujoco.mjtWarning.mjWARN_BADQACC),
         int(mujoco.mjtWarning.mjWARN_BADQVEL),
         int(mujoco.mjtWarning.mjWARN_BADQPOS),
+        int(mujoco.mjtWarning.mjWARN_BADCTRL),
     ]
+    """MuJoCo warnings that count as instability (`info["sim_unstable"]`, truncation)."""
 
     def _simulate(self, ctrl: np.ndarray | None = None) -> bool:
         """Run the physics for one control period; False if the simulation went unstable.

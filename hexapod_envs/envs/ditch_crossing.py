@@ -176,6 +176,7 @@ class DitchCrossingEnv(HexapodEnv):
         width: int = 640,
         height: int = 480,
         camera_name: str | None = "track",
+        task_distribution: str = "paper",
     ):
         super().__init__(
             control_dt=control_dt,
@@ -184,6 +185,7 @@ class DitchCrossingEnv(HexapodEnv):
             width=width,
             height=height,
             camera_name=camera_name,
+            task_distribution=task_distribution,
         )
         check_choice("terrain", terrain, TERRAINS)
         check_choice("action_mode", action_mode, ACTION_MODES)

@@ -203,6 +203,7 @@ class IrregularTerrainEnv(HexapodEnv):
         width: int = 640,
         height: int = 480,
         camera_name: str | None = None,
+        task_distribution: str = "paper",
     ):
         super().__init__(
             control_dt=control_dt,
@@ -211,6 +212,7 @@ class IrregularTerrainEnv(HexapodEnv):
             width=width,
             height=height,
             camera_name=camera_name,
+            task_distribution=task_distribution,
         )
         check_choice("terrain", terrain, TERRAINS)
         check_choice("action_mode", action_mode, ACTION_MODES)
