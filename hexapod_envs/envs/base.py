@@ -99,7 +99,8 @@ def check_settings(cls: type, kwargs: Mapping[str, Any]) -> None:
             raise ValueError(f"{name} must be a tuple of numbers, got {value!r}")
         for x in _numbers_in(value):
             if isinstance(x, bool) or not isinstance(x, numbers.Real):
-                raise ValueError(f"{name} must be a real number, got {value!r} ({type(x).__name__})")
+                kind = type(x).__name__
+                raise ValueError(f"{name} must be a real number, got {value!r} ({kind})")
             if not math.isfinite(float(x)):
                 raise ValueError(f"{name} must be finite, got {value!r}")
             if name not in SIGNED_SETTINGS and x < 0:

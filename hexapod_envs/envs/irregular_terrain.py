@@ -117,6 +117,48 @@ blocks' steps of up to 9 cm from one block to the next). The paper gives no valu
 RAMP_TOP_LENGTH = 2.0
 """Flat top after the slope [m], long enough that a 1200-step episode ends on it."""
 
+
+@dataclasses.dataclass(frozen=True)
+class TerrainTaskRanges:
+    """Ranges of one task distribution (uniform draws; a tuple of ranges: one chosen at random).
+
+    Held-out test ranges (`TERRAIN_TEST`): slopes interleaved with training (8.5-11.5 deg, which
+    holds the paper's 10 deg, against 5-8.5 and 11.5-15), taller blocks and smaller blocks than
+    in training (extrapolated), lower friction, servo stiffness farther from nominal.
+    """
+
+    slope_deg: tuple[tuple[float, float], ...]
+    block_height_max: tuple[float, float]
+    """Highest block [m] (blocks are drawn 0.04 m up to it)."""
+    block_size: tuple[float, float]
+    """Block edge length [m] (square blocks)."""
+    friction: tuple[float, float]
+    servo_kp_scale: tuple[tuple[float, float], ...]
+    """Servo stiffness as a multiple of `servo_kp`."""
+
+
+TERRAIN_TRAIN = TerrainTaskRanges(
+    slope_deg=((5.0, 8.5), (11.5, 15.0)),
+    block_height_max=(0.08, 0.12),
+    block_size=(0.10, 0.14),
+    friction=(0.7, 1.1),
+    servo_kp_scale=((0.85, 1.15),),
+)
+TERRAIN_TEST = TerrainTaskRanges(
+    slope_deg=((8.5, 11.5),),
+    block_height_max=(0.12, 0.15),
+    block_size=(0.08, 0.10),
+    friction=(0.5, 0.7),
+    servo_kp_scale=((0.7, 0.85), (1.15, 1.3)),
+)
+TERRAIN_RANGES = {"train": TERRAIN_TRAIN, "test": TERRAIN_TEST}
+
+
+def _uniform_in(rng: np.random.Generator, ranges: tuple[tuple[float, float], ...]) -> float:
+    low, high = ranges[int(rng.integers(len(ranges)))]
+    return float(rng.uniform(low, high))
+
+
 _CONTACT_CHECKS = 5
 """Torso-terrain contact is looked for this many times per control period (every 10 ms)."""
 
@@ -273,6 +315,7 @@ class IrregularTerrainEnv(HexapodEnv):
             "tip_over": tip_over_penalty,
         }
         self.tipping_threshold_deg = float(tipping_threshold_deg)
+        self.stability_criterion = f"FASM >= {self.tipping_threshold_deg:g} deg"
         self.tip_over_cos = float(np.cos(np.radians(tip_over_angle_deg)))
         self.reset_noise_scale = float(reset_noise_scale)
         self.settle_time = float(settle_time)
@@ -285,6 +328,14 @@ class IrregularTerrainEnv(HexapodEnv):
         else:
             self.action_space = spaces.Box(-1.0, 1.0, shape=(18,), dtype=np.float32)
         self._contact_force_sq = self.contact_threshold**2
+        self._paper = {
+            "slope_deg": self.ramp["slope_deg"],
+            "block_height_max": float(self.blocks["height_range"][1]),
+            "block_size": float(self.blocks["block_size"][0]),
+            "friction": self.friction,
+            "servo_kp": float(servo_kp),
+        }
+        self._built_task = self.paper_task()
         self._build(np.random.default_rng(block_layout_seed or 0))
         self._set_observation_layout(
             {
@@ -361,10 +412,48 @@ class IrregularTerrainEnv(HexapodEnv):
         return (0.0, 0.0, top + standing + 0.003), (1.0, 0.0, 0.0, 0.0)
 
     # --- reset / step --------------------------------------------------------------------
+    # --- task distribution -----------------------------------------------------------------
+    def paper_task(self) -> dict:
+        return {
+            "terrain": self.terrain,
+            "slope_deg": self._paper["slope_deg"],
+            "block_height_max": self._paper["block_height_max"],
+            "block_size": self._paper["block_size"],
+            "friction": self._paper["friction"],
+            "servo_kp": self._paper["servo_kp"],
+        }
+
+    def sample_task(self, rng: np.random.Generator, distribution: str) -> dict:
+        r = TERRAIN_RANGES[distribution]
+        return {
+            "terrain": self.terrain,
+            "slope_deg": _uniform_in(rng, r.slope_deg),
+            "block_height_max": float(rng.uniform(*r.block_height_max)),
+            "block_size": float(rng.uniform(*r.block_size)),
+            "friction": float(rng.uniform(*r.friction)),
+            "servo_kp": self._paper["servo_kp"] * _uniform_in(rng, r.servo_kp_scale),
+        }
+
+    def _apply_task(self, task: dict) -> bool:
+        """Set the terrain and servo parameters of `task`; True if the model must be rebuilt."""
+        if task == self._built_task:
+            return False
+        self._built_task = dict(task)
+        self.ramp["slope_deg"] = task["slope_deg"]
+        low = self.blocks["height_range"][0]
+        self.blocks["height_range"] = (low, max(low, task["block_height_max"]))
+        self.blocks["block_size"] = (task["block_size"], task["block_size"])
+        self.friction = task["friction"]
+        self.robot = dataclasses.replace(self.robot, servo_kp=task["servo_kp"])
+        return True
+
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
+        super().reset(seed=seed, options=options)
+        rebuild = self._apply_task(self.task)
         if self.terrain == "blocks" and self.block_layout_seed is None:
             self._build(self.np_random)  # a new test bed per episode, from the episode's seed
+        elif rebuild:
+            self._build(np.random.default_rng(self.block_layout_seed or 0))
         mujoco.mj_resetData(self.model, self.data)
         standing = np.tile(self.robot.standing_posture, 6)
         noise = self.reset_noise_scale * self.action_map.half
@@ -407,14 +496,16 @@ class IrregularTerrainEnv(HexapodEnv):
         self._touched = touched
         self._collisions += touched
         self._read_sensors()
+        # The penalty is paid once; stepping on after termination keeps `terminated` True.
         tipped = bool(self.data.xmat[self.sensors.torso_id, 8] < self.tip_over_cos)
+        tipped = tipped and not self._tipped
         self._tipped = self._tipped or tipped
         terms = self._reward_terms(touched, tipped)
         cycle_stats = self._update_cycle_window(touched)
         self._prev_cog_x = float(self._cog[0])
         self._last_obs = self._observation()
         reward = float(sum(terms.values()))
-        return self._last_obs, reward, tipped, False, self._info(terms, False, cycle_stats)
+        return self._last_obs, reward, self._tipped, False, self._info(terms, False, cycle_stats)
 
     def _ctrl_from_action(self, action: np.ndarray) -> np.ndarray:
         if self.action_mode == "joint":
@@ -605,6 +696,7 @@ class IrregularTerrainEnv(HexapodEnv):
             posture_gains=self.controller.gains if self.action_mode != "joint" else None,
             gait_cycle=self._gait_cycle_index(),
             cycle_stats=cycle_stats,
+            task=dict(self.task),
         )
         if cycle_stats is not None or self._step_count == 0:
             # A fresh copy whenever the lists change (and at reset): infos must not share data.
