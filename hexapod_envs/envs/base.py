@@ -52,7 +52,6 @@ SIGNED_SETTINGS = frozenset(
         "block_region",
         "ditch_start_x",
         "ditch_start_x_range",
-        "max_tilt_deg",
     }
 )
 """Numeric settings for which a negative value is meaningful (positions, signed offsets)."""
