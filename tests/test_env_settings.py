@@ -163,3 +163,17 @@ def test_sampled_task_changes_the_physics():
     assert env.cliff["drop"] == pytest.approx(info["task"]["cliff_drop"])
     obs, *_ = env.step(np.zeros(18))
     assert np.all(np.isfinite(obs))
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_sensor_noise_perturbs_forces_and_imu_only(env_id):
+    clean = gym.make(env_id).unwrapped
+    noisy = gym.make(env_id, sensor_noise=0.05).unwrapped
+    o_clean, i_clean = clean.reset(seed=4)
+    o_noisy, i_noisy = noisy.reset(seed=4)
+    s = clean.observation_structure
+    for name in ("foot_force", "imu_gyro", "imu_accel"):
+        assert not np.allclose(o_clean[s[name]], o_noisy[s[name]]), name
+    np.testing.assert_array_equal(o_clean[s["joint_pos"]], o_noisy[s["joint_pos"]])
+    assert i_clean["fasm_margin_deg"] == i_noisy["fasm_margin_deg"]
+    assert np.linalg.norm(o_noisy[s["imu_quat"]]) == pytest.approx(1.0)

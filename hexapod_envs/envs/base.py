@@ -195,8 +195,12 @@ class HexapodEnv(gym.Env):
         height: int = 480,
         camera_name: str | None = None,
         task_distribution: str = "paper",
+        sensor_noise: float = 0.0,
     ):
         check_choice("task_distribution", task_distribution, TASK_DISTRIBUTIONS)
+        self.sensor_noise = float(sensor_noise)
+        """Relative std of the Gaussian noise added to the observed foot forces and IMU
+        (`_add_sensor_noise`); 0 (default) observes the true values."""
         self.task_distribution = task_distribution
         self.task: dict[str, Any] = {}
         """The episode's task parameters (plain floats/ints/strings), also `info["task"]`."""
@@ -245,7 +249,27 @@ class HexapodEnv(gym.Env):
 
     def _observation(self) -> np.ndarray:
         self.observation_layout.pack(self._observation_pieces(), self._obs_buffer)
+        if self.sensor_noise:
+            self._add_sensor_noise(self._obs_buffer)
         return self._obs_buffer.copy()
+
+    def _add_sensor_noise(self, obs: np.ndarray) -> None:
+        """Add zero-mean Gaussian noise (from `np_random`) to the observed sensors, with
+        std `sensor_noise` x: a sixth of the robot's weight for each foot-force component [N],
+        1 rad/s for the gyro, g for the accelerometer, 1 for the quaternion components (then
+        renormalised). The info, FASM and reward keep the true values."""
+        o, rng, k = self.observation_layout.slices, self.np_random, self.sensor_noise
+        weight = float(self.model.body_subtreemass[self.sensors.torso_id]) * 9.81
+        for name, scale in (
+            ("foot_force", weight / 6),
+            ("imu_gyro", 1.0),
+            ("imu_accel", 9.81),
+            ("imu_quat", 1.0),
+        ):
+            sl = o[name]
+            obs[sl] += rng.normal(0.0, k * scale, sl.stop - sl.start)
+        q = obs[o["imu_quat"]]
+        q /= max(float(np.linalg.norm(q)), 1e-9)
 
     # --- episode ---------------------------------------------------------------------------
     tipping_threshold_deg: float = 20.0

@@ -202,6 +202,7 @@ class DitchCrossingEnv(HexapodEnv):
         height: int = 480,
         camera_name: str | None = "track",
         task_distribution: str = "paper",
+        sensor_noise: float = 0.0,
     ):
         super().__init__(
             control_dt=control_dt,
@@ -211,6 +212,7 @@ class DitchCrossingEnv(HexapodEnv):
             height=height,
             camera_name=camera_name,
             task_distribution=task_distribution,
+            sensor_noise=sensor_noise,
         )
         check_choice("terrain", terrain, TERRAINS)
         check_choice("action_mode", action_mode, ACTION_MODES)
@@ -606,6 +608,8 @@ class DitchCrossingEnv(HexapodEnv):
             min(self._tick, len(self._reference_actions) - 1)
         ]
         b[o["residual_state"]] = self._residual_units()
+        if self.sensor_noise:
+            self._add_sensor_noise(b)
         return b.copy()
 
     def _reward_terms(self, cog_x: float, tipped: bool) -> dict[str, float]:

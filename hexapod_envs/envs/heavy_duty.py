@@ -61,6 +61,7 @@ class HeavyDutyEnv(HexapodEnv):
         height: int = 480,
         camera_name: str | None = None,
         task_distribution: str = "paper",
+        sensor_noise: float = 0.0,
     ):
         super().__init__(
             control_dt=control_dt,
@@ -70,6 +71,7 @@ class HeavyDutyEnv(HexapodEnv):
             height=height,
             camera_name=camera_name,
             task_distribution=task_distribution,
+            sensor_noise=sensor_noise,
         )
         check_choice("action_mode", action_mode, ACTION_MODES)
         self.action_mode = action_mode

@@ -246,6 +246,7 @@ class IrregularTerrainEnv(HexapodEnv):
         height: int = 480,
         camera_name: str | None = None,
         task_distribution: str = "paper",
+        sensor_noise: float = 0.0,
     ):
         super().__init__(
             control_dt=control_dt,
@@ -255,6 +256,7 @@ class IrregularTerrainEnv(HexapodEnv):
             height=height,
             camera_name=camera_name,
             task_distribution=task_distribution,
+            sensor_noise=sensor_noise,
         )
         check_choice("terrain", terrain, TERRAINS)
         check_choice("action_mode", action_mode, ACTION_MODES)
