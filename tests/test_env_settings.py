@@ -177,3 +177,20 @@ def test_sensor_noise_perturbs_forces_and_imu_only(env_id):
     np.testing.assert_array_equal(o_clean[s["joint_pos"]], o_noisy[s["joint_pos"]])
     assert i_clean["fasm_margin_deg"] == i_noisy["fasm_margin_deg"]
     assert np.linalg.norm(o_noisy[s["imu_quat"]]) == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_settings_are_one_frozen_record_that_rebuilds_the_env(env_id):
+    import dataclasses
+
+    env = gym.make(env_id, task_distribution="train", reset_noise_scale=0.002).unwrapped
+    settings = env.settings
+    assert settings.task_distribution == "train" and settings.reset_noise_scale == 0.002
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        settings.reset_noise_scale = 0.1
+    fields = {f.name: getattr(settings, f.name) for f in dataclasses.fields(settings)}
+    again = gym.make(env_id, **fields).unwrapped
+    o1, i1 = env.reset(seed=9)
+    o2, i2 = again.reset(seed=9)
+    np.testing.assert_array_equal(o1, o2)
+    assert i1["task"] == i2["task"]

@@ -7,6 +7,7 @@ observation pieces (`_observation_pieces`), the reward terms and the termination
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import math
 import numbers
@@ -108,6 +109,23 @@ def check_settings(cls: type, kwargs: Mapping[str, Any]) -> None:
         check_choice("task_distribution", kwargs["task_distribution"], TASK_DISTRIBUTIONS)
 
 
+_SETTINGS_CLASSES: dict[type, type] = {}
+
+
+def settings_class(cls: type) -> type:
+    """A frozen dataclass with one field per keyword setting of `cls` (its name, annotation and
+    default), built once per env class: ``env.unwrapped.settings`` is an instance of it."""
+    if cls not in _SETTINGS_CLASSES:
+        fields = [
+            (name, p.annotation, dataclasses.field(default=p.default))
+            for name, p in _settings_signature(cls).items()
+        ]
+        _SETTINGS_CLASSES[cls] = dataclasses.make_dataclass(
+            f"{cls.__name__}Settings", fields, frozen=True
+        )
+    return _SETTINGS_CLASSES[cls]
+
+
 def check_choice(name: str, value: Any, choices) -> None:
     """Raise a ValueError naming `name`, the bad value and the valid choices."""
     if value not in choices:
@@ -183,7 +201,11 @@ class HexapodEnv(gym.Env):
     def __new__(cls, *args: Any, **kwargs: Any):
         check_kwargs(cls, kwargs)
         check_settings(cls, kwargs)
-        return super().__new__(cls)
+        env = super().__new__(cls)
+        env.settings = settings_class(cls)(**kwargs)
+        """Every setting of this env (the defaults and the keyword arguments given), frozen:
+        ``gym.make(id, **vars(env.unwrapped.settings))`` rebuilds the same env."""
+        return env
 
     def __init__(
         self,
