@@ -160,3 +160,19 @@ def test_mujoco_warning_counts_as_instability(env_id):
     obs, reward, terminated, truncated, info = env.step(np.zeros(env.action_space.shape))
     assert info["sim_unstable"] and truncated and not terminated and reward == 0.0
     assert np.all(np.isfinite(obs))
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_task_description_is_declared_and_frozen(env_id):
+    import dataclasses
+
+    env = gym.make(env_id, task_distribution="train").unwrapped
+    _, info = env.reset(seed=2)
+    desc = env.task_description
+    assert dict(desc.course) == info["task"] and desc.reference
+    assert len(desc.joint_low) == len(desc.joint_high) and desc.control_dt == env.control_dt
+    assert desc.tipping_threshold_deg == env.tipping_threshold_deg
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        desc.control_dt = 1.0
+    with pytest.raises(TypeError):
+        desc.course["x"] = 1.0

@@ -13,6 +13,7 @@ import math
 import numbers
 import re
 from collections.abc import Mapping
+from types import MappingProxyType
 from typing import Any, ClassVar
 
 import gymnasium as gym
@@ -190,6 +191,29 @@ def set_physics_options(spec: mujoco.MjSpec, timestep: float) -> None:
     spec.option.impratio = 10.0
 
 
+@dataclasses.dataclass(frozen=True)
+class TaskDescription:
+    """What a controller may know about the env's task, declared by the env (instead of reading
+    its attributes): robot, action mapping, timing, stability criterion, the episode's course
+    and the reference gait. Per-step information comes through the observation."""
+
+    robot: Any
+    """The robot's parameters (frozen dataclass of its `params` module)."""
+    action_mode: str
+    control_dt: float
+    """Control period [s]."""
+    joint_low: tuple[float, ...]
+    """Joint (command) target at action -1, per action entry, robot units ("joint" mode)."""
+    joint_high: tuple[float, ...]
+    """Joint (command) target at action +1."""
+    tipping_threshold_deg: float
+    stability_criterion: str
+    course: Mapping[str, Any]
+    """The episode's task parameters (`info["task"]`, read-only)."""
+    reference: Mapping[str, Any]
+    """Env-specific reference gait and timing (see the env's `_reference_description`)."""
+
+
 class HexapodEnv(gym.Env):
     """Base class; see the module docstring. Keyword arguments are checked by name."""
 
@@ -308,6 +332,31 @@ class HexapodEnv(gym.Env):
         else:
             self.task = self.sample_task(self.np_random, self.task_distribution)
         return None
+
+    @property
+    def task_description(self) -> TaskDescription:
+        """The declared task description of the current episode (see `TaskDescription`)."""
+        low, high = self._joint_limits()
+        return TaskDescription(
+            robot=self._robot_params(),
+            action_mode=self.action_mode,
+            control_dt=float(self.control_dt),
+            joint_low=tuple(float(x) for x in low),
+            joint_high=tuple(float(x) for x in high),
+            tipping_threshold_deg=float(self.tipping_threshold_deg),
+            stability_criterion=self.stability_criterion,
+            course=MappingProxyType(dict(self.task)),
+            reference=MappingProxyType(self._reference_description()),
+        )
+
+    def _robot_params(self) -> Any:
+        return self.robot
+
+    def _joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.action_map.low, self.action_map.high
+
+    def _reference_description(self) -> dict[str, Any]:
+        return {}
 
     def paper_task(self) -> dict[str, Any]:
         """The task parameters of the paper's scenario (from the constructor's settings)."""

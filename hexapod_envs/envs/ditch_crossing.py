@@ -422,6 +422,25 @@ class DitchCrossingEnv(HexapodEnv):
     tipping_threshold_deg = 0.0
     stability_criterion = "static margin > 0 mm"
 
+    def _robot_params(self):
+        return self.params
+
+    def _joint_limits(self):
+        return self.command_low, self.command_high
+
+    def _reference_description(self) -> dict:
+        """The reference gait: plan and timed schedule for this episode's ditch, timing and
+        planner settings, start and finish x [m], residual gains [m]."""
+        return {
+            "plan": self.plan,
+            "schedule": self.schedule,
+            "gait_timing": self.gait_timing,
+            "gait_settings": self.gait_settings,
+            "start_x": self.start_x,
+            "finish_x": self.finish_x,
+            "residual_gain": tuple(float(g) for g in self.residual_gain),
+        }
+
     def paper_task(self) -> dict:
         return {
             "terrain": self.terrain,

@@ -207,6 +207,19 @@ class HeavyDutyEnv(HexapodEnv):
     def _on_reset(self) -> None:
         """Hook for scenario state (terrain randomisation, platform pose)."""
 
+    def _reference_description(self) -> dict:
+        """The reference: tripod gait parameters, its table of joint targets per control step
+        of a cycle, steps per cycle and standing steps, residual scale and filter."""
+        return {
+            "gait": self.gait.gait,
+            "reference_table": self._reference_table.copy(),
+            "steps_per_cycle": self._steps_per_cycle,
+            "stand_steps": self._stand_steps,
+            "residual_scale": self.residual_scale,
+            "residual_filter_alpha": self._filter_alpha,
+            "walks": self.walks,
+        }
+
     # --- task distribution -----------------------------------------------------------------
     PAYLOAD_RANGES = {"train": ((0.0, 500.0), 0.15), "test": ((500.0, 800.0), 0.25)}
     """Payload on the body per distribution: (mass range [kg], max CoG offset in x and y [m]).

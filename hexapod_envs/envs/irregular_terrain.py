@@ -414,6 +414,17 @@ class IrregularTerrainEnv(HexapodEnv):
         return (0.0, 0.0, top + standing + 0.003), (1.0, 0.0, 0.0, 0.0)
 
     # --- reset / step --------------------------------------------------------------------
+    def _reference_description(self) -> dict:
+        """The reference gait: `AthenaPostureController` settings, gains, ticks per cycle,
+        residual scale and the ramp geometry."""
+        return {
+            "gait_config": dict(self.gait_config),
+            "reference_gains": self.reference_gains,
+            "ticks_per_cycle": self.ticks_per_cycle,
+            "residual_scale": self.residual_scale,
+            "ramp": dict(self.ramp),
+        }
+
     # --- task distribution -----------------------------------------------------------------
     def paper_task(self) -> dict:
         return {
