@@ -23,6 +23,11 @@ recovery controller, the robot tips over.
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
 | reward_effort | -effort_weight x sum of |joint power| / (weight x gait speed) |
 
+Task distributions (``task_distribution=``): "paper" (default) is the scenario above;
+"train" / "test" draw cliff distance, side, edge offset, drop, ground friction and a payload
+(mass, CoG offset) at every reset from `CLIFF_TRAIN` / `CLIFF_TEST` (held out: farther, deeper,
+nearer the centre line, lower friction, heavier payload). ``info["task"]`` holds the values.
+
 Action: see `HeavyDutyEnv` (``action_mode="joint"`` or ``"residual"``, 18 values in [-1, 1]).
 """
 

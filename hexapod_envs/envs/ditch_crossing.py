@@ -13,6 +13,12 @@ episode's terrain (made at reset, after any randomisation), timed by
 reference stands still and ``info["planner_status"]`` says why ("too_deep", "too_wide",
 "no_plan").
 
+Task distributions (``task_distribution=``): "paper" (default) is the ditch above (or the
+``ditch_*_range`` draws); "train" / "test" draw the ditch's start, width, depth and the ground
+friction at every reset from `DITCH_TRAIN` / `DITCH_TEST` (held out: wider, deeper, farther,
+lower friction). ``info["task"]`` holds the values; the stability criterion is a positive
+static margin (`tipping_threshold_deg` = 0 on the FASM).
+
 | Observation piece | size | unit |
 |---|---|---|
 | joint_pos | 9 | limb lengths l_1..l_3, then leg extensions U1..L3 (+ = longer) [m] |

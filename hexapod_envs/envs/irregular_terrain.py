@@ -15,6 +15,12 @@ gait of eqs. (19)-(23) (t_g = 1 s per phase, control at 20 Hz) over
 The block heights are drawn from the episode's ``np_random`` at every reset (one bed per seed);
 ``block_layout_seed=<int>`` fixes one bed for all episodes.
 
+Task distributions (``task_distribution=``): "paper" (default) is the terrain above; "train" /
+"test" draw the slope, the block bed's highest block and block size, friction and servo
+stiffness at every reset from `TERRAIN_TRAIN` / `TERRAIN_TEST` (held out: slopes 8.5-11.5 deg,
+taller and smaller blocks, lower friction, stiffness farther from nominal). ``info["task"]``
+holds the values. ``sensor_noise`` adds Gaussian noise to the observed foot forces and IMU.
+
 Servos and gait. The paper's joints are servos with a 1.89 N·m stall torque. Ours are
 proportional position servos with that torque limit, a stiffness ``servo_kp`` and viscous damping
 ``servo_damping``. The default stiffness, 8 N·m/rad, reaches the stall torque at 0.24 rad (13.5°)

@@ -20,6 +20,11 @@ The hold posture is a little taller and narrower than the walking stance (feet a
 1.95 m below the hips) so that the side case tips within the platform's reach (the 6-UPS
 platform tilts at most ~44-46 deg; the walking stance would need 48.5 deg).
 
+Task distributions (``task_distribution=``): "paper" (default) runs `scenario`; "train" /
+"test" draw the held tripod, the tilt axis (one of the six paper cases or an arbitrary axis),
+the tilt rate, the platform friction and a payload at every reset from `TILT_TRAIN` /
+`TILT_TEST` (held out: rates 4-8 and 12-20 deg/s). ``info["task"]`` holds the values.
+
 Observation: as HexapodCliffWalk-v0 without the gait phase (joint_pos, joint_vel, foot_force,
 foot_contact, fasm_margin_deg, imu_gyro, imu_accel, imu_quat). Action: 18 values in [-1, 1];
 ``"residual"`` (default) offsets the hold posture by residual_scale x half range (default 2, so
