@@ -9,6 +9,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
+from hexapod_envs.envs.base import JointActionMap
 from hexapod_envs.robots.heavy_duty.gait import TripodGait
 
 from .policy import ObservationReader
@@ -19,11 +20,12 @@ class TripodGaitPolicy:
 
     def __init__(self, env: gym.Env):
         base = env.unwrapped
-        self.action_mode = base.action_mode
-        self.action_map = base.action_map
+        task = base.task_description  # what the env declares a controller may know
+        self.action_mode = task.action_mode
+        self.action_map = JointActionMap(np.column_stack([task.joint_low, task.joint_high]))
         self.read = ObservationReader(base.observation_structure)
-        self.gait = TripodGait(base.robot, base.gait.gait)
-        self._steps = base._steps_per_cycle
+        self.gait = TripodGait(task.robot, task.reference["gait"])
+        self._steps = task.reference["steps_per_cycle"]
         self._zero = np.zeros(env.action_space.shape, dtype=env.action_space.dtype)
 
     def reset(self) -> None:

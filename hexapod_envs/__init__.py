@@ -1,4 +1,4 @@
-"""Gymnasium environments on MuJoCo for hexapod robots (see DESIGN.md).
+"""Gymnasium environments on MuJoCo for hexapod robots (see docs/architecture.md).
 
 Importing the package registers the env ids with Gymnasium:
 

@@ -7,9 +7,13 @@ observation pieces (`_observation_pieces`), the reward terms and the termination
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import math
+import numbers
+import re
 from collections.abc import Mapping
+from types import MappingProxyType
 from typing import Any, ClassVar
 
 import gymnasium as gym
@@ -36,6 +40,91 @@ def check_kwargs(cls: type, kwargs: Mapping[str, Any]) -> None:
         raise TypeError(
             f"{cls.__name__} got unknown keyword argument(s) {unknown}; valid: {sorted(valid)}"
         )
+
+
+TASK_DISTRIBUTIONS = ("paper", "train", "test")
+"""``task_distribution`` values: the paper's scenario (plus small reset noise), or task and
+physical parameters sampled at every reset from the env's training or held-out test ranges."""
+
+SIGNED_SETTINGS = frozenset(
+    {
+        "cliff_x",
+        "cliff_edge_y",
+        "ramp_start_x",
+        "block_region",
+        "ditch_start_x",
+        "ditch_start_x_range",
+    }
+)
+"""Numeric settings for which a negative value is meaningful (positions, signed offsets)."""
+
+
+def _settings_signature(cls: type) -> dict[str, inspect.Parameter]:
+    """Keyword-only parameters of `cls.__init__` and of the bases it forwards **kwargs to."""
+    params: dict[str, inspect.Parameter] = {}
+    for klass in cls.__mro__:
+        init = klass.__dict__.get("__init__")
+        if init is None:
+            continue
+        sig = inspect.signature(init).parameters.values()
+        for p in sig:
+            if p.kind is p.KEYWORD_ONLY:
+                params.setdefault(p.name, p)
+        if not any(p.kind is p.VAR_KEYWORD for p in sig):
+            break
+    return params
+
+
+def _numbers_in(value: Any):
+    if isinstance(value, (tuple, list)):
+        for v in value:
+            yield from _numbers_in(v)
+    else:
+        yield value
+
+
+def check_settings(cls: type, kwargs: Mapping[str, Any]) -> None:
+    """Check every numeric setting passed to `cls` by name: a real number (not a string, bool
+    or complex), finite, and >= 0 unless the setting is signed (`SIGNED_SETTINGS`). Numeric
+    settings are those whose annotation is int/float or a tuple of them. Raises ValueError
+    naming the setting, so a bad value never reaches the physics (NaN gains, inf drops)."""
+    params = _settings_signature(cls)
+    for name, value in kwargs.items():
+        p = params.get(name)
+        if p is None or value is None:
+            continue
+        ann = str(p.annotation)
+        if not re.match(r"^(int|float|tuple\[[\w\[\], .]*\])( \| None)?$", ann):
+            continue
+        if ann.startswith("tuple") and not isinstance(value, (tuple, list)):
+            raise ValueError(f"{name} must be a tuple of numbers, got {value!r}")
+        for x in _numbers_in(value):
+            if isinstance(x, bool) or not isinstance(x, numbers.Real):
+                kind = type(x).__name__
+                raise ValueError(f"{name} must be a real number, got {value!r} ({kind})")
+            if not math.isfinite(float(x)):
+                raise ValueError(f"{name} must be finite, got {value!r}")
+            if name not in SIGNED_SETTINGS and x < 0:
+                raise ValueError(f"{name} must be >= 0, got {value!r}")
+    if "task_distribution" in kwargs:
+        check_choice("task_distribution", kwargs["task_distribution"], TASK_DISTRIBUTIONS)
+
+
+_SETTINGS_CLASSES: dict[type, type] = {}
+
+
+def settings_class(cls: type) -> type:
+    """A frozen dataclass with one field per keyword setting of `cls` (its name, annotation and
+    default), built once per env class: ``env.unwrapped.settings`` is an instance of it."""
+    if cls not in _SETTINGS_CLASSES:
+        fields = [
+            (name, p.annotation, dataclasses.field(default=p.default))
+            for name, p in _settings_signature(cls).items()
+        ]
+        _SETTINGS_CLASSES[cls] = dataclasses.make_dataclass(
+            f"{cls.__name__}Settings", fields, frozen=True
+        )
+    return _SETTINGS_CLASSES[cls]
 
 
 def check_choice(name: str, value: Any, choices) -> None:
@@ -102,6 +191,29 @@ def set_physics_options(spec: mujoco.MjSpec, timestep: float) -> None:
     spec.option.impratio = 10.0
 
 
+@dataclasses.dataclass(frozen=True)
+class TaskDescription:
+    """What a controller may know about the env's task, declared by the env (instead of reading
+    its attributes): robot, action mapping, timing, stability criterion, the episode's course
+    and the reference gait. Per-step information comes through the observation."""
+
+    robot: Any
+    """The robot's parameters (frozen dataclass of its `params` module)."""
+    action_mode: str
+    control_dt: float
+    """Control period [s]."""
+    joint_low: tuple[float, ...]
+    """Joint (command) target at action -1, per action entry, robot units ("joint" mode)."""
+    joint_high: tuple[float, ...]
+    """Joint (command) target at action +1."""
+    tipping_threshold_deg: float
+    stability_criterion: str
+    course: Mapping[str, Any]
+    """The episode's task parameters (`info["task"]`, read-only)."""
+    reference: Mapping[str, Any]
+    """Env-specific reference gait and timing (see the env's `_reference_description`)."""
+
+
 class HexapodEnv(gym.Env):
     """Base class; see the module docstring. Keyword arguments are checked by name."""
 
@@ -112,7 +224,12 @@ class HexapodEnv(gym.Env):
 
     def __new__(cls, *args: Any, **kwargs: Any):
         check_kwargs(cls, kwargs)
-        return super().__new__(cls)
+        check_settings(cls, kwargs)
+        env = super().__new__(cls)
+        env.settings = settings_class(cls)(**kwargs)
+        """Every setting of this env (the defaults and the keyword arguments given), frozen:
+        ``gym.make(id, **vars(env.unwrapped.settings))`` rebuilds the same env."""
+        return env
 
     def __init__(
         self,
@@ -123,7 +240,17 @@ class HexapodEnv(gym.Env):
         width: int = 640,
         height: int = 480,
         camera_name: str | None = None,
+        task_distribution: str = "paper",
+        sensor_noise: float = 0.0,
     ):
+        check_choice("task_distribution", task_distribution, TASK_DISTRIBUTIONS)
+        self.sensor_noise = float(sensor_noise)
+        """Relative std of the Gaussian noise added to the observed foot forces and IMU
+        (`_add_sensor_noise`); 0 (default) observes the true values."""
+        self.task_distribution = task_distribution
+        self.task: dict[str, Any] = {}
+        """The episode's task parameters (plain floats/ints/strings), also `info["task"]`."""
+        self._needs_reset = True
         if render_mode is not None:
             check_choice("render_mode", render_mode, self.metadata["render_modes"])
         self.control_dt = control_dt
@@ -168,13 +295,90 @@ class HexapodEnv(gym.Env):
 
     def _observation(self) -> np.ndarray:
         self.observation_layout.pack(self._observation_pieces(), self._obs_buffer)
+        if self.sensor_noise:
+            self._add_sensor_noise(self._obs_buffer)
         return self._obs_buffer.copy()
 
+    def _add_sensor_noise(self, obs: np.ndarray) -> None:
+        """Add zero-mean Gaussian noise (from `np_random`) to the observed sensors, with
+        std `sensor_noise` x: a sixth of the robot's weight for each foot-force component [N],
+        1 rad/s for the gyro, g for the accelerometer, 1 for the quaternion components (then
+        renormalised). The info, FASM and reward keep the true values."""
+        o, rng, k = self.observation_layout.slices, self.np_random, self.sensor_noise
+        weight = float(self.model.body_subtreemass[self.sensors.torso_id]) * 9.81
+        for name, scale in (
+            ("foot_force", weight / 6),
+            ("imu_gyro", 1.0),
+            ("imu_accel", 9.81),
+            ("imu_quat", 1.0),
+        ):
+            sl = o[name]
+            obs[sl] += rng.normal(0.0, k * scale, sl.stop - sl.start)
+        q = obs[o["imu_quat"]]
+        q /= max(float(np.linalg.norm(q)), 1e-9)
+
+    # --- episode ---------------------------------------------------------------------------
+    tipping_threshold_deg: float = 20.0
+    """The robot's tipping threshold ξ on the FASM [deg]: `info["is_tipping"]` below it."""
+    stability_criterion: str = "FASM >= 20 deg"
+    """The stability criterion in words, for reports."""
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        """Seed `np_random` and draw the episode's task (`sample_task`); subclasses extend it."""
+        super().reset(seed=seed, options=options)
+        self._needs_reset = False
+        if self.task_distribution == "paper":
+            self.task = self.paper_task()
+        else:
+            self.task = self.sample_task(self.np_random, self.task_distribution)
+        return None
+
+    @property
+    def task_description(self) -> TaskDescription:
+        """The declared task description of the current episode (see `TaskDescription`)."""
+        low, high = self._joint_limits()
+        return TaskDescription(
+            robot=self._robot_params(),
+            action_mode=self.action_mode,
+            control_dt=float(self.control_dt),
+            joint_low=tuple(float(x) for x in low),
+            joint_high=tuple(float(x) for x in high),
+            tipping_threshold_deg=float(self.tipping_threshold_deg),
+            stability_criterion=self.stability_criterion,
+            course=MappingProxyType(dict(self.task)),
+            reference=MappingProxyType(self._reference_description()),
+        )
+
+    def _robot_params(self) -> Any:
+        return self.robot
+
+    def _joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
+        return self.action_map.low, self.action_map.high
+
+    def _reference_description(self) -> dict[str, Any]:
+        return {}
+
+    def paper_task(self) -> dict[str, Any]:
+        """The task parameters of the paper's scenario (from the constructor's settings)."""
+        return {}
+
+    def sample_task(self, rng: np.random.Generator, distribution: str) -> dict[str, Any]:
+        """Task parameters drawn from the `distribution` ("train" or "test") ranges."""
+        return self.paper_task()
+
     # --- stepping ------------------------------------------------------------------------
-    @staticmethod
-    def _validate_action(action: Any, space: spaces.Box) -> np.ndarray:
-        """Check shape and finiteness (clear errors), then clip into the action space."""
-        a = np.asarray(action, dtype=np.float64)
+    def _validate_action(self, action: Any, space: spaces.Box) -> np.ndarray:
+        """Check that an episode is running, the dtype is real, shape and finiteness (clear
+        errors), then clip into the action space."""
+        if self._needs_reset:
+            raise RuntimeError(f"{type(self).__name__}: call reset() first, before step()")
+        a = np.asarray(action)
+        if a.dtype.kind not in "fiu":
+            raise ValueError(
+                f"action must be real numbers (float or int), got dtype {a.dtype}; "
+                "complex, bool, string and object actions are refused"
+            )
+        a = a.astype(np.float64, copy=False)
         if a.shape != space.shape:
             raise ValueError(f"action has shape {a.shape}; this env expects {space.shape}")
         if not math.isfinite(a.sum()):  # one reduction instead of an element-wise test
@@ -187,7 +391,9 @@ class HexapodEnv(gym.Env):
         int(mujoco.mjtWarning.mjWARN_BADQACC),
         int(mujoco.mjtWarning.mjWARN_BADQVEL),
         int(mujoco.mjtWarning.mjWARN_BADQPOS),
+        int(mujoco.mjtWarning.mjWARN_BADCTRL),
     ]
+    """MuJoCo warnings that count as instability (`info["sim_unstable"]`, truncation)."""
 
     def _simulate(self, ctrl: np.ndarray | None = None) -> bool:
         """Run the physics for one control period; False if the simulation went unstable.

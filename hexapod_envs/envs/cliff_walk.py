@@ -23,12 +23,20 @@ recovery controller, the robot tips over.
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
 | reward_effort | -effort_weight x sum of |joint power| / (weight x gait speed) |
 
+Task distributions (``task_distribution=``): "paper" (default) is the scenario above;
+"train" / "test" draw cliff distance, side, edge offset, drop, ground friction and a payload
+(mass, CoG offset) at every reset from `CLIFF_TRAIN` / `CLIFF_TEST` (held out: farther, deeper,
+nearer the centre line, lower friction, heavier payload). ``info["task"]`` holds the values.
+
 Action: see `HeavyDutyEnv` (``action_mode="joint"`` or ``"residual"``, 18 values in [-1, 1]).
 """
 
 from __future__ import annotations
 
+import dataclasses
+
 import mujoco
+import numpy as np
 
 from ..terrain.cliff import CLIFF_SIDES, add_cliff
 from ..terrain.flat import add_flat
@@ -36,6 +44,30 @@ from .base import check_choice
 from .heavy_duty import HeavyDutyEnv
 
 TERRAINS = ("cliff", "flat")
+
+
+@dataclasses.dataclass(frozen=True)
+class CliffTaskRanges:
+    """Ranges of one task distribution (uniform draws; `side` is drawn from `sides`).
+
+    Held-out test ranges (the defaults of `CLIFF_TEST`) extrapolate beyond training: the cliff
+    farther ahead and deeper, the edge nearer the centre line, lower friction, heavier payload.
+    """
+
+    cliff_x: tuple[float, float]
+    edge_y: tuple[float, float]
+    drop: tuple[float, float]
+    friction: tuple[float, float]
+    sides: tuple[str, ...] = CLIFF_SIDES
+
+
+CLIFF_TRAIN = CliffTaskRanges(
+    cliff_x=(2.8, 3.4), edge_y=(-1.3, -0.9), drop=(1.0, 3.0), friction=(0.8, 1.2)
+)
+CLIFF_TEST = CliffTaskRanges(
+    cliff_x=(3.4, 4.0), edge_y=(-0.9, -0.7), drop=(3.0, 5.0), friction=(0.6, 0.8)
+)
+CLIFF_RANGES = {"train": CLIFF_TRAIN, "test": CLIFF_TEST}
 
 
 class CliffWalkEnv(HeavyDutyEnv):
@@ -68,6 +100,7 @@ class CliffWalkEnv(HeavyDutyEnv):
             "edge_y": cliff_edge_y,
         }
         self.friction = friction
+        self._paper_cliff, self._paper_friction = dict(self.cliff), friction
         super().__init__(**kwargs)
 
     def _add_terrain(self, spec: mujoco.MjSpec) -> None:
@@ -75,3 +108,41 @@ class CliffWalkEnv(HeavyDutyEnv):
             add_flat(spec, friction=self.friction)
         else:
             add_cliff(spec, friction=self.friction, **self.cliff)
+
+    # --- task distribution -----------------------------------------------------------------
+    def paper_task(self) -> dict:
+        return {
+            "terrain": self.terrain,
+            "cliff_x": float(self._paper_cliff["start_x"]),
+            "cliff_side": self._paper_cliff["side"],
+            "cliff_drop": float(self._paper_cliff["drop"]),
+            "cliff_edge_y": float(self._paper_cliff["edge_y"]),
+            "friction": float(self._paper_friction),
+            "payload_mass": 0.0,
+            "payload_offset_x": 0.0,
+            "payload_offset_y": 0.0,
+        }
+
+    def sample_task(self, rng: np.random.Generator, distribution: str) -> dict:
+        r = CLIFF_RANGES[distribution]
+        return {
+            "terrain": self.terrain,
+            "cliff_x": float(rng.uniform(*r.cliff_x)),
+            "cliff_side": str(r.sides[int(rng.integers(len(r.sides)))]),
+            "cliff_drop": float(rng.uniform(*r.drop)),
+            "cliff_edge_y": float(rng.uniform(*r.edge_y)),
+            "friction": float(rng.uniform(*r.friction)),
+            **self._sample_payload(rng, distribution),
+        }
+
+    def _rebuild_needed(self, task: dict) -> bool:
+        cliff = {
+            "start_x": task["cliff_x"],
+            "side": task["cliff_side"],
+            "drop": task["cliff_drop"],
+            "edge_y": task["cliff_edge_y"],
+        }
+        if cliff == self.cliff and task["friction"] == self.friction:
+            return False
+        self.cliff, self.friction = cliff, task["friction"]
+        return True

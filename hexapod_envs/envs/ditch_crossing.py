@@ -13,6 +13,12 @@ episode's terrain (made at reset, after any randomisation), timed by
 reference stands still and ``info["planner_status"]`` says why ("too_deep", "too_wide",
 "no_plan").
 
+Task distributions (``task_distribution=``): "paper" (default) is the ditch above (or the
+``ditch_*_range`` draws); "train" / "test" draw the ditch's start, width, depth and the ground
+friction at every reset from `DITCH_TRAIN` / `DITCH_TEST` (held out: wider, deeper, farther,
+lower friction). ``info["task"]`` holds the values; the stability criterion is a positive
+static margin (`tipping_threshold_deg` = 0 on the FASM).
+
 | Observation piece | size | unit |
 |---|---|---|
 | joint_pos | 9 | limb lengths l_1..l_3, then leg extensions U1..L3 (+ = longer) [m] |
@@ -68,6 +74,7 @@ finish_x [m], gait_step and gait_phase (the reference's plan step and phase), ti
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from itertools import compress
 
@@ -103,6 +110,30 @@ TERRAINS = ("ditch", "flat")
 ACTION_MODES = ("joint", "residual")
 GRAVITY = 9.81
 _RANGE_KWARGS = ("ditch_start_x_range", "ditch_width_range", "ditch_depth_range")
+
+
+@dataclasses.dataclass(frozen=True)
+class DitchTaskRanges:
+    """Ranges of one task distribution (uniform draws) [m], friction coefficient.
+
+    Held-out test ranges (`DITCH_TEST`) extrapolate beyond training: wider ditches (0.40-0.50
+    m against 0.25-0.40), deeper (0.12-0.15 m against 0.06-0.12; the planner refuses depths
+    above ~0.16 m), farther ahead, lower friction.
+    """
+
+    start_x: tuple[float, float]
+    width: tuple[float, float]
+    depth: tuple[float, float]
+    friction: tuple[float, float]
+
+
+DITCH_TRAIN = DitchTaskRanges(
+    start_x=(0.6, 0.9), width=(0.25, 0.40), depth=(0.06, 0.12), friction=(0.8, 1.2)
+)
+DITCH_TEST = DitchTaskRanges(
+    start_x=(0.9, 1.1), width=(0.40, 0.50), depth=(0.12, 0.15), friction=(0.5, 0.8)
+)
+DITCH_RANGES = {"train": DITCH_TRAIN, "test": DITCH_TEST}
 
 
 def _check_range(name: str, value) -> tuple[float, float] | None:
@@ -182,6 +213,8 @@ class DitchCrossingEnv(HexapodEnv):
         width: int = 640,
         height: int = 480,
         camera_name: str | None = "track",
+        task_distribution: str = "paper",
+        sensor_noise: float = 0.0,
     ):
         super().__init__(
             control_dt=control_dt,
@@ -190,6 +223,8 @@ class DitchCrossingEnv(HexapodEnv):
             width=width,
             height=height,
             camera_name=camera_name,
+            task_distribution=task_distribution,
+            sensor_noise=sensor_noise,
         )
         check_choice("terrain", terrain, TERRAINS)
         check_choice("action_mode", action_mode, ACTION_MODES)
@@ -216,6 +251,7 @@ class DitchCrossingEnv(HexapodEnv):
         self.gait_timing = gait_timing or GaitTiming()
         self.gait_settings = gait_settings or GaitSettings()
         self.friction = friction
+        self._paper_friction = friction
         self.reset_noise_scale = reset_noise_scale
         self.weights = {
             "progress": progress_weight,
@@ -313,7 +349,8 @@ class DitchCrossingEnv(HexapodEnv):
         return self.ditch.end_x
 
     def _geometry_key(self, ditch: Ditch) -> tuple:
-        return (ditch.start_x, ditch.width, ditch.depth) if self.terrain == "ditch" else ()
+        geometry = (ditch.start_x, ditch.width, ditch.depth) if self.terrain == "ditch" else ()
+        return (*geometry, self.friction)
 
     def _build(self, ditch: Ditch) -> None:
         key = self._geometry_key(ditch)
@@ -393,10 +430,63 @@ class DitchCrossingEnv(HexapodEnv):
         return Ditch(values["ditch_start_x"], values["ditch_width"], values["ditch_depth"])
 
     # --- reset / step ------------------------------------------------------------------------
+    # --- task distribution ---------------------------------------------------------------------
+    tipping_threshold_deg = 0.0
+    stability_criterion = "static margin > 0 mm"
+
+    def _robot_params(self):
+        return self.params
+
+    def _joint_limits(self):
+        return self.command_low, self.command_high
+
+    def _reference_description(self) -> dict:
+        """The reference gait: plan and timed schedule for this episode's ditch, timing and
+        planner settings, start and finish x [m], residual gains [m]."""
+        return {
+            "plan": self.plan,
+            "schedule": self.schedule,
+            "gait_timing": self.gait_timing,
+            "gait_settings": self.gait_settings,
+            "start_x": self.start_x,
+            "finish_x": self.finish_x,
+            "residual_gain": tuple(float(g) for g in self.residual_gain),
+        }
+
+    def paper_task(self) -> dict:
+        return {
+            "terrain": self.terrain,
+            "ditch_start_x": float(self.ditch_defaults["ditch_start_x"]),
+            "ditch_width": float(self.ditch_defaults["ditch_width"]),
+            "ditch_depth": float(self.ditch_defaults["ditch_depth"]),
+            "friction": float(self._paper_friction),
+        }
+
+    def sample_task(self, rng: np.random.Generator, distribution: str) -> dict:
+        r = DITCH_RANGES[distribution]
+        return {
+            "terrain": self.terrain,
+            "ditch_start_x": float(rng.uniform(*r.start_x)),
+            "ditch_width": float(rng.uniform(*r.width)),
+            "ditch_depth": float(rng.uniform(*r.depth)),
+            "friction": float(rng.uniform(*r.friction)),
+        }
+
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
-        if any(r is not None for r in self.ditch_ranges.values()):
+        super().reset(seed=seed, options=options)
+        if self.task_distribution != "paper":
+            t = self.task
+            self.friction = t["friction"]
+            self.ditch = Ditch(t["ditch_start_x"], t["ditch_width"], t["ditch_depth"])
+            self._build(self.ditch)
+            self._set_plan(self.ditch)
+        elif any(r is not None for r in self.ditch_ranges.values()):
             self.ditch = self._sample_ditch()
+            self.task.update(
+                ditch_start_x=self.ditch.start_x,
+                ditch_width=self.ditch.width,
+                ditch_depth=self.ditch.depth,
+            )
             self._build(self.ditch)
             self._set_plan(self.ditch)
         m, d = self.model, self.data
@@ -460,15 +550,16 @@ class DitchCrossingEnv(HexapodEnv):
         if not stable:
             return self._last_obs.copy(), 0.0, False, True, self._info({}, unstable=True)
         self._update_stability()
-        tipped = d.xmat[self._torso, 8] < self.tip_over_cos
-        self._tipped = self._tipped or bool(tipped)
+        # The penalty is paid once; stepping on after termination keeps `terminated` True.
+        tipped = bool(d.xmat[self._torso, 8] < self.tip_over_cos) and not self._tipped
+        self._tipped = self._tipped or tipped
         self._success = not self._tipped and self._all_feet_past_finish()
         cog_x = float(d.subtree_com[self._torso, 0])
-        terms = self._reward_terms(cog_x, bool(tipped))
+        terms = self._reward_terms(cog_x, tipped)
         self._prev_cog_x = cog_x
         self._last_obs = self._observation()
         reward = terms["progress"] + terms["stability"] + terms["tip_over"] + terms["effort"]
-        terminated = bool(tipped) or self._success
+        terminated = self._tipped or self._success
         return self._last_obs, reward, terminated, False, self._info(terms, unstable=False)
 
     # --- measurements ------------------------------------------------------------------------
@@ -548,6 +639,8 @@ class DitchCrossingEnv(HexapodEnv):
             min(self._tick, len(self._reference_actions) - 1)
         ]
         b[o["residual_state"]] = self._residual_units()
+        if self.sensor_noise:
+            self._add_sensor_noise(b)
         return b.copy()
 
     def _reward_terms(self, cog_x: float, tipped: bool) -> dict[str, float]:
@@ -585,4 +678,5 @@ class DitchCrossingEnv(HexapodEnv):
             "gait_phase": phase,
             "time": self._tick * self.control_dt,
             "cog": cog.copy(),
+            "task": dict(self.task),
         }

@@ -33,6 +33,9 @@ ACTION_MODES = ("joint", "residual")
 class HeavyDutyEnv(HexapodEnv):
     """Base for the heavy-duty hexapod scenarios: robot, sensors, FASM, action modes, rewards."""
 
+    tipping_threshold_deg = XI_F_DEG
+    stability_criterion = f"FASM >= {XI_F_DEG:g} deg"
+
     walks: bool = True
     """Walking scenarios follow the reference tripod gait and observe its phase."""
 
@@ -61,6 +64,8 @@ class HeavyDutyEnv(HexapodEnv):
         width: int = 640,
         height: int = 480,
         camera_name: str | None = None,
+        task_distribution: str = "paper",
+        sensor_noise: float = 0.0,
     ):
         super().__init__(
             control_dt=control_dt,
@@ -69,6 +74,8 @@ class HeavyDutyEnv(HexapodEnv):
             width=width,
             height=height,
             camera_name=camera_name,
+            task_distribution=task_distribution,
+            sensor_noise=sensor_noise,
         )
         check_choice("action_mode", action_mode, ACTION_MODES)
         self.action_mode = action_mode
@@ -175,7 +182,8 @@ class HeavyDutyEnv(HexapodEnv):
         return self._reference_table[0]
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
+        super().reset(seed=seed, options=options)
+        self._apply_task(self.task)
         mujoco.mj_resetData(self.model, self.data)
         self._step_count = 0
         self._residual = np.zeros(self.action_space.shape)
@@ -203,6 +211,54 @@ class HeavyDutyEnv(HexapodEnv):
     def _on_reset(self) -> None:
         """Hook for scenario state (terrain randomisation, platform pose)."""
 
+    def _reference_description(self) -> dict:
+        """The reference: tripod gait parameters, its table of joint targets per control step
+        of a cycle, steps per cycle and standing steps, residual scale and filter."""
+        return {
+            "gait": self.gait.gait,
+            "reference_table": self._reference_table.copy(),
+            "steps_per_cycle": self._steps_per_cycle,
+            "stand_steps": self._stand_steps,
+            "residual_scale": self.residual_scale,
+            "residual_filter_alpha": self._filter_alpha,
+            "walks": self.walks,
+        }
+
+    # --- task distribution -----------------------------------------------------------------
+    PAYLOAD_RANGES = {"train": ((0.0, 500.0), 0.15), "test": ((500.0, 800.0), 0.25)}
+    """Payload on the body per distribution: (mass range [kg], max CoG offset in x and y [m]).
+    The test payload is heavier (extrapolated) and may sit farther off centre."""
+
+    def _sample_payload(self, rng: np.random.Generator, distribution: str) -> dict:
+        (m_lo, m_hi), off = self.PAYLOAD_RANGES[distribution]
+        return {
+            "payload_mass": float(rng.uniform(m_lo, m_hi)),
+            "payload_offset_x": float(rng.uniform(-off, off)),
+            "payload_offset_y": float(rng.uniform(-off, off)),
+        }
+
+    def _apply_task(self, task: dict) -> None:
+        """Rebuild the model when the task changes it, then place the payload (a point mass
+        added to the body at its CoG offset; the body's inertia is kept)."""
+        if self._rebuild_needed(task):
+            self._build()
+        m = self.model
+        torso = self.sensors.torso_id
+        if not hasattr(self, "_torso_mass0"):
+            self._torso_mass0 = float(m.body_mass[torso])
+            self._torso_ipos0 = m.body_ipos[torso].copy()
+        mass = task.get("payload_mass", 0.0)
+        offset = np.array([task.get("payload_offset_x", 0.0), task.get("payload_offset_y", 0.0)])
+        total = self._torso_mass0 + mass
+        m.body_mass[torso] = total
+        m.body_ipos[torso] = self._torso_ipos0
+        m.body_ipos[torso, :2] = (self._torso_mass0 * self._torso_ipos0[:2] + mass * offset) / total
+        mujoco.mj_setConst(m, self.data)
+
+    def _rebuild_needed(self, task: dict) -> bool:
+        """Whether the task changes the terrain geometry (the model is then rebuilt)."""
+        return False
+
     def step(self, action):
         action = self._validate_action(action, self.action_space)
         ctrl = self._ctrl_from_action(action)
@@ -214,7 +270,9 @@ class HeavyDutyEnv(HexapodEnv):
             # Keep training runs alive: end the episode with a flag, return the last good obs.
             return self._last_obs.copy(), 0.0, False, True, self._info({}, unstable=True)
         self._update_stability()
-        tipped = self._is_tipped_over()
+        # The penalty is paid once, on the step the robot tips over; stepping on after the
+        # episode terminated keeps `terminated` True and never pays it again.
+        tipped = self._is_tipped_over() and not self._tipped
         self._tipped = self._tipped or tipped
         self._power = float(
             np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
@@ -224,7 +282,7 @@ class HeavyDutyEnv(HexapodEnv):
         self._prev_cog_x = cog_x
         self._last_obs = self._observation()
         reward = float(sum(terms.values()))
-        return self._last_obs, reward, tipped, False, self._info(terms, unstable=False)
+        return self._last_obs, reward, self._tipped, False, self._info(terms, unstable=False)
 
     def _before_physics(self) -> None:
         """Hook run before each control period's physics (e.g. driving a platform)."""
@@ -266,7 +324,7 @@ class HeavyDutyEnv(HexapodEnv):
         """Named reward terms; the progress term only in walking scenarios."""
         w = self.weights
         v_ref = self.gait.gait.body_speed
-        margin = min(max(self._fasm_deg, -XI_F_DEG), 45.0)
+        margin = min(max(self._fasm_deg, -self.tipping_threshold_deg), 45.0)
         terms = {}
         if self.walks:
             # Progress up to the reference gait's speed: faster is not rewarded, so a policy
@@ -289,7 +347,7 @@ class HeavyDutyEnv(HexapodEnv):
             fasm_margin_deg=self._fasm_deg,
             fasm_edge=edge,
             stance_legs=stance,
-            is_tipping=self._fasm_deg < XI_F_DEG,
+            is_tipping=self._fasm_deg < self.tipping_threshold_deg,
             is_tipped_over=self._tipped,
             is_success=not self._tipped and not unstable and self._made_progress(cog),
             actuator_power_w=self._power,
@@ -297,6 +355,7 @@ class HeavyDutyEnv(HexapodEnv):
             time=self.time,
             cog=cog.copy(),
             distance=float(cog[0] - self._start_cog[0]),
+            task=dict(self.task),
         )
         info.update(self._extra_info())
         return info

@@ -15,6 +15,12 @@ gait of eqs. (19)-(23) (t_g = 1 s per phase, control at 20 Hz) over
 The block heights are drawn from the episode's ``np_random`` at every reset (one bed per seed);
 ``block_layout_seed=<int>`` fixes one bed for all episodes.
 
+Task distributions (``task_distribution=``): "paper" (default) is the terrain above; "train" /
+"test" draw the slope, the block bed's highest block and block size, friction and servo
+stiffness at every reset from `TERRAIN_TRAIN` / `TERRAIN_TEST` (held out: slopes 8.5-11.5 deg,
+taller and smaller blocks, lower friction, stiffness farther from nominal). ``info["task"]``
+holds the values. ``sensor_noise`` adds Gaussian noise to the observed foot forces and IMU.
+
 Servos and gait. The paper's joints are servos with a 1.89 N·m stall torque. Ours are
 proportional position servos with that torque limit, a stiffness ``servo_kp`` and viscous damping
 ``servo_damping``. The default stiffness, 8 N·m/rad, reaches the stall torque at 0.24 rad (13.5°)
@@ -117,6 +123,48 @@ blocks' steps of up to 9 cm from one block to the next). The paper gives no valu
 RAMP_TOP_LENGTH = 2.0
 """Flat top after the slope [m], long enough that a 1200-step episode ends on it."""
 
+
+@dataclasses.dataclass(frozen=True)
+class TerrainTaskRanges:
+    """Ranges of one task distribution (uniform draws; a tuple of ranges: one chosen at random).
+
+    Held-out test ranges (`TERRAIN_TEST`): slopes interleaved with training (8.5-11.5 deg, which
+    holds the paper's 10 deg, against 5-8.5 and 11.5-15), taller blocks and smaller blocks than
+    in training (extrapolated), lower friction, servo stiffness farther from nominal.
+    """
+
+    slope_deg: tuple[tuple[float, float], ...]
+    block_height_max: tuple[float, float]
+    """Highest block [m] (blocks are drawn 0.04 m up to it)."""
+    block_size: tuple[float, float]
+    """Block edge length [m] (square blocks)."""
+    friction: tuple[float, float]
+    servo_kp_scale: tuple[tuple[float, float], ...]
+    """Servo stiffness as a multiple of `servo_kp`."""
+
+
+TERRAIN_TRAIN = TerrainTaskRanges(
+    slope_deg=((5.0, 8.5), (11.5, 15.0)),
+    block_height_max=(0.08, 0.12),
+    block_size=(0.10, 0.14),
+    friction=(0.7, 1.1),
+    servo_kp_scale=((0.85, 1.15),),
+)
+TERRAIN_TEST = TerrainTaskRanges(
+    slope_deg=((8.5, 11.5),),
+    block_height_max=(0.12, 0.15),
+    block_size=(0.08, 0.10),
+    friction=(0.5, 0.7),
+    servo_kp_scale=((0.7, 0.85), (1.15, 1.3)),
+)
+TERRAIN_RANGES = {"train": TERRAIN_TRAIN, "test": TERRAIN_TEST}
+
+
+def _uniform_in(rng: np.random.Generator, ranges: tuple[tuple[float, float], ...]) -> float:
+    low, high = ranges[int(rng.integers(len(ranges)))]
+    return float(rng.uniform(low, high))
+
+
 _CONTACT_CHECKS = 5
 """Torso-terrain contact is looked for this many times per control period (every 10 ms)."""
 
@@ -207,6 +255,8 @@ class IrregularTerrainEnv(HexapodEnv):
         width: int = 640,
         height: int = 480,
         camera_name: str | None = None,
+        task_distribution: str = "paper",
+        sensor_noise: float = 0.0,
     ):
         super().__init__(
             control_dt=control_dt,
@@ -215,6 +265,8 @@ class IrregularTerrainEnv(HexapodEnv):
             width=width,
             height=height,
             camera_name=camera_name,
+            task_distribution=task_distribution,
+            sensor_noise=sensor_noise,
         )
         check_choice("terrain", terrain, TERRAINS)
         check_choice("action_mode", action_mode, ACTION_MODES)
@@ -275,6 +327,7 @@ class IrregularTerrainEnv(HexapodEnv):
             "tip_over": tip_over_penalty,
         }
         self.tipping_threshold_deg = float(tipping_threshold_deg)
+        self.stability_criterion = f"FASM >= {self.tipping_threshold_deg:g} deg"
         self.tip_over_cos = float(np.cos(np.radians(tip_over_angle_deg)))
         self.reset_noise_scale = float(reset_noise_scale)
         self.settle_time = float(settle_time)
@@ -287,6 +340,14 @@ class IrregularTerrainEnv(HexapodEnv):
         else:
             self.action_space = spaces.Box(-1.0, 1.0, shape=(18,), dtype=np.float32)
         self._contact_force_sq = self.contact_threshold**2
+        self._paper = {
+            "slope_deg": self.ramp["slope_deg"],
+            "block_height_max": float(self.blocks["height_range"][1]),
+            "block_size": float(self.blocks["block_size"][0]),
+            "friction": self.friction,
+            "servo_kp": float(servo_kp),
+        }
+        self._built_task = self.paper_task()
         self._build(np.random.default_rng(block_layout_seed or 0))
         self._set_observation_layout(
             {
@@ -363,10 +424,59 @@ class IrregularTerrainEnv(HexapodEnv):
         return (0.0, 0.0, top + standing + 0.003), (1.0, 0.0, 0.0, 0.0)
 
     # --- reset / step --------------------------------------------------------------------
+    def _reference_description(self) -> dict:
+        """The reference gait: `AthenaPostureController` settings, gains, ticks per cycle,
+        residual scale and the ramp geometry."""
+        return {
+            "gait_config": dict(self.gait_config),
+            "reference_gains": self.reference_gains,
+            "ticks_per_cycle": self.ticks_per_cycle,
+            "residual_scale": self.residual_scale,
+            "ramp": dict(self.ramp),
+        }
+
+    # --- task distribution -----------------------------------------------------------------
+    def paper_task(self) -> dict:
+        return {
+            "terrain": self.terrain,
+            "slope_deg": self._paper["slope_deg"],
+            "block_height_max": self._paper["block_height_max"],
+            "block_size": self._paper["block_size"],
+            "friction": self._paper["friction"],
+            "servo_kp": self._paper["servo_kp"],
+        }
+
+    def sample_task(self, rng: np.random.Generator, distribution: str) -> dict:
+        r = TERRAIN_RANGES[distribution]
+        return {
+            "terrain": self.terrain,
+            "slope_deg": _uniform_in(rng, r.slope_deg),
+            "block_height_max": float(rng.uniform(*r.block_height_max)),
+            "block_size": float(rng.uniform(*r.block_size)),
+            "friction": float(rng.uniform(*r.friction)),
+            "servo_kp": self._paper["servo_kp"] * _uniform_in(rng, r.servo_kp_scale),
+        }
+
+    def _apply_task(self, task: dict) -> bool:
+        """Set the terrain and servo parameters of `task`; True if the model must be rebuilt."""
+        if task == self._built_task:
+            return False
+        self._built_task = dict(task)
+        self.ramp["slope_deg"] = task["slope_deg"]
+        low = self.blocks["height_range"][0]
+        self.blocks["height_range"] = (low, max(low, task["block_height_max"]))
+        self.blocks["block_size"] = (task["block_size"], task["block_size"])
+        self.friction = task["friction"]
+        self.robot = dataclasses.replace(self.robot, servo_kp=task["servo_kp"])
+        return True
+
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed)
+        super().reset(seed=seed, options=options)
+        rebuild = self._apply_task(self.task)
         if self.terrain == "blocks" and self.block_layout_seed is None:
             self._build(self.np_random)  # a new test bed per episode, from the episode's seed
+        elif rebuild:
+            self._build(np.random.default_rng(self.block_layout_seed or 0))
         mujoco.mj_resetData(self.model, self.data)
         standing = np.tile(self.robot.standing_posture, 6)
         noise = self.reset_noise_scale * self.action_map.half
@@ -409,14 +519,16 @@ class IrregularTerrainEnv(HexapodEnv):
         self._touched = touched
         self._collisions += touched
         self._read_sensors()
+        # The penalty is paid once; stepping on after termination keeps `terminated` True.
         tipped = bool(self.data.xmat[self.sensors.torso_id, 8] < self.tip_over_cos)
+        tipped = tipped and not self._tipped
         self._tipped = self._tipped or tipped
         terms = self._reward_terms(touched, tipped)
         cycle_stats = self._update_cycle_window(touched)
         self._prev_cog_x = float(self._cog[0])
         self._last_obs = self._observation()
         reward = float(sum(terms.values()))
-        return self._last_obs, reward, tipped, False, self._info(terms, False, cycle_stats)
+        return self._last_obs, reward, self._tipped, False, self._info(terms, False, cycle_stats)
 
     def _ctrl_from_action(self, action: np.ndarray) -> np.ndarray:
         if self.action_mode == "joint":
@@ -607,6 +719,7 @@ class IrregularTerrainEnv(HexapodEnv):
             posture_gains=self.controller.gains if self.action_mode != "joint" else None,
             gait_cycle=self._gait_cycle_index(),
             cycle_stats=cycle_stats,
+            task=dict(self.task),
         )
         if cycle_stats is not None or self._step_count == 0:
             # A fresh copy whenever the lists change (and at reset): infos must not share data.

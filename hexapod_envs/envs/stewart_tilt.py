@@ -20,6 +20,11 @@ The hold posture is a little taller and narrower than the walking stance (feet a
 1.95 m below the hips) so that the side case tips within the platform's reach (the 6-UPS
 platform tilts at most ~44-46 deg; the walking stance would need 48.5 deg).
 
+Task distributions (``task_distribution=``): "paper" (default) runs `scenario`; "train" /
+"test" draw the held tripod, the tilt axis (one of the six paper cases or an arbitrary axis),
+the tilt rate, the platform friction and a payload at every reset from `TILT_TRAIN` /
+`TILT_TEST` (held out: rates 4-8 and 12-20 deg/s). ``info["task"]`` holds the values.
+
 Observation: as HexapodCliffWalk-v0 without the gait phase (joint_pos, joint_vel, foot_force,
 foot_contact, fasm_margin_deg, imu_gyro, imu_accel, imu_quat). Action: 18 values in [-1, 1];
 ``"residual"`` (default) offsets the hold posture by residual_scale x half range (default 2, so
@@ -30,6 +35,8 @@ adjustment_leg (the first lifted leg to land after tipping was flagged) and reco
 
 from __future__ import annotations
 
+import dataclasses
+
 import mujoco
 import numpy as np
 
@@ -37,7 +44,7 @@ from ..robots.heavy_duty import LEG_NAMES, TRIPODS, joints_for_foot
 from ..terrain.stewart import add_stewart_platform
 from ..terrain.stewart_kinematics import DEFAULT_PLATFORM
 from .base import check_choice
-from .heavy_duty import XI_F_DEG, HeavyDutyEnv
+from .heavy_duty import HeavyDutyEnv
 
 SCENARIOS = ("climb", "descend", "side", "random")
 STANCES = {"LF-LR-RM": TRIPODS[0], "LM-RF-RR": TRIPODS[1]}
@@ -51,6 +58,31 @@ SWING_LIFT = 0.45
 DEFAULT_MAX_TILT_DEG = {"climb": 38.0, "descend": 38.0, "side": 44.0}
 RAMP_TIME = 1.0
 """Time to reach (and leave) the tilt rate [s]."""
+
+
+CASES = tuple((scenario, stance) for scenario in ("climb", "descend", "side") for stance in STANCES)
+"""The paper's six cases: three tilt directions for each held tripod."""
+
+
+@dataclasses.dataclass(frozen=True)
+class TiltTaskRanges:
+    """Ranges of one task distribution. Each reset holds a random tripod and tilts either about
+    one of the six paper cases' axes (probability `case_probability`) or about an arbitrary
+    horizontal axis, at a rate drawn uniformly from one of `rates_deg_s` (chosen at random).
+
+    Held-out test ranges (`TILT_TEST`): tilt rates interleaved with and beyond training (4-8 and
+    12-20 deg/s against 1-4 and 8-12), where the time budget of seed 000 eq. 15 binds; lower
+    platform friction; a heavier payload (see `HeavyDutyEnv.PAYLOAD_RANGES`).
+    """
+
+    rates_deg_s: tuple[tuple[float, float], ...]
+    friction: tuple[float, float]
+    case_probability: float = 0.5
+
+
+TILT_TRAIN = TiltTaskRanges(rates_deg_s=((1.0, 4.0), (8.0, 12.0)), friction=(1.2, 1.8))
+TILT_TEST = TiltTaskRanges(rates_deg_s=((4.0, 8.0), (12.0, 20.0)), friction=(0.9, 1.2))
+TILT_RANGES = {"train": TILT_TRAIN, "test": TILT_TEST}
 
 
 def tilt_axis(scenario: str, stance: tuple[str, ...]) -> np.ndarray:
@@ -94,6 +126,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         self.tilt_rate = np.radians(tilt_rate_deg)
         self.settle = settle_time
         self.platform_friction = platform_friction
+        self._paper_friction = platform_friction
         self._max_tilt_arg = max_tilt_deg
         self.platform = DEFAULT_PLATFORM
         super().__init__(
@@ -182,8 +215,59 @@ class StewartTiltEnv(HeavyDutyEnv):
     def _initial_joints(self) -> np.ndarray:
         return self._hold
 
+    # --- task distribution -----------------------------------------------------------------
+    def paper_task(self) -> dict:
+        axis = {}
+        if self.scenario != "random":
+            a = tilt_axis(self.scenario, STANCES[self.stance_name])
+            axis = {"tilt_axis_x": float(a[0]), "tilt_axis_y": float(a[1])}
+        return {
+            "scenario": self.scenario,
+            "stance": self.stance_name,
+            **axis,
+            "tilt_rate_deg": float(np.degrees(self.tilt_rate)),
+            "platform_friction": float(self._paper_friction),
+            "payload_mass": 0.0,
+            "payload_offset_x": 0.0,
+            "payload_offset_y": 0.0,
+        }
+
+    def sample_task(self, rng: np.random.Generator, distribution: str) -> dict:
+        r = TILT_RANGES[distribution]
+        if rng.uniform() < r.case_probability:
+            scenario, stance = CASES[int(rng.integers(len(CASES)))]
+            axis = tilt_axis(scenario, STANCES[stance])
+        else:
+            scenario, stance = "random", sorted(STANCES)[int(rng.integers(2))]
+            angle = rng.uniform(0, 2 * np.pi)
+            axis = np.array([np.cos(angle), np.sin(angle), 0.0])
+        band = r.rates_deg_s[int(rng.integers(len(r.rates_deg_s)))]
+        return {
+            "scenario": scenario,
+            "stance": stance,
+            "tilt_axis_x": float(axis[0]),
+            "tilt_axis_y": float(axis[1]),
+            "tilt_rate_deg": float(rng.uniform(*band)),
+            "platform_friction": float(rng.uniform(*r.friction)),
+            **self._sample_payload(rng, distribution),
+        }
+
+    def _rebuild_needed(self, task: dict) -> bool:
+        if task["platform_friction"] == self.platform_friction:
+            return False
+        self.platform_friction = task["platform_friction"]
+        return True
+
+    def _configure_sampled(self, task: dict) -> None:
+        axis = np.array([task["tilt_axis_x"], task["tilt_axis_y"], 0.0])
+        scenario = task["scenario"]
+        self._configure(scenario, STANCES[task["stance"]], np.radians(task["tilt_rate_deg"]), axis)
+        self.max_tilt = min(self.max_tilt, 0.95 * self.platform.max_tilt(axis))
+
     def _on_reset(self) -> None:
-        if self.scenario == "random":
+        if self.task_distribution != "paper":
+            self._configure_sampled(self.task)
+        elif self.scenario == "random":
             rng = self.np_random
             stance = STANCES[sorted(STANCES)[int(rng.integers(2))]]
             angle = rng.uniform(0, 2 * np.pi)
@@ -192,6 +276,12 @@ class StewartTiltEnv(HeavyDutyEnv):
             self._configure("random", stance, rate, axis)
             reach = self.platform.max_tilt(axis)
             self.max_tilt = min(self.max_tilt, 0.95 * reach)
+            self.task.update(
+                stance="-".join(stance),
+                tilt_axis_x=float(axis[0]),
+                tilt_axis_y=float(axis[1]),
+                tilt_rate_deg=float(np.degrees(rate)),
+            )
         self.data.qpos[self._platform_qpos] = 0.0
         self.data.ctrl[self._platform_act] = 0.0
         self.data.act[self.model.actuator_actadr[self._platform_act]] = 0.0
@@ -219,7 +309,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         super()._update_stability()
         if self._step_count == 0:
             return
-        if self._first_tipping_time is None and self._fasm_deg < XI_F_DEG:
+        if self._first_tipping_time is None and self._fasm_deg < self.tipping_threshold_deg:
             self._first_tipping_time = self.time
         if self._first_tipping_time is not None and self._adjustment_leg is None:
             for i, leg in enumerate(LEG_NAMES):

@@ -1,0 +1,50 @@
+"""The `info` keys every hexapod env returns (from `reset` and every `step`), shared by the envs,
+the evaluation pipeline and the tests, so that one list says what a consumer may rely on.
+
+Env-specific keys (platform tilt, ZMP, planner status, ...) are documented in each env's module
+docstring; the keys below are common to all four envs.
+"""
+
+from __future__ import annotations
+
+FASM_MARGIN_DEG = "fasm_margin_deg"
+"""Force-angle stability margin from the measured foot forces [deg]; 0 without a support
+polygon (fewer than two loaded feet), never NaN."""
+STANCE_LEGS = "stance_legs"
+"""Tuple of the leg names whose foot carries more than the contact threshold."""
+IS_TIPPING = "is_tipping"
+"""True while the stability criterion fails (`env.unwrapped.stability_criterion`, e.g. FASM
+below the robot's `tipping_threshold_deg`)."""
+IS_TIPPED_OVER = "is_tipped_over"
+"""True from the step the body leaned past the env's tip-over angle (sticky for the episode)."""
+IS_SUCCESS = "is_success"
+"""The env's success rule (see the env's docstring), False on an unstable simulation."""
+SIM_UNSTABLE = "sim_unstable"
+"""True when MuJoCo met a numerical problem (bad qacc/qvel/qpos/ctrl warning or a reset clock);
+the step is then truncated with reward 0 and the last good observation."""
+TIME = "time"
+"""Episode time [s] (the settle phase in reset is not counted)."""
+COG = "cog"
+"""Centre of mass of the robot, world frame [m] (a fresh array every step)."""
+DISTANCE = "distance"
+"""CoG travel along +x since reset [m]."""
+TASK = "task"
+"""Flat dict of the episode's task parameters (plain floats, ints, strings): the paper
+scenario's values with ``task_distribution="paper"``, the sampled ones with "train"/"test"."""
+
+COMMON_INFO_KEYS: tuple[str, ...] = (
+    FASM_MARGIN_DEG,
+    STANCE_LEGS,
+    IS_TIPPING,
+    IS_TIPPED_OVER,
+    IS_SUCCESS,
+    SIM_UNSTABLE,
+    TIME,
+    COG,
+    DISTANCE,
+    TASK,
+)
+"""Keys present in the info of every reset and step of every hexapod env."""
+
+REWARD_PREFIX = "reward_"
+"""Each reward term is reported as ``info["reward_<term>"]``; the reward is their sum."""
