@@ -55,7 +55,7 @@ def render() -> str:
             size = env.observation_space.shape[0]
             low, high = env.action_space.low.min(), env.action_space.high.max()
             lines += [
-                f"### action_mode=\"{mode}\": observation size {size}, "
+                f'### action_mode="{mode}": observation size {size}, '
                 f"action shape {env.action_space.shape} in [{low:g}, {high:g}]",
                 "",
                 "| piece | indices | size |",

@@ -289,8 +289,8 @@ HOW_TO_READ = [
     "tip-over angle, counted in the tip-over column.",
     "- **ξ** is the robot's FASM threshold (below it the robot is judged to be tipping); it "
     "differs per robot and is listed per env below. Where the paper judges a robot by another "
-    "criterion (the 3-UPU robot: the static margin), no ξ applies and the FASM is shown for "
-    "comparison only.",
+    "criterion (the 3-UPU robot: the static margin > 0), its FASM is shown for comparison and "
+    "ξ = 0° only marks a net force outside the support polygon.",
     "- **Success** is the env's `is_success` at the episode's end: the cliff walk and the "
     "Stewart tilt: no tip-over to the time limit; the irregular terrain: no tip-over and no torso "
     "contact; the ditch crossing: across the ditch with the static margin above 0.",

@@ -176,11 +176,10 @@ class DitchCrossingEnv(HexapodEnv):
     ``schedule`` (the reference gait), ``gait_settings``, ``gait_timing``.
     """
 
-    tipping_threshold_deg = None
-    """No FASM threshold: the paper judges this robot by its static margin (observation
-    ``static_margin_m``); the FASM is observed and reported for comparison only."""
+    tipping_threshold_deg = 0.0
+    """The paper judges this robot by its static margin (observation ``static_margin_m``), not
+    by a FASM threshold; 0 deg only marks a net force outside the support polygon."""
     stability_criterion = "static margin > 0 mm (CoG projection inside the support triangle)"
-
 
     def __init__(
         self,
@@ -429,11 +428,7 @@ class DitchCrossingEnv(HexapodEnv):
                 values[key] = float(self.np_random.uniform(rng[0], rng[1]))
         return Ditch(values["ditch_start_x"], values["ditch_width"], values["ditch_depth"])
 
-    # --- reset / step ------------------------------------------------------------------------
-    # --- task distribution ---------------------------------------------------------------------
-    tipping_threshold_deg = 0.0
-    stability_criterion = "static margin > 0 mm"
-
+    # --- task description ----------------------------------------------------------------------
     def _robot_params(self):
         return self.params
 

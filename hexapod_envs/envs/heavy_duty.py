@@ -33,15 +33,12 @@ ACTION_MODES = ("joint", "residual")
 class HeavyDutyEnv(HexapodEnv):
     """Base for the heavy-duty hexapod scenarios: robot, sensors, FASM, action modes, rewards."""
 
-    tipping_threshold_deg = XI_F_DEG
-    stability_criterion = f"FASM >= {XI_F_DEG:g} deg"
-
     walks: bool = True
     """Walking scenarios follow the reference tripod gait and observe its phase."""
 
     tipping_threshold_deg: float = XI_F_DEG
     """ξ_f [deg]: FASM below it means the robot is tipping (the paper's judgment threshold)."""
-    stability_criterion = "FASM >= ξ_f = 20 deg (tipping judgment threshold of the paper)"
+    stability_criterion = f"FASM >= ξ_f = {XI_F_DEG:g} deg (the paper's tipping judgment)"
 
     def __init__(
         self,

@@ -172,10 +172,6 @@ _CONTACT_CHECKS = 5
 class IrregularTerrainEnv(HexapodEnv):
     """ATHENA on a ramp, a block test bed or flat ground; see the module docstring."""
 
-    stability_criterion = (
-        "FASM >= tipping_threshold_deg (10 deg by default; the paper itself reports the ZMP margin)"
-    )
-
     evaluation_metrics = {
         "torso_collisions": {
             "reduce": "last",
