@@ -348,8 +348,10 @@ def tipping_force_matrices(
         la = _v_cross(lv, a)
         inv = 1.0 / (l_norm * l_norm)
         couple[i] = [[la[r] * a[s] * inv for s in range(3)] for r in range(3)]
-    force_part = np.tile(np.eye(3) - aa, (1, 1, k))
-    return force_part + couple @ moment_rows
+    out = couple @ moment_rows  # (m, 3, 3k)
+    # + [I - a aᵀ ... I - a aᵀ], added per foot block in place (np.tile cost a copy).
+    out.reshape(m, 3, k, 3)[...] += (np.eye(3) - aa)[:, :, None, :]
+    return out
 
 
 @dataclass(frozen=True)
@@ -486,7 +488,9 @@ class ForceDistributor:
 
         cone = None
         hull = support_polygon(feet, up=n)
-        edges = np.column_stack([hull, np.roll(hull, -1)])
+        edges = np.empty((len(hull), 2), dtype=np.intp)
+        edges[:, 0] = hull
+        edges[:-1, 1], edges[-1, 1] = hull[1:], hull[0]  # next vertex, wrapping (np.roll is slow)
         n_cone = 4 * len(edges) if cfg.stability_cone else 0
         g_mat = np.zeros((5 * k + n_cone, 3 * k))
         h_vec = np.zeros(5 * k + n_cone)
