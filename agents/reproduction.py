@@ -539,6 +539,7 @@ FULL = {
         cliff_judgment_rows,
         table_ii_rows,
         stewart_rows,
+        stewart_paper_reach_rows,
         stewart_stop_rows,
     ),
     "002": (athena_rows, athena_calibrated_rows),
