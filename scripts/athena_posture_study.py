@@ -58,19 +58,20 @@ def plot(terrain: str, result: dict, path: Path) -> None:
 
 
 def report(terrain: str, result: dict) -> dict:
-    s, change = result["summary"], result["change_pct"]
+    s = result["summary"]
+    changes: dict[str, float | None] = {}
     print(f"\n{terrain}: gains {result['gains']}")
     print(f"  {'metric':24s} {'simple':>10s} {'posture':>10s} {'change':>9s} {'paper':>9s}")
     for metric in ("height", "pitch_rate", "roll_rate", "zmp_margin", "zmp_margin_step"):
         a, b = s["simple"][f"{metric}_median"], s["posture"][f"{metric}_median"]
         paper = PAPER_CHANGES.get(terrain, {}).get(metric)
         paper_txt = f"{paper:+8.2f}%" if paper is not None else f"{'-':>9s}"
-        change = percent_change(a, b)
+        change = changes[metric] = percent_change(a, b)
         change_txt = f"{change:+8.1f}%" if change is not None else f"{'n/a':>9s}"
         print(f"  {metric + ' median':24s} {a:10.4f} {b:10.4f} {change_txt} {paper_txt}")
     for key in ("episodes_with_collision", "torso_collision_steps", "mean_distance"):
         print(f"  {key:24s} {s['simple'][key]:10.3g} {s['posture'][key]:10.3g}")
-    return {"gains": result["gains"], "summary": s, "change_pct": change}
+    return {"gains": result["gains"], "summary": s, "change_pct": changes}
 
 
 def main(argv: list[str] | None = None) -> None:

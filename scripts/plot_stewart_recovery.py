@@ -47,9 +47,19 @@ PAPER = {  # seed 000 §5.2: adjustment leg, adjustment time t_s [s], foothold [
 LEG_COLORS = dict(zip(LEG_NAMES, plt.cm.tab10.colors[:6], strict=True))
 
 
-def run(scenario: str, stance: str, controlled: bool, seed: int, **policy_kwargs) -> dict:
-    """One episode; per-step time series and the controller's final diagnostics."""
-    env = gym.make("HexapodStewartTilt-v0", scenario=scenario, stance=stance)
+def run(
+    scenario: str,
+    stance: str,
+    controlled: bool,
+    seed: int,
+    env_kwargs: dict | None = None,
+    **policy_kwargs,
+) -> dict:
+    """One episode; per-step time series and the controller's final diagnostics.
+
+    `env_kwargs` go to the env (e.g. tilt_rate_deg, max_tilt_deg), `policy_kwargs` to
+    TippingRecoveryPolicy."""
+    env = gym.make("HexapodStewartTilt-v0", scenario=scenario, stance=stance, **(env_kwargs or {}))
     s = env.unwrapped.observation_structure
     policy = TippingRecoveryPolicy(env, **policy_kwargs) if controlled else None
     obs, info = env.reset(seed=seed)

@@ -27,6 +27,13 @@ f*·l̂ = f_r·l̂ and f*·t̂ = f_r·t̂ - (a·n_r)/‖l‖ (because l̂ × a =
 which equals the ±acos form with its sign rule ((l̂ × f̂*)·a = f̂*·t̂) and needs no clipping.
 f_r·(a × l) - a·n_r is minus the moment of the destabilising wrench about the edge axis a, so
 θ_i < 0 exactly when that wrench rolls the body over the edge.
+
+Note on seed 000's printed eq. (8): it gives θ = +acos(l̂·f*) when (l̂·f*)·â < 0 and -acos
+otherwise. As printed the condition multiplies a scalar by a vector (a dot where Papadopoulos &
+Rey have a cross product); dropping the vector factor, it would make every angle with l̂·f* > 0
+negative, i.e. call a robot standing upright unstable. This module uses Papadopoulos & Rey's rule,
++ when (l̂ × f̂*)·â > 0, with which the paper's own figures are reproduced (standing ≈ 48°,
+31.41° at the tripod switch; see reports/reproduction.md).
 """
 
 from __future__ import annotations

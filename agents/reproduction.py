@@ -1,0 +1,619 @@
+"""Rows of the reproduction report: each headline number of the three papers beside ours.
+
+Every row is a dict with `id`, `paper`, `quantity`, `paper_value`, `value`, `unit`,
+`tolerance` (human phrase), `holds` (bool) and `setting` (how it was measured). Every value is
+simulated when the report is made, by the measurement code of the study scripts and tests
+(agents.athena_study, scripts/plot_stewart_recovery.py, scripts/plot_cliff_recovery.py);
+`quick` keeps the closed-form rows (Table II, 3-UPU limb length and IK).
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _row(id_, paper, quantity, paper_value, value, unit, tolerance, holds, setting):
+    return {
+        "id": id_,
+        "paper": paper,
+        "quantity": quantity,
+        "paper_value": paper_value,
+        "value": value,
+        "unit": unit,
+        "tolerance": tolerance,
+        "holds": bool(holds),
+        "setting": setting,
+    }
+
+
+def cliff_flat_walk_rows(cycles: int = 5) -> list[dict]:
+    """Rows 1-3 (seed 000 §5.1): FASM standing, at the tripod switch, and its walking band.
+
+    Same protocol as tests/test_cliff_walk.py: 150 standing steps then `cycles` tripod cycles.
+    """
+    import gymnasium as gym
+
+    import hexapod_envs  # noqa: F401  (registers the env ids)
+    from agents.tripod_gait import TripodGaitPolicy
+
+    steps = 150 + cycles * 300 + 10
+    env = gym.make(
+        "HexapodCliffWalk-v0", terrain="flat", action_mode="joint", max_episode_steps=steps
+    )
+    policy = TripodGaitPolicy(env)
+    obs, info = env.reset(seed=0)
+    policy.reset()
+    infos = [info]
+    for _ in range(steps):
+        obs, _, terminated, truncated, info = env.step(policy(obs))
+        infos.append(info)
+        if terminated or truncated:
+            break
+    env.close()
+    standing = float(np.median([i["fasm_margin_deg"] for i in infos[10:150]]))
+    switches = [
+        infos[k]["fasm_margin_deg"]
+        for k in range(151, len(infos))
+        if len(infos[k - 1]["stance_legs"]) > 3 and len(infos[k]["stance_legs"]) == 3
+    ]
+    walking = np.array([i["fasm_margin_deg"] for i in infos[151:]])
+    setting = f"HexapodCliffWalk-v0 terrain=flat, tripod gait, seed 0, {cycles} cycles"
+    sw = float(np.median(switches))
+    return [
+        _row(
+            "1",
+            "000",
+            "FASM standing on six legs (median)",
+            48.0,
+            round(standing, 2),
+            "deg",
+            "46-50",
+            46.0 <= standing <= 50.0,
+            setting,
+        ),
+        _row(
+            "2",
+            "000",
+            "FASM at the switch to three legs (median)",
+            31.41,
+            round(sw, 2),
+            "deg",
+            "29-33",
+            29.0 <= sw <= 33.0,
+            setting + f", {len(switches)} switches",
+        ),
+        _row(
+            "3",
+            "000",
+            "FASM band while walking (min, max)",
+            [21.0, 51.0],
+            [round(float(walking.min()), 2), round(float(walking.max()), 2)],
+            "deg",
+            "within 18-53",
+            walking.min() >= 18.0 and walking.max() <= 53.0,
+            setting,
+        ),
+    ]
+
+
+def table_ii_rows() -> list[dict]:
+    """Row 5 (seed 000 Table II): adjustment leg for each of the six tipping edges."""
+    from agents.tipping.judgment import select_adjustment_leg
+    from hexapod_envs.robots.heavy_duty import TRIPODS
+
+    t1, t2 = TRIPODS
+    table = [
+        (t1, ("LF", "LR"), "LM"),
+        (t1, ("LR", "RM"), "RR"),
+        (t1, ("RM", "LF"), "RF"),
+        (t2, ("LM", "RF"), "LF"),
+        (t2, ("RF", "RR"), "RM"),
+        (t2, ("RR", "LM"), "LR"),
+    ]
+    ok = sum(
+        select_adjustment_leg(s, e) == leg and select_adjustment_leg(s, e[::-1]) == leg
+        for s, e, leg in table
+    )
+    return [
+        _row(
+            "5",
+            "000",
+            "Table II adjustment legs matched",
+            6,
+            int(ok),
+            "of 6",
+            "6/6",
+            ok == 6,
+            "agents.tipping.judgment.select_adjustment_leg, both edge orders",
+        )
+    ]
+
+
+def upu_kinematics_rows() -> list[dict]:
+    """Row 12 (seed 003 §4): limb 1 length at (80, 0, 443) mm, and the IK/FK round trip."""
+    from hexapod_envs.robots.upu.kinematics import forward_kinematics, inverse_kinematics
+    from hexapod_envs.robots.upu.params import UpuParams
+
+    p = UpuParams()
+    point = np.array([0.080, 0.0, 0.443])
+    lengths = inverse_kinematics(point, p)
+    limb = float(lengths[0]) * 1e3
+    back = np.asarray(forward_kinematics(lengths, p), dtype=float)
+    err = float(np.linalg.norm(np.ravel(back)[:3] - point)) * 1e3
+    setting = "UpuParams() defaults, upper platform at (80, 0, 443) mm"
+    return [
+        _row(
+            "12",
+            "003",
+            "limb 1 length at (80, 0, 443) mm",
+            457.7,
+            round(limb, 3),
+            "mm",
+            "+-0.05",
+            abs(limb - 457.7) <= 0.05,
+            setting,
+        ),
+        _row(
+            "12b",
+            "003",
+            "IK -> FK round-trip error",
+            0.0,
+            round(err, 9),
+            "mm",
+            "< 1e-6",
+            err < 1e-6,
+            setting,
+        ),
+    ]
+
+
+def athena_rows(seeds=range(4), steps: int = 1200, env_kwargs: dict | None = None) -> list[dict]:
+    """Rows 8-11 (seed 002 §5.2): posture vs simple control on the ramp and the block bed,
+    measured with agents.athena_study.compare (the posture study's protocol, default env)."""
+    from agents.athena_study import compare
+
+    d = {"seeds": list(seeds), "steps": steps}
+    for terrain in ("ramp", "blocks"):
+        result = compare(terrain, d["seeds"], steps=steps, **(env_kwargs or {}))
+        d[terrain] = {"summary": result["summary"], "change_pct": result["change_pct"]}
+    ramp, blocks = d["ramp"], d["blocks"]
+    rc, bc = ramp["change_pct"], blocks["change_pct"]
+    n = len(d["seeds"])
+    setting = (
+        f"HexapodIrregularTerrain-v0 {env_kwargs or 'default env (servo_kp 8 N m/rad)'}, "
+        f"seeds 0-{n - 1} x "
+        f"{d['steps']} steps, medians of per-cycle RMS, posture vs simple (paper gains)"
+    )
+    bs, bp = blocks["summary"]["simple"], blocks["summary"]["posture"]
+
+    def r(x):
+        return None if x is None else round(float(x), 2)
+
+    posture_free = n - bp["episodes_with_collision"]
+    rows = [
+        _row(
+            "8",
+            "002",
+            "ramp torso height change",
+            60.77,
+            r(rc["height"]),
+            "%",
+            ">= +40",
+            rc["height"] >= 40.0,
+            setting,
+        ),
+        _row(
+            "9",
+            "002",
+            "ramp roll-rate change",
+            -35.98,
+            r(rc["roll_rate"]),
+            "%",
+            "< 0",
+            rc["roll_rate"] < 0.0,
+            setting,
+        ),
+        _row(
+            "10",
+            "002",
+            "ramp pitch-rate change",
+            -11.92,
+            r(rc["pitch_rate"]),
+            "%",
+            "<= 0",
+            rc["pitch_rate"] <= 0.0,
+            setting,
+        ),
+        _row(
+            "11",
+            "002",
+            "blocks torso-contact steps, posture / simple",
+            [0, ">0"],
+            [bp["torso_collision_steps"], bs["torso_collision_steps"]],
+            "steps",
+            "posture 0 in >= 3 of 4 seeds, simple > 0 in all",
+            posture_free >= 3 and bs["episodes_with_collision"] == n,
+            setting + f"; posture touched in {bp['episodes_with_collision']} of {n} episodes",
+        ),
+        _row(
+            "11b",
+            "002",
+            "blocks pitch-rate change",
+            54.0,
+            r(bc["pitch_rate"]),
+            "%",
+            "same sign as paper",
+            bc["pitch_rate"] > 0,
+            setting,
+        ),
+        _row(
+            "11c",
+            "002",
+            "blocks roll-rate change",
+            82.0,
+            r(bc["roll_rate"]),
+            "%",
+            "same sign as paper",
+            bc["roll_rate"] > 0,
+            setting,
+        ),
+        _row(
+            "11d",
+            "002",
+            "ramp median torso height, simple control",
+            0.068,
+            round(ramp["summary"]["simple"]["height_median"], 4),
+            "m",
+            "+-0.005",
+            abs(ramp["summary"]["simple"]["height_median"] - 0.068) <= 0.005,
+            setting,
+        ),
+    ]
+    tag = "" if not env_kwargs else "@" + ",".join(f"{k}={v}" for k, v in env_kwargs.items())
+    for row in rows:
+        row["id"] += tag
+    return rows
+
+
+def ditch_episode(seed: int = 0, **env_kwargs) -> dict:
+    """One HexapodDitchCrossing-v0 episode with UpuGaitPolicy: success, minimum static margin."""
+    import gymnasium as gym
+
+    import hexapod_envs  # noqa: F401  (registers the env ids)
+    from agents.upu_gait import UpuGaitPolicy
+
+    env = gym.make("HexapodDitchCrossing-v0", **env_kwargs)
+    policy = UpuGaitPolicy(env)
+    obs, info = env.reset(seed=seed)
+    policy.reset()
+    margins, terminated, truncated = [], False, False
+    while not (terminated or truncated):
+        obs, _, terminated, truncated, info = env.step(policy(obs))
+        margins.append(info["static_margin_m"])
+    env.close()
+    return {
+        "status": policy.status,
+        "success": bool(info["is_success"]) and not info["is_tipped_over"],
+        "min_margin_m": float(np.min(margins)),
+    }
+
+
+DITCHES = (  # (id, width m, depth m, action mode, seed): the paper's and two others
+    ("14", 0.35, 0.14, "residual", 0),
+    ("14b", 0.25, 0.10, "joint", 1),
+    ("14c", 0.45, 0.15, "joint", 1),
+)
+
+
+def ditch_rows() -> list[dict]:
+    """Rows 13-14 (seed 003 §5-7): flat-walk static margin; the paper's 350 x 140 mm ditch
+    and two other sizes crossed with a positive margin at every control step."""
+    flat = ditch_episode(seed=2, terrain="flat", action_mode="joint")
+    rows = [
+        _row(
+            "13",
+            "003",
+            "flat walk minimum static margin",
+            "> 0",
+            round(flat["min_margin_m"] * 1e3, 2),
+            "mm",
+            "> 0",
+            flat["success"] and flat["min_margin_m"] > 0,
+            "HexapodDitchCrossing-v0 terrain=flat, joint mode, UpuGaitPolicy, seed 2",
+        ),
+    ]
+    for id_, width, depth, mode, seed in DITCHES:
+        r = ditch_episode(seed=seed, action_mode=mode, ditch_width=width, ditch_depth=depth)
+        rows.append(
+            _row(
+                id_,
+                "003",
+                f"{width * 1e3:.0f} mm wide x {depth * 1e3:.0f} mm deep ditch "
+                "crossed (min static margin)",
+                "crossed" if id_ == "14" else "(not in paper)",
+                round(r["min_margin_m"] * 1e3, 2),
+                "mm",
+                "crossed, margin > 0 at every step",
+                r["success"] and r["min_margin_m"] > 0,
+                f"HexapodDitchCrossing-v0 {mode} mode, UpuGaitPolicy, seed {seed}; "
+                f"planner status {r['status']}",
+            )
+        )
+    return rows
+
+
+def _script(name: str):
+    """Load `scripts/<name>.py` as a module (to reuse its measurement code, not duplicate it)."""
+    import importlib.util
+
+    path = ROOT / "scripts" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(f"_repro_{name}", path)
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def stewart_rows(seed: int = 0, cases=None, env_kwargs: dict | None = None) -> list[dict]:
+    """Rows 6, 7 and 7b (seed 000 §5.2) for each Stewart case with TippingRecoveryPolicy:
+    adjustment leg, t_s, FASM 0.5 s after landing and its minimum from landing to the end.
+
+    Uses `run` / `fasm_at` of scripts/plot_stewart_recovery.py with `env_kwargs` (default:
+    the env's defaults, 2 deg/s without a stop). With `env_kwargs` (a calibration setting, e.g.
+    STEWART_STOP) the row ids get the suffix "@" + the kwargs and row 6 is left out.
+    """
+    from agents.tipping.judgment import XI_F_DEG
+
+    mod = _script("plot_stewart_recovery")
+    tag = "" if not env_kwargs else "@" + ",".join(f"{k}={v}" for k, v in env_kwargs.items())
+    cases = mod.CASES if cases is None else cases
+    rows, legs_ok = [], 0
+    for scenario, stance in cases:
+        ctrl = mod.run(scenario, stance, controlled=True, seed=seed, env_kwargs=env_kwargs)
+        d = ctrl["diagnostics"]
+        p_leg, p_ts, _, p_after = mod.PAPER[(scenario, stance)]
+        legs_ok += d["adjustment_leg"] == p_leg
+        case = f"{scenario} {stance}" + tag
+        setting = (
+            f"HexapodStewartTilt-v0 scenario={scenario} stance={stance} {env_kwargs or ''}, "
+            f"seed {seed}"
+        )
+        ts = d["t_s"]
+        rows.append(
+            _row(
+                f"7b.{case}",
+                "000",
+                f"t_s, {case}",
+                p_ts,
+                None if ts is None else round(ts, 3),
+                "s",
+                "inside 0.5-2.5, not at a clamp (0.5 / 3.0)",
+                ts is not None and 0.5 < ts < 2.5,
+                setting,
+            )
+        )
+        landed = d["landing_time"]
+        if landed is None:
+            rows.append(
+                _row(
+                    f"7.{case}",
+                    "000",
+                    f"FASM after landing, {case}",
+                    p_after,
+                    None,
+                    "deg",
+                    ">= 35 / 35 / 20",
+                    False,
+                    setting + "; never landed",
+                )
+            )
+            continue
+        after = mod.fasm_at(ctrl, landed + 0.5)
+        later = ctrl["fasm"][ctrl["t"] >= landed + 0.5]
+        low = float(later.min()) if len(later) else float("nan")
+        need = 20.0 if scenario == "side" else 35.0
+        rows.append(
+            _row(
+                f"7.{case}",
+                "000",
+                f"FASM 0.5 s after landing / min to end, {case}",
+                p_after,
+                [round(after, 2), round(low, 2)],
+                "deg",
+                f">= {need:g} after 0.5 s, never below xi_f={XI_F_DEG:g} after",
+                after >= need and low >= XI_F_DEG and not ctrl["tipped"],
+                setting + f"; platform tilt at end {ctrl['tilt'][-1]:.1f} deg",
+            ),
+        )
+    if tag:
+        return rows
+    rows.insert(
+        0,
+        _row(
+            "6",
+            "000",
+            "Stewart adjustment leg as paper",
+            6,
+            legs_ok,
+            "of 6",
+            "6/6",
+            legs_ok == len(cases),
+            "HexapodStewartTilt-v0, six cases, seed 0",
+        ),
+    )
+    return rows
+
+
+def cliff_judgment_rows(seed: int = 0) -> list[dict]:
+    """Row 4 (seed 000 §5.1): the tipping judgment fires before the gait alone tips over.
+
+    Uses `rollout` of scripts/plot_cliff_recovery.py: judgment time of GaitWithRecoveryPolicy
+    (joint mode) and the tip-over time of TripodGaitPolicy alone, same seed and cliff.
+    """
+    mod = _script("plot_cliff_recovery")
+    gait = mod.rollout(*mod.RUNS["gait only"], seed)
+    ctrl = mod.rollout(*mod.RUNS["gait + recovery (joint mode)"], seed)
+    judged = ctrl["diagnostics"]["judgment_time"]
+    tipped_at = float(gait["t"][-1]) if gait["tipped"] else None
+    holds = judged is not None and tipped_at is not None and judged < tipped_at
+    return [
+        _row(
+            "4",
+            "000",
+            "cliff: judgment time / gait-alone tip-over time",
+            [22.08, 22.36],
+            [
+                None if judged is None else round(judged, 2),
+                None if tipped_at is None else round(tipped_at, 2),
+            ],
+            "s",
+            "judgment fires before",
+            holds,
+            f"HexapodCliffWalk-v0 default cliff, seed {seed}; recovery run tipped="
+            f"{ctrl['tipped']} (our walk starts at 3 s, the paper's cliff is reached later)",
+        )
+    ]
+
+
+STEWART_STOP = {"max_tilt_deg": 25.0}
+"""Calibration setting: the platform stops at 25 deg (2 deg/s). The paper does not give its final
+tilt; without a stop ours keeps tilting to 38-44 deg and the post-landing margin falls back below
+xi_f. Measured 25 deg: margins 0.5 s after landing 36.2 / 36.2 / 26.0 deg and >= 26 deg to the
+end; 30 deg at 10 deg/s: 21.9 deg (climb/descend) and the side case falls to 0."""
+
+
+ATHENA_SERVO_CALIBRATED = {"servo_kp": 6.8}
+"""Servo stiffness [N m/rad] at which the simple controller's median ramp torso height is the
+paper's 0.068 m (measured 0.0681 m over seeds 0-3; kp 8: 0.089 m, kp 6: 0.049 m). Not the env
+default: with it the ramp roll-rate RMS rises (+1.9 %, row 9 fails) and posture control still
+touches the blocks in 4/4 episodes, although rows 8, 11b, 11c and 11d then hold."""
+
+
+def athena_calibrated_rows() -> list[dict]:
+    """Rows 8-11 with the calibrated servo model (ATHENA_SERVO_CALIBRATED)."""
+    return athena_rows(env_kwargs=ATHENA_SERVO_CALIBRATED)
+
+
+def stewart_paper_reach_rows(seed: int = 0) -> list[dict]:
+    """Row 6b: the side cases with the paper's reach model (eqs. 10-12) instead of ours."""
+    mod = _script("plot_stewart_recovery")
+    rows = []
+    for stance in ("LF-LR-RM", "LM-RF-RR"):
+        ctrl = mod.run("side", stance, controlled=True, seed=seed, reach_model="paper")
+        d = ctrl["diagnostics"]
+        foot = d["foothold"]
+        p_foot = mod.PAPER[("side", stance)][2]
+        rows.append(
+            _row(
+                f"6b.side {stance}",
+                "000",
+                f"side {stance} recovers with the paper's reach model (foothold)",
+                ["recovers", list(p_foot)],
+                [
+                    "tipped" if ctrl["tipped"] else "recovers",
+                    None if foot is None else [round(float(v) * 1e3) for v in foot],
+                ],
+                "mm",
+                "no tip-over",
+                not ctrl["tipped"],
+                f"HexapodStewartTilt-v0 scenario=side stance={stance}, reach_model='paper', "
+                f"seed {seed}",
+            )
+        )
+    return rows
+
+
+def stewart_stop_rows() -> list[dict]:
+    """Rows 7 / 7b with the platform stopping at STEWART_STOP (calibration setting)."""
+    return stewart_rows(env_kwargs=STEWART_STOP)
+
+
+CHEAP = {"000": (table_ii_rows,), "003": (upu_kinematics_rows,)}
+FULL = {
+    "000": (
+        cliff_flat_walk_rows,
+        cliff_judgment_rows,
+        table_ii_rows,
+        stewart_rows,
+        stewart_paper_reach_rows,
+        stewart_stop_rows,
+    ),
+    "002": (athena_rows, athena_calibrated_rows),
+    "003": (upu_kinematics_rows, ditch_rows),
+}
+
+
+def collect(only: str | None = None, quick: bool = False) -> list[dict]:
+    """All rows (or only paper `only`, one of "000", "002", "003"); `quick` = cheap rows only."""
+    groups = CHEAP if quick else FULL
+    if only is not None and only not in FULL:
+        raise ValueError(f"only must be one of {sorted(FULL)}, got {only!r}")
+    rows = []
+    for paper, funcs in groups.items():
+        if only is None or paper == only:
+            for f in funcs:
+                rows.extend(f())
+    return rows
+
+
+NOTES = (
+    "7b (t_s, all cases, default 2 deg/s): t_s is the 3.0 s upper clamp. The margin falls at "
+    "only 1.7-2.0 deg/s, so eq. 15 forecasts 10-12 s. Tried: 5 deg/s gives 3.0 / 3.0 / 2.79 s, "
+    "10 deg/s 3.0 / 3.0 / 1.38 s, 20 deg/s the 0.5 s lower clamp, and the margin after landing "
+    "drops to 0-9 deg at >= 10 deg/s (no stop) or 0 deg sideways at 20 deg/s. No tilt rate gives "
+    "the paper's t_s with recovery intact.",
+    "7 (post-landing margin, default): 36.2 / 36.2 / 22.0 deg 0.5 s after landing, then the "
+    "platform keeps tilting to 38-44 deg and the margin falls to 13.5 / 13.5 / 3.6 deg. With the "
+    "platform stopping at 25 deg (STEWART_STOP, env kwarg max_tilt_deg=25; the paper does not "
+    "give its final tilt) the rows hold: 36.2 / 36.2 / 26.0 deg and >= 26 deg to the end.",
+    "8 (ramp height +14 % vs +60.77 %) and 11d (simple-control sag 0.089 m vs 0.068 m): the "
+    "default servo model (kp 8 N m/rad) sags less than the paper's robot; the servo model was not "
+    "recalibrated in this round (see reports/athena_gain_sweep.md for the stiffness sensitivity).",
+    "ATHENA servo calibration: servo_kp 6.8 N m/rad reproduces the 0.068 m sag (0.0681 m); "
+    "then ramp height +48 %, pitch rate -50 % and the blocks rate changes take the paper's sign, "
+    "but the ramp roll rate rises (+1.9 %, paper -36 %) and posture control still touches the "
+    "blocks in 4/4 episodes, so the env default stays at kp 8 (rows with @servo_kp=6.8).",
+    "11, 11b, 11c (blocks): posture control still touches the blocks (192 steps, 4/4 episodes) "
+    "and lowers the pitch/roll-rate RMS where the paper's rose; the block bed layout was not "
+    "recalibrated in this round.",
+    "6b (paper's reach model, side cases): the robot tips; the foothold (0, +-1889, -1946) mm is "
+    "the paper's kind but 163 mm lower (our hold posture stands taller), so the default is the "
+    "kinematic reach model. The leg geometry was not recalibrated in this round.",
+    "4 (cliff): our gait starts walking at 3 s and meets the cliff earlier than the paper's, so "
+    "the absolute times differ; the order (judgment before the tip-over) holds.",
+)
+"""Causes of the rows that fall short, measured (see the rows' settings)."""
+
+
+def markdown(rows: list[dict]) -> str:
+    """The rows as a Markdown table."""
+    lines = [
+        "# Reproduction of the three papers",
+        "",
+        "Generated by `python scripts/reproduce_papers.py` (every value simulated or computed",
+        "in that run; `holds` compares it with the tolerance). Papers: 000 heavy-duty hexapod",
+        "tipping recovery, 002 ATHENA posture control, 003 3-UPU hexapod ditch crossing.",
+        "",
+        "| id | paper | quantity | paper | ours | unit | tolerance | holds | setting |",
+        "|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r['id']} | {r['paper']} | {r['quantity']} | {r['paper_value']} | {r['value']} "
+            f"| {r['unit']} | {r['tolerance']} | {'yes' if r['holds'] else '**no**'} "
+            f"| {r['setting']} |"
+        )
+    lines += ["", "## Rows that do not hold, and why (measured)", ""]
+    lines += [f"- {note}" for note in NOTES]
+    return "\n".join(lines) + "\n"
+
+
+def _isclose(a, b) -> bool:
+    """Equal, or within 1e-6 (relative and absolute) for numbers."""
+    if isinstance(a, (int, float)) and isinstance(b, (int, float)):
+        return math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-6)
+    return a == b

@@ -1,0 +1,37 @@
+"""Regenerate the reproduction report: the three papers' headline numbers beside ours.
+
+Run: python scripts/reproduce_papers.py [--only 000|002|003] [--quick] [--out reports]
+Writes `reproduction.md` and `reproduction.json` under --out (rows: see agents/reproduction.py).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from agents.reproduction import collect, markdown  # noqa: E402
+
+
+def main(argv: list[str] | None = None) -> list[dict]:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--only", choices=("000", "002", "003"), default=None)
+    parser.add_argument("--quick", action="store_true", help="cheap rows only")
+    parser.add_argument("--out", type=Path, default=Path("reports"))
+    args = parser.parse_args(argv)
+    rows = collect(args.only, args.quick)
+    args.out.mkdir(parents=True, exist_ok=True)
+    (args.out / "reproduction.json").write_text(json.dumps(rows, indent=2) + "\n")
+    (args.out / "reproduction.md").write_text(markdown(rows))
+    for r in rows:
+        print(
+            f"{r['id']:>4s} {r['quantity']:48s} paper {r['paper_value']!s:>12s} "
+            f"ours {r['value']!s:>16s} {r['unit']:6s} {'holds' if r['holds'] else 'FAILS'}"
+        )
+    return rows
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,46 @@
+"""The cheap rows of the reproduction report, recomputed and compared with the committed JSON."""
+
+import json
+from pathlib import Path
+
+import pytest
+
+from agents.reproduction import _isclose, collect, markdown
+
+COMMITTED = Path(__file__).resolve().parents[1] / "reports" / "reproduction.json"
+
+
+def test_cheap_rows_match_committed_report():
+    committed = {r["id"]: r for r in json.loads(COMMITTED.read_text())}
+    rows = collect(quick=True)
+    assert {r["id"] for r in rows} >= {"5", "12", "12b"}
+    for row in rows:
+        old = committed[row["id"]]
+        assert _isclose(row["value"], old["value"]), row["id"]
+        assert row["holds"] == old["holds"], row["id"]
+
+
+def test_flat_walk_margin_rows_match_committed_report():
+    committed = {r["id"]: r for r in json.loads(COMMITTED.read_text())}
+    from agents.reproduction import cliff_flat_walk_rows
+
+    for row in cliff_flat_walk_rows():
+        old = committed[row["id"]]
+        if isinstance(row["value"], list):
+            assert all(_isclose(a, b) for a, b in zip(row["value"], old["value"], strict=True))
+        else:
+            assert _isclose(row["value"], old["value"]), row["id"]
+        assert row["holds"] and old["holds"]
+
+
+def test_rows_have_the_required_fields_and_markdown_lists_them():
+    rows = json.loads(COMMITTED.read_text())
+    keys = {"id", "paper", "quantity", "paper_value", "value", "unit", "tolerance", "holds"}
+    assert all(keys <= set(r) for r in rows)
+    text = markdown(rows)
+    assert text.count("\n| ") == len(rows) + 1  # header + one line per row
+
+
+def test_bad_paper_id_is_rejected_with_choices():
+    with pytest.raises(ValueError, match="000"):
+        collect(only="001")
