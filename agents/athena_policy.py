@@ -1,4 +1,5 @@
-"""Seed 002's tripod gait with posture control as a policy for ``HexapodIrregularTerrain-v0``.
+"""Coelho et al. 2024's tripod gait with posture control as a policy for
+``HexapodIrregularTerrain-v0``.
 
 `AthenaPosturePolicy(env, kz=..., ka=..., kb=...)` is the analytical controller of the env, in
 any of its action modes, reading the observation by name (``joint_pos``, ``foot_force``,
@@ -31,7 +32,7 @@ from .policy import ObservationReader
 
 
 class AthenaPosturePolicy:
-    """The posture controller of seed 002 with gains (k_z, k_α, k_β) in [0, 1]."""
+    """The posture controller of Coelho et al. 2024 with gains (k_z, k_α, k_β) in [0, 1]."""
 
     def __init__(self, env: gym.Env, kz: float = 0.0, ka: float = 0.0, kb: float = 0.0):
         base = env.unwrapped

@@ -1,4 +1,5 @@
-"""Seed 002's evaluation protocol on ``HexapodIrregularTerrain-v0``: run the posture controller
+"""Coelho et al. 2024's evaluation protocol on ``HexapodIrregularTerrain-v0``: run the posture
+controller
 with given gains and collect the paper's per-gait-cycle metrics.
 
 The paper (Section 5.2) computes, per gait cycle, the RMS of the torso height (infrared sensor)

@@ -32,7 +32,7 @@ def _row(id_, paper, quantity, paper_value, value, unit, tolerance, holds, setti
 
 
 def cliff_flat_walk_rows(cycles: int = 5) -> list[dict]:
-    """Rows 1-3 (seed 000 §5.1): FASM standing, at the tripod switch, and its walking band.
+    """Rows 1-3 (Zhang et al. 2024 §5.1): FASM standing, at the tripod switch, and its walking band.
 
     Same protocol as tests/test_cliff_walk.py: 150 standing steps then `cycles` tripod cycles.
     """
@@ -102,7 +102,7 @@ def cliff_flat_walk_rows(cycles: int = 5) -> list[dict]:
 
 
 def table_ii_rows() -> list[dict]:
-    """Row 5 (seed 000 Table II): adjustment leg for each of the six tipping edges."""
+    """Row 5 (Zhang et al. 2024 Table II): adjustment leg for each of the six tipping edges."""
     from agents.tipping.judgment import select_adjustment_leg
     from hexapod_envs.robots.heavy_duty import TRIPODS
 
@@ -135,7 +135,7 @@ def table_ii_rows() -> list[dict]:
 
 
 def upu_kinematics_rows() -> list[dict]:
-    """Row 12 (seed 003 §4): limb 1 length at (80, 0, 443) mm, and the IK/FK round trip."""
+    """Row 12 (Li et al. 2018 §4): limb 1 length at (80, 0, 443) mm, and the IK/FK round trip."""
     from hexapod_envs.robots.upu.kinematics import forward_kinematics, inverse_kinematics
     from hexapod_envs.robots.upu.params import UpuParams
 
@@ -173,7 +173,7 @@ def upu_kinematics_rows() -> list[dict]:
 
 
 def athena_rows(seeds=range(4), steps: int = 1200, env_kwargs: dict | None = None) -> list[dict]:
-    """Rows 8-11 (seed 002 §5.2): posture vs simple control on the ramp and the block bed,
+    """Rows 8-11 (Coelho et al. 2024 §5.2): posture vs simple control on the ramp and the block bed,
     measured with agents.athena_study.compare (the posture study's protocol, default env)."""
     from agents.athena_study import compare
 
@@ -311,7 +311,7 @@ DITCHES = (  # (id, width m, depth m, action mode, seed): the paper's and two ot
 
 
 def ditch_rows() -> list[dict]:
-    """Rows 13-14 (seed 003 §5-7): flat-walk static margin; the paper's 350 x 140 mm ditch
+    """Rows 13-14 (Li et al. 2018 §5-7): flat-walk static margin; the paper's 350 x 140 mm ditch
     and two other sizes crossed with a positive margin at every control step."""
     flat = ditch_episode(seed=2, terrain="flat", action_mode="joint")
     rows = [
@@ -359,7 +359,7 @@ def _script(name: str):
 
 
 def stewart_rows(seed: int = 0, cases=None, env_kwargs: dict | None = None) -> list[dict]:
-    """Rows 6, 7 and 7b (seed 000 §5.2) for each Stewart case with TippingRecoveryPolicy:
+    """Rows 6, 7 and 7b (Zhang et al. 2024 §5.2) for each Stewart case with TippingRecoveryPolicy:
     adjustment leg, t_s, FASM 0.5 s after landing and its minimum from landing to the end.
 
     Uses `run` / `fasm_at` of scripts/plot_stewart_recovery.py with `env_kwargs` (default:
@@ -449,7 +449,7 @@ def stewart_rows(seed: int = 0, cases=None, env_kwargs: dict | None = None) -> l
 
 
 def cliff_judgment_rows(seed: int = 0) -> list[dict]:
-    """Row 4 (seed 000 §5.1): the tipping judgment fires before the gait alone tips over.
+    """Row 4 (Zhang et al. 2024 §5.1): the tipping judgment fires before the gait alone tips over.
 
     Uses `rollout` of scripts/plot_cliff_recovery.py: judgment time of GaitWithRecoveryPolicy
     (joint mode) and the tip-over time of TripodGaitPolicy alone, same seed and cliff.

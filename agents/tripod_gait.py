@@ -1,4 +1,4 @@
-"""The reference tripod gait of seed 000 §5.1 as a policy for the heavy-duty hexapod envs.
+"""The reference tripod gait of Zhang et al. 2024 §5.1 as a policy for the heavy-duty hexapod envs.
 
 It reads the gait clock from the observation's ``gait_phase`` piece (sin, cos, walking flag), so it
 is a pure function of the observation and needs no state of its own.

@@ -1,4 +1,4 @@
-"""The 3-3 gait of the 3-UPU hexapod (seed 003 §6-7) as a policy for HexapodDitchCrossing-v0.
+"""The 3-3 gait of the 3-UPU hexapod (Li et al. 2018 §6-7) as a policy for HexapodDitchCrossing-v0.
 
 The policy plans the walk the way the paper's robot does, knowing the ditch: it reads the
 ditch geometry the env exposes (`env.unwrapped.ditch`, `terrain`, `start_x`; the robot's

@@ -1,4 +1,4 @@
-"""Speed of the seed-000 force-distribution QP (agents/tipping/force_distribution.py).
+"""Speed of the Zhang et al. 2024 force-distribution QP (agents/tipping/force_distribution.py).
 
 Problem: the 5 t heavy-duty robot on four stance feet (LF, LR, RM, RR: a tripod plus the landed
 adjustment leg), body pitched 10° nose-up, stability cone on: 12 variables, 4 normal-force,

@@ -3,7 +3,7 @@ controller's step time.
 
 Targets (issue 4): env/raw ratio >= 0.9 (Gymnasium's Ant-v5 is measured alongside for context);
 controller step time reported in µs. The env/raw figure is measured per terrain in each action
-mode (zero actions: in "residual" and "gains" mode the env runs the seed-002 gait with its
+mode (zero actions: in "residual" and "gains" mode the env runs the Coelho et al. 2024 gait with its
 internal controller, in "joint" mode it holds zero targets), and the per-step costs of the
 pieces that the env adds to the physics are timed on their own, so that a shortfall can be
 attributed. Run: python benchmarks/bench_irregular_terrain.py

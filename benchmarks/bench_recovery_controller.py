@@ -1,4 +1,4 @@
-"""Speed of seed 000's tipping-recovery controller (agents/tipping/controller.py).
+"""Speed of Zhang et al. 2024's tipping-recovery controller (agents/tipping/controller.py).
 
 1. The force-distribution QP for four stance feet (the problem of bench_force_distribution.py:
    a tripod plus the landed adjustment leg, body pitched 10°, stability cone on): median and 90th

@@ -1,4 +1,5 @@
-"""Seed 002 Figs. 16-19 for HexapodIrregularTerrain-v0: posture control vs "simple control".
+"""Coelho et al. 2024 Figs. 16-19 for HexapodIrregularTerrain-v0: posture control vs "simple
+control".
 
 For the ramp ((k_z, k_α, k_β) = (0.8, 0.6, 0.0)) and the block bed ((0.6, 0.4, 0.4)) it runs
 one default episode (60 s) per seed with each controller on the same seeds and draws box plots of
@@ -46,7 +47,7 @@ def plot(terrain: str, result: dict, path: Path) -> None:
         ax.grid(alpha=0.3)
     s = result["summary"]
     fig.suptitle(
-        f"ATHENA on the {terrain} (seed 002 protocol, {s['posture']['cycles']} posture / "
+        f"ATHENA on the {terrain} (Coelho et al. 2024 protocol, {s['posture']['cycles']} posture / "
         f"{s['simple']['cycles']} simple gait cycles); torso-contact steps: simple "
         f"{s['simple']['torso_collision_steps']}, posture {s['posture']['torso_collision_steps']}",
         fontsize=10,

@@ -1,4 +1,5 @@
-"""Seed 000 §5.1 with recovery: the tripod gait alone vs gait + tipping recovery on the cliff.
+"""Zhang et al. 2024 §5.1 with recovery: the tripod gait alone vs gait + tipping recovery on the
+cliff.
 
 Runs HexapodCliffWalk-v0 (default unilateral cliff) from the same seed with
   - the reference tripod gait alone (TripodGaitPolicy; the paper's case, which it could not
@@ -40,7 +41,7 @@ RUNS = {
     "gait + recovery (residual 0.25)": ("residual", GaitWithRecoveryPolicy),
 }
 WALK_START = 3.0
-"""The gait stands for 3 s before walking (seed 000 §5.1)."""
+"""The gait stands for 3 s before walking (Zhang et al. 2024 §5.1)."""
 
 
 def rollout(action_mode: str, policy_cls, seed: int) -> dict:

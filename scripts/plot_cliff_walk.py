@@ -1,4 +1,5 @@
-"""Seed 000 Fig. 5 for HexapodCliffWalk-v0: CoG position, FASM and vertical foot forces over time.
+"""Zhang et al. 2024 Fig. 5 for HexapodCliffWalk-v0: CoG position, FASM and vertical foot forces
+over time.
 
 Runs the reference tripod gait on flat ground and on the default unilateral cliff and writes
 `reports/figures/cliff_walk_fasm.png`. Run: python scripts/plot_cliff_walk.py [--out PATH]
@@ -83,7 +84,7 @@ def main() -> None:
         ax.set_ylabel("vertical foot force [kN]")
         ax.set_xlabel("time [s]")
         ax.legend(ncol=6, fontsize=7, loc="upper right")
-    fig.suptitle("HexapodCliffWalk-v0, reference tripod gait (cf. seed 000 Fig. 5)")
+    fig.suptitle("HexapodCliffWalk-v0, reference tripod gait (cf. Zhang et al. 2024 Fig. 5)")
     fig.tight_layout()
     out = Path(args.out)
     out.parent.mkdir(parents=True, exist_ok=True)

@@ -1,4 +1,5 @@
-"""Seed 003 Figs. 9, 12, 13, 14: the 3-UPU hexapod's 3-3 gait on flat ground and across a ditch.
+"""Li et al. 2018 Figs. 9, 12, 13, 14: the 3-UPU hexapod's 3-3 gait on flat ground and across a
+ditch.
 
 Runs `agents.upu_gait.UpuGaitPolicy` on HexapodDitchCrossing-v0 and writes to
 reports/figures/ (default):

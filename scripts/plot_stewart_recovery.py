@@ -1,4 +1,5 @@
-"""Seed 000 Fig. 6 for HexapodStewartTilt-v0: tipping recovery on the tilting Stewart platform.
+"""Zhang et al. 2024 Fig. 6 for HexapodStewartTilt-v0: tipping recovery on the tilting Stewart
+platform.
 
 For each of the six cases (climb / descend / side x stance LF-LR-RM / LM-RF-RR) runs the robot
 twice from the same seed: held on its tripod (zero residual) and with TippingRecoveryPolicy.
@@ -34,7 +35,8 @@ from hexapod_envs.robots.heavy_duty import LEG_NAMES  # noqa: E402
 
 CASES = [(s, st) for st in ("LF-LR-RM", "LM-RF-RR") for s in ("climb", "descend", "side")]
 
-PAPER = {  # seed 000 §5.2: adjustment leg, adjustment time t_s [s], foothold [mm], FASM after
+PAPER = {  # Zhang et al. 2024 §5.2: adjustment leg, adjustment time t_s [s], foothold [mm], FASM
+    # after
     ("climb", "LF-LR-RM"): ("RR", 0.74, (-2390, -1908, -1741), "≈40"),
     ("descend", "LF-LR-RM"): ("RF", 1.0, (2490, -1908, -1741), "≈45"),
     ("side", "LF-LR-RM"): ("LM", 2.1, (0, 1894, -1783), "≈21.5"),

@@ -1,4 +1,4 @@
-"""Seed 003 Fig. 9: workspace of the 3-UPU mechanism by the limit-boundary search (§4.2).
+"""Li et al. 2018 Fig. 9: workspace of the 3-UPU mechanism by the limit-boundary search (§4.2).
 
 Writes the xz, yz and xy projections and a 3-D view of the boundary points, coloured by the
 limit that bounds them (limb length -> top/bottom surfaces, Hooke joints -> side surfaces), with

@@ -1,4 +1,4 @@
-"""Seed 002's tripod gait and posture controller (hexapod_envs/robots/athena/gait.py):
+"""Coelho et al. 2024's tripod gait and posture controller (hexapod_envs/robots/athena/gait.py):
 closed-form checks."""
 
 import math

@@ -1,4 +1,5 @@
-"""Closed loop in MuJoCo: ATHENA walks with the seed-002 gait, and the posture gains act in the
+"""Closed loop in MuJoCo: ATHENA walks with the Coelho et al. 2024 gait, and the posture gains act
+in the
 right direction on the 10 degree ramp (direction checks, not the paper's figures)."""
 
 import math

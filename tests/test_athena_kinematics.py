@@ -1,4 +1,5 @@
-"""ATHENA parameters and DH kinematics (seed 002, Section 3.2): closed-form checks, no MuJoCo."""
+"""ATHENA parameters and DH kinematics (Coelho et al. 2024, Section 3.2): closed-form checks, no
+MuJoCo."""
 
 import math
 

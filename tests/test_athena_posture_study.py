@@ -1,4 +1,5 @@
-"""Seed 002 §5.2.3 in MuJoCo: posture control vs the "simple control" on the same seeds, one
+"""Coelho et al. 2024 §5.2.3 in MuJoCo: posture control vs the "simple control" on the same seeds,
+one
 default episode (60 s, 30 gait cycles) per seed; the directions of the paper's results.
 
 Measured with the default env (servo_kp 8 N·m/rad; see reports/athena_gain_sweep.md), 4 seeds:

@@ -1,4 +1,5 @@
-"""Seed 002's irregular terrain pieces (ramp, block test bed), checked with MuJoCo ray casts."""
+"""Coelho et al. 2024's irregular terrain pieces (ramp, block test bed), checked with MuJoCo ray
+casts."""
 
 import math
 

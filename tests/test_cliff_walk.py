@@ -1,4 +1,4 @@
-"""HexapodCliffWalk-v0: the seed-000 §5.1 numbers, env contract and bad input."""
+"""HexapodCliffWalk-v0: the Zhang et al. 2024 §5.1 numbers, env contract and bad input."""
 
 import gymnasium as gym
 import numpy as np

@@ -1,4 +1,4 @@
-"""The 3-3 gait policy on HexapodDitchCrossing-v0 (seed 003 §6-7, Figs. 12-14).
+"""The 3-3 gait policy on HexapodDitchCrossing-v0 (Li et al. 2018 §6-7, Figs. 12-14).
 
 End to end in MuJoCo: the planner's gait walks on flat ground and crosses the paper's ditch
 (140 mm deep, 350 mm wide) and other ditches within the mechanism's reach with the static

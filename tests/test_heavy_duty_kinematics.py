@@ -1,4 +1,4 @@
-"""Heavy-duty hexapod leg kinematics (seed 000 eqs. 1-2) and standing geometry."""
+"""Heavy-duty hexapod leg kinematics (Zhang et al. 2024 eqs. 1-2) and standing geometry."""
 
 import numpy as np
 import pytest

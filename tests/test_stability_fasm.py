@@ -1,4 +1,4 @@
-"""Closed-form tests of the Force-Angle Stability Measure (seed 000 eqs. 5-9)."""
+"""Closed-form tests of the Force-Angle Stability Measure (Zhang et al. 2024 eqs. 5-9)."""
 
 from __future__ import annotations
 
@@ -13,7 +13,8 @@ from hexapod_envs.stability import FasmResult, fasm, support_polygon
 W = 5000.0 * 9.81  # weight of the heavy-duty hexapod [N]
 GRAVITY_FORCE = np.array([0.0, 0.0, -W])
 
-# Seed 000 stance: feet at x = ±2.4 m, y = ±1.9 m, 1.75 m below the CoG (DESIGN.md §4).
+# Zhang et al. 2024 stance: feet at x = ±2.4 m, y = ±1.9 m, 1.75 m below the CoG (the footholds of
+# Zhang et al. 2024 §5.2).
 HEXAPOD_FEET = {
     "LF": (2.4, 1.9, -1.75),
     "LM": (0.0, 1.9, -1.75),
@@ -54,7 +55,7 @@ def rotation(axis, angle: float) -> np.ndarray:
 
 
 def reference_fasm(feet, cog, force, moment, up) -> np.ndarray:
-    """Literal transcription of seed 000 eqs. 5-8 (acos form with the sign rule), numpy."""
+    """Literal transcription of Zhang et al. 2024 eqs. 5-8 (acos form with the sign rule), numpy."""
     feet = np.asarray(feet, dtype=float)
     hull = support_polygon(feet, up=up)
     angles = []

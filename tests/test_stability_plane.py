@@ -1,4 +1,4 @@
-"""Least-squares ground plane z = a x + b y + c (seed 000 §4.2)."""
+"""Least-squares ground plane z = a x + b y + c (Zhang et al. 2024 §4.2)."""
 
 from __future__ import annotations
 

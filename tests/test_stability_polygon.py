@@ -179,7 +179,8 @@ def test_static_margin_errors():
 
 
 def test_stability_package_imports_only_numpy_and_the_standard_library():
-    """The stability measures must stay usable without MuJoCo (pure math, DESIGN.md §2)."""
+    """The stability measures must stay usable without MuJoCo (pure math, docs/architecture.md,
+    Layers)."""
     import ast
     import pathlib
     import sys

@@ -1,4 +1,5 @@
-"""ZMP estimate and margin (seed 002 eqs. 32-33) and Hirose's NESM, against closed forms."""
+"""ZMP estimate and margin (Coelho et al. 2024 eqs. 32-33) and Hirose's NESM, against closed
+forms."""
 
 from __future__ import annotations
 

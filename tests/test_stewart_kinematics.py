@@ -1,4 +1,4 @@
-"""Inverse kinematics of seed 000's 6-UPS Stewart platform (§5.2)."""
+"""Inverse kinematics of Zhang et al. 2024's 6-UPS Stewart platform (§5.2)."""
 
 import math
 

@@ -1,4 +1,5 @@
-"""Reachable region and foothold selection of the adjustment leg (seed 000 §4.2, eqs. 10-14)."""
+"""Reachable region and foothold selection of the adjustment leg (Zhang et al. 2024 §4.2, eqs.
+10-14)."""
 
 import math
 

@@ -1,4 +1,4 @@
-"""Foot-force distribution QP with the FASM stability cone (seed 000 §4.3, eqs. 16-24)."""
+"""Foot-force distribution QP with the FASM stability cone (Zhang et al. 2024 §4.3, eqs. 16-24)."""
 
 import math
 

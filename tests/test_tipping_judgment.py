@@ -1,4 +1,4 @@
-"""Tipping judgment and Table II adjustment-leg selection (seed 000 §3, §4.1)."""
+"""Tipping judgment and Table II adjustment-leg selection (Zhang et al. 2024 §3, §4.1)."""
 
 import numpy as np
 import pytest

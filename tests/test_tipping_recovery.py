@@ -1,4 +1,5 @@
-"""Tipping-recovery controller of seed 000 (agents/tipping/controller.py): its sensor model, the
+"""Tipping-recovery controller of Zhang et al. 2024 (agents/tipping/controller.py): its sensor
+model, the
 margin-rate estimate, leg selection and the state machine driven by synthetic sensor readings.
 The full Stewart-platform and cliff runs are in test_tipping_recovery_e2e.py."""
 

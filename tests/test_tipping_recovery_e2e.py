@@ -1,4 +1,5 @@
-"""Seed 000 §5.1-5.2 end to end: the tipping-recovery controller on the tilting Stewart platform
+"""Zhang et al. 2024 §5.1-5.2 end to end: the tipping-recovery controller on the tilting Stewart
+platform
 (six cases) and on the unilateral cliff, against the same robot left to itself."""
 
 import gymnasium as gym
@@ -11,7 +12,7 @@ from agents.tipping.gait_with_recovery import GaitWithRecoveryPolicy
 from agents.tripod_gait import TripodGaitPolicy
 
 WEIGHT = 5000.0 * 9.81
-PAPER_ADJUSTMENT_LEG = {  # seed 000 §5.2
+PAPER_ADJUSTMENT_LEG = {  # Zhang et al. 2024 §5.2
     ("climb", "LF-LR-RM"): "RR",
     ("descend", "LF-LR-RM"): "RF",
     ("side", "LF-LR-RM"): "LM",

@@ -1,4 +1,4 @@
-"""Adjustment time budget (seed 000 eq. 15) and quintic foot trajectory."""
+"""Adjustment time budget (Zhang et al. 2024 eq. 15) and quintic foot trajectory."""
 
 import math
 

@@ -1,7 +1,7 @@
 """End to end (open loop): the planned 3-3 gait carries the MuJoCo model across the paper's ditch.
 
 A minimal executor replays `plan_ditch_crossing` on the model (legs retract, limbs follow the
-planned path, legs extend to the planned landing extensions) and checks the seed 003 §7 claim:
+planned path, legs extend to the planned landing extensions) and checks the Li et al. 2018 §7 claim:
 the robot crosses a 140 mm deep, 350 mm wide ditch with a positive static margin (the paper's
 d: true CoG projection to the sides of the supporting platform's foot triangle), staying level.
 """

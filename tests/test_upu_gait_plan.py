@@ -1,4 +1,4 @@
-"""Tests of the 3-UPU "3-3" gait-planning math (seed 003 §5-7)."""
+"""Tests of the 3-UPU "3-3" gait-planning math (Li et al. 2018 §5-7)."""
 
 import math
 

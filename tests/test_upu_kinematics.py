@@ -1,4 +1,4 @@
-"""Closed-form tests of the 3-UPU kinematics (seed 003 §3-4) and parameters."""
+"""Closed-form tests of the 3-UPU kinematics (Li et al. 2018 §3-4) and parameters."""
 
 import math
 
@@ -30,7 +30,7 @@ MM = 1e-3
 
 
 def test_paper_check_point_limb_lengths():
-    """(80, 0, 443) mm, the apex of eq. (20): limb 1 = sqrt(115^2 + 443^2) (DESIGN quick check);
+    """(80, 0, 443) mm, the apex of eq. (20): limb 1 = sqrt(115^2 + 443^2) (a closed-form check);
     limbs 2 and 3 from eq. (6) with Delta = 35 mm: sqrt(62.5^2 + 30.31^2 + 443^2)."""
     lengths = inverse_kinematics([0.080, 0.0, 0.443], P)
     assert lengths[0] / MM == pytest.approx(math.sqrt(115**2 + 443**2), abs=1e-9)

@@ -1,4 +1,5 @@
-"""Tests of the ditch terrain (seed 003 §7): surface heights by ray casts and argument checks."""
+"""Tests of the ditch terrain (Li et al. 2018 §7): surface heights by ray casts and argument
+checks."""
 
 import mujoco
 import numpy as np

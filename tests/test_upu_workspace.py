@@ -1,4 +1,4 @@
-"""Tests of the limit-boundary workspace search (seed 003 §4.2, Fig. 9)."""
+"""Tests of the limit-boundary workspace search (Li et al. 2018 §4.2, Fig. 9)."""
 
 import math
 

@@ -1,6 +1,7 @@
 """Per-episode statistics from the env's ``info`` dicts, shared by training logs and evaluation.
 
-Standard keys read from ``info`` (DESIGN.md §3): ``fasm_margin_deg`` (every step),
+Standard keys read from ``info`` (docs/architecture.md, Conventions): ``fasm_margin_deg`` (every
+step),
 ``reward_<term>`` (every step), ``is_success`` and ``distance`` (last step), ``is_tipped_over``
 (any step), and, when an env reports it, ``actuator_power_w`` (sum over actuators of
 |force x velocity| in W, integrated to energy in J).
@@ -32,7 +33,7 @@ An env adds its own episode metrics in one or both of two ways; neither needs an
    update it whenever it changes. Values: numbers or bools (aggregated with mean ± std, median,
    min/max over episodes), strings or None (counted: e.g. which adjustment leg), or lists of
    numbers (per-cycle values such as height/pitch/roll RMS: pooled over all episodes and shown
-   as box plots, medians and spreads as in seed 002).
+   as box plots, medians and spreads as in Coelho et al. 2024).
 
 Every key of ``info["episode_metrics"]`` is collected, declared or not.
 """
@@ -45,7 +46,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 XI_F_DEG = 20.0
-"""Tipping threshold ξ_f of seed 000 [deg]: time below it is reported."""
+"""Tipping threshold ξ_f of Zhang et al. 2024 [deg]: time below it is reported."""
 
 STEP_REDUCTIONS = ("last", "first", "min", "max", "mean", "sum", "rms", "any", "all")
 REDUCTIONS = (*STEP_REDUCTIONS, "episode")

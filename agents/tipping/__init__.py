@@ -1,4 +1,4 @@
-"""Seed 000's tipping judgment and recovery controller (no MuJoCo import anywhere).
+"""Zhang et al. 2024's tipping judgment and recovery controller (no MuJoCo import anywhere).
 
 The closed-loop controller and its policies:
 

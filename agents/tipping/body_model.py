@@ -4,14 +4,14 @@ Pure numpy (no MuJoCo). Everything here is what the real robot computes from its
 its IMU and its 3-D foot force sensors, with the robot's known geometry and masses
 (`HeavyDutyParams`):
 
-- feet in the body frame by forward kinematics (seed 000 eq. 1) of the encoders;
+- feet in the body frame by forward kinematics (Zhang et al. 2024 eq. 1) of the encoders;
 - the whole-robot centre of gravity (CoG) in the body frame from the link masses placed by the
   same kinematics (the body box at the body origin; per leg the hip link rotating with the swing
   joint, the carriage moved by the horizontal joint, the shank and the foot moved along the leg);
 - the body's composite inertia about that CoG (box + legs as point masses), for eq. (16);
 - world-frame foot forces and gravity rotated into the body frame with the IMU quaternion;
 - the leg Jacobian and its stiffness, to turn a wanted change of foot force into a change of the
-  position servo targets (the "known stiffness" of seed 000 §4.3).
+  position servo targets (the "known stiffness" of Zhang et al. 2024 §4.3).
 
 Link mass split (params docstring): hip 40 %, carriage 30 %, shank 28 %, foot 2 % of the leg mass.
 The link centres follow the robot's model (robots/heavy_duty/model.py): hip box centred half-way

@@ -1,4 +1,5 @@
-"""Closed-loop tipping recovery of seed 000 (§3-4) for the heavy-duty hexapod, from sensors only.
+"""Closed-loop tipping recovery of Zhang et al. 2024 (§3-4) for the heavy-duty hexapod, from
+sensors only.
 
 Every control period the controller reads the joint encoders, the 3-D foot force sensors (world
 frame) and the IMU, and works in the body frame:
@@ -325,7 +326,7 @@ class TippingRecoveryController:
     def _margin(self, feet, forces, cog, loaded) -> tuple[float, tuple[int, int] | None]:
         """FASM [deg] over the loaded feet (body frame); (0, None) without a support polygon.
 
-        f_r and n_r are minus the measured support wrench about the CoG (seed 000 eq. 4).
+        f_r and n_r are minus the measured support wrench about the CoG (Zhang et al. 2024 eq. 4).
         """
         return fasm_from_feet(feet, forces, cog, loaded)
 
@@ -599,7 +600,7 @@ class TippingRecoveryController:
 
 
 class TippingRecoveryPolicy:
-    """Seed 000's tipping recovery as a policy for the heavy-duty hexapod envs.
+    """Zhang et al. 2024's tipping recovery as a policy for the heavy-duty hexapod envs.
 
     Works in either action mode: the joint targets of :class:`TippingRecoveryController` become
     normalised targets ("joint") or offsets from the env's reference posture ("residual"; the

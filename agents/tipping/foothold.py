@@ -1,4 +1,5 @@
-"""Reachable region and foothold of the adjustment leg on the fitted terrain (seed 000 §4.2).
+"""Reachable region and foothold of the adjustment leg on the fitted terrain (Zhang et al. 2024
+§4.2).
 
 Everything is in the body frame {C} (x forward, y left, z up, metres). The terrain is the
 least-squares plane through the stance feet. For the adjustment leg with coxa origin B_i:
@@ -101,7 +102,7 @@ class ReachableRegion:
 
 @dataclass(frozen=True)
 class FootholdChoice:
-    """Target foothold of the adjustment leg (seed 000 §4.2).
+    """Target foothold of the adjustment leg (Zhang et al. 2024 §4.2).
 
     Attributes:
         status: ``"ok"``; ``"no_outside_foothold"`` (every reachable point lies inside the
@@ -286,7 +287,7 @@ def select_foothold(
     model: ReachModel = "kinematic",
     plane: Plane | None = None,
 ) -> FootholdChoice:
-    """Target foothold of the adjustment leg ``leg`` (seed 000 §4.2, eq. 14).
+    """Target foothold of the adjustment leg ``leg`` (Zhang et al. 2024 §4.2, eq. 14).
 
     Args:
         leg: the adjustment leg (see :func:`agents.tipping.judgment.select_adjustment_leg`).

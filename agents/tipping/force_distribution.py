@@ -1,4 +1,4 @@
-"""Foot force distribution with a stability-cone constraint, seed 000 §4.3 (eqs. 16-24).
+"""Foot force distribution with a stability-cone constraint, Zhang et al. 2024 §4.3 (eqs. 16-24).
 
 All vectors are in the body frame {C} (x forward, y left, z up); forces in N, lengths in m. The
 unknown x ∈ R^{3k} stacks the ground reaction forces on the k stance feet.
@@ -409,7 +409,7 @@ class ForceDistributionResult:
 
 
 class ForceDistributor:
-    """Force-distribution QP for a fixed number of stance feet (seed 000 §4.3).
+    """Force-distribution QP for a fixed number of stance feet (Zhang et al. 2024 §4.3).
 
     Pre-builds what is constant between control steps (the force-sum block [E ... E], the
     weights S and κW, the friction pyramid in the tangent frame); :meth:`build` fills in the

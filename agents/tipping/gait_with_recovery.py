@@ -1,4 +1,5 @@
-"""The reference tripod gait with seed 000's tipping recovery taking over when tipping is judged.
+"""The reference tripod gait with Zhang et al. 2024's tipping recovery taking over when tipping is
+judged.
 
 `GaitWithRecoveryPolicy` walks the paper's tripod gait
 (:class:`agents.tripod_gait.TripodGaitPolicy`) while the tipping-recovery controller

@@ -1,4 +1,4 @@
-"""Tipping judgment and adjustment-leg selection of seed 000 (§3 end, §4.1, Table II).
+"""Tipping judgment and adjustment-leg selection of Zhang et al. 2024 (§3 end, §4.1, Table II).
 
 The robot is judged to be tipping when its FASM margin falls below the threshold ξ_f = 20°
 (§5.1). It then rolls about the line through the feet of the two *effective support legs*, the
@@ -12,7 +12,7 @@ edge legs when going round the body, i.e. on the far side of the tipping edge:
     (LF, LR) -> LM    (LR, RM) -> RR    (RM, LF) -> RF
     (LM, RF) -> LF    (RF, RR) -> RM    (RR, LM) -> LR
 
-Leg names follow DESIGN.md (paper legs 1-6 = LF LM LR RF RM RR; tripods {LF, LR, RM} and
+Leg names follow docs/architecture.md (paper legs 1-6 = LF LM LR RF RM RR; tripods {LF, LR, RM} and
 {LM, RF, RR}).
 """
 
@@ -26,7 +26,7 @@ import numpy as np
 from hexapod_envs.robots.heavy_duty.params import LEG_NAMES, TRIPODS
 
 XI_F_DEG: float = 20.0
-"""Instability threshold ξ_f [deg] on the FASM margin (seed 000 §5.1)."""
+"""Instability threshold ξ_f [deg] on the FASM margin (Zhang et al. 2024 §5.1)."""
 
 CCW_LEG_ORDER: tuple[str, ...] = ("LF", "LM", "LR", "RR", "RM", "RF")
 """Legs in counter-clockwise order round the body seen from above (x forward, y left, z up)."""
@@ -39,7 +39,7 @@ ADJUSTMENT_LEG: dict[frozenset[str], str] = {
     frozenset(("RF", "RR")): "RM",
     frozenset(("RR", "LM")): "LR",
 }
-"""Table II of seed 000: tipping edge (either order) -> adjustment leg."""
+"""Table II of Zhang et al. 2024: tipping edge (either order) -> adjustment leg."""
 
 
 @dataclass(frozen=True)
@@ -187,7 +187,7 @@ def judge(
     feet: Mapping[str, np.ndarray] | None = None,
     threshold_deg: float = XI_F_DEG,
 ) -> TippingJudgment:
-    """Tipping judgment for one control step (seed 000 §3, §4.1).
+    """Tipping judgment for one control step (Zhang et al. 2024 §3, §4.1).
 
     Args:
         margin_deg: current FASM margin [deg].

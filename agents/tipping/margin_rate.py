@@ -1,6 +1,7 @@
 """Rate and acceleration of the FASM margin from its recent history (inputs of eq. 15).
 
-Seed 000 §4.2 needs the margin's rate v_s [deg/s] and acceleration a_s [deg/s²] at the moment the
+Zhang et al. 2024 §4.2 needs the margin's rate v_s [deg/s] and acceleration a_s [deg/s²] at the
+moment the
 robot is judged to be tipping. The margin is measured once per control period and carries sensor
 noise, so both are taken from a least-squares quadratic S(τ) ≈ c0 + c1 τ + c2 τ² fitted to the
 samples of the last `window` seconds (τ = sample time - newest time): v_s = c1, a_s = 2 c2.

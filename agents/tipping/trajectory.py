@@ -1,4 +1,4 @@
-"""Adjustment time budget (seed 000 eq. 15) and the quintic foot trajectory of §4.2.
+"""Adjustment time budget (Zhang et al. 2024 eq. 15) and the quintic foot trajectory of §4.2.
 
 Time budget. When the margin S [deg] has fallen below ξ_f, its rate v_s [deg/s] and acceleration
 a_s [deg/s²] give a quadratic forecast S(t) = S + v_s t + ½ a_s t², and the leg must land before

@@ -1,6 +1,7 @@
 """HexapodCliffWalk-v0: the heavy-duty hexapod walks a tripod gait toward a unilateral cliff.
 
-Seed 000 §5.1: after 3 s of standing the robot walks on flat ground that, ahead of it, drops away
+Zhang et al. 2024 §5.1: after 3 s of standing the robot walks on flat ground that, ahead of it,
+drops away
 on one side; a leg on that side steps into the void, the FASM falls below ξ_f = 20° and, without a
 recovery controller, the robot tips over.
 

@@ -1,6 +1,6 @@
 """HexapodDitchCrossing-v0: the 3-UPU parallel-mechanism hexapod walks forward across a ditch.
 
-Seed 003 §6-7 (Li et al., Robotics 2018): the robot walks with the "3-3" gait, one platform
+Li et al. 2018 §6-7 (Li et al., Robotics 2018): the robot walks with the "3-3" gait, one platform
 standing on its three legs while the other lifts its legs, travels along a quadratic path
 (eqs. 19-21) and lands; strides are at most l_max1 = 160 mm (eq. 17) and are shortened near
 the ditch, and legs extend into it (Fig. 13). The default ditch is the paper's: 140 mm deep,

@@ -1,4 +1,4 @@
-"""Common part of the envs that use the 5 t heavy-duty hexapod of seed 000.
+"""Common part of the envs that use the 5 t heavy-duty hexapod of Zhang et al. 2024.
 
 Action modes:
 - ``"joint"``: 18 joint position targets, each normalised to [-1, 1] over its range
@@ -25,7 +25,7 @@ from .base import HexapodEnv, JointActionMap, check_choice
 from .sensors import RobotSensors
 
 XI_F_DEG = 20.0
-"""Tipping threshold ξ_f of seed 000 §3 [deg]."""
+"""Tipping threshold ξ_f of Zhang et al. 2024 §3 [deg]."""
 
 ACTION_MODES = ("joint", "residual")
 

@@ -1,6 +1,7 @@
 """HexapodIrregularTerrain-v0: ATHENA walks a tripod gait across a 10° ramp or a bed of blocks.
 
-Seed 002 §5 (Coelho et al.): the 0.7 kg-body hexapod ATHENA walks forward (+x) with the tripod
+Coelho et al. 2024 §5 (Coelho et al.): the 0.7 kg-body hexapod ATHENA walks forward (+x) with the
+tripod
 gait of eqs. (19)-(23) (t_g = 1 s per phase, control at 20 Hz) over
 
 | terrain | what | robot starts |
@@ -56,7 +57,8 @@ Action modes (``action_mode=``):
 
 - ``"residual"`` (default): 18 values in [-1, 1] added, times ``residual_scale`` x each joint's
   half range, to the joint targets of the reference gait that the env runs internally: the
-  seed-002 tripod gait with posture control, gains ``reference_gains`` (default (0, 0, 0), the
+  Coelho et al. 2024 tripod gait with posture control, gains ``reference_gains`` (default (0, 0,
+  0), the
   paper's "simple control"). A zero action walks the reference gait.
 - ``"joint"``: 18 joint targets, each normalised to [-1, 1] over its range; no internal gait
   (the gait phase then comes from a fixed clock of 2 t_g per cycle).
@@ -190,7 +192,7 @@ class IrregularTerrainEnv(HexapodEnv):
         },
         "cycle_height_rms": {
             "reduce": "episode",
-            "description": "per-gait-cycle RMS torso height [m] (seed 002 Figs. 10-17)",
+            "description": "per-gait-cycle RMS torso height [m] (Coelho et al. 2024 Figs. 10-17)",
         },
         "cycle_pitch_rate_rms": {
             "reduce": "episode",

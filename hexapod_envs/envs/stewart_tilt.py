@@ -1,6 +1,6 @@
 """HexapodStewartTilt-v0: the heavy-duty hexapod on a tilting 6-UPS Stewart platform.
 
-Seed 000 §5.2.
+Zhang et al. 2024 §5.2.
 
 The robot stands on one tripod with the other tripod lifted in swing posture. After
 `settle_time` the platform tilts at `tilt_rate_deg` [deg/s] up to `max_tilt_deg` and holds
@@ -71,7 +71,8 @@ class TiltTaskRanges:
     horizontal axis, at a rate drawn uniformly from one of `rates_deg_s` (chosen at random).
 
     Held-out test ranges (`TILT_TEST`): tilt rates interleaved with and beyond training (4-8 and
-    12-20 deg/s against 1-4 and 8-12), where the time budget of seed 000 eq. 15 binds; lower
+    12-20 deg/s against 1-4 and 8-12), where the time budget of Zhang et al. 2024 eq. 15 binds;
+    lower
     platform friction; a heavier payload (see `HeavyDutyEnv.PAYLOAD_RANGES`).
     """
 

@@ -4,12 +4,13 @@ All functions take contact points in one frame (metres) and are cheap enough to 
 control step:
 
 - :func:`support_polygon` - convex hull of the contacts, counter-clockwise seen from above.
-- :func:`fasm` - Force-Angle Stability Measure (seed 000 eqs. 5-9), degrees;
+- :func:`fasm` - Force-Angle Stability Measure (Zhang et al. 2024 eqs. 5-9), degrees;
   :func:`fasm_from_feet` - the same from measured foot forces (minus the support wrench).
 - :func:`static_stability_margin` - CoG projection to support polygon boundary, metres.
-- :func:`zmp`, :func:`zmp_margin` - force-weighted ZMP and its margin (seed 002 eqs. 32-33).
+- :func:`zmp`, :func:`zmp_margin` - force-weighted ZMP and its margin (Coelho et al. 2024 eqs.
+32-33).
 - :func:`nesm` - Hirose's normalised energy stability margin, metres.
-- :func:`fit_plane` - least-squares ground plane z = a x + b y + c (seed 000 §4.2).
+- :func:`fit_plane` - least-squares ground plane z = a x + b y + c (Zhang et al. 2024 §4.2).
 """
 
 from hexapod_envs.stability.fasm import FasmResult, fasm, fasm_from_feet

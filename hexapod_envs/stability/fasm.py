@@ -1,4 +1,5 @@
-"""Force-Angle Stability Measure (FASM) of Papadopoulos & Rey, as used in seed 000 (eqs. 3-9).
+"""Force-Angle Stability Measure (FASM) of Papadopoulos & Rey, as used in Zhang et al. 2024 (eqs.
+3-9).
 
 For every edge of the support polygon the net destabilising force at the CoG and the net moment
 (replaced by an equivalent force couple) are projected onto the plane normal to the edge; the
@@ -6,7 +7,8 @@ angle between that tipping force and the perpendicular from the CoG to the edge 
 stability angle. It is positive while the force points inside the edge (stable), zero at the
 tipping point and negative beyond it. The margin is the smallest angle over the edges.
 
-Seed 000's notation, for edge i with unit direction a_i (edges counter-clockwise seen from above):
+Zhang et al. 2024's notation, for edge i with unit direction a_i (edges counter-clockwise seen from
+above):
 
     l_i   = (I - a aᵀ)(p_{i+1} - p_G)          perpendicular from the CoG to the edge line
     f_i   = (I - a aᵀ) f_r                      force component that can tip about the edge
@@ -28,7 +30,7 @@ which equals the ±acos form with its sign rule ((l̂ × f̂*)·a = f̂*·t̂) a
 f_r·(a × l) - a·n_r is minus the moment of the destabilising wrench about the edge axis a, so
 θ_i < 0 exactly when that wrench rolls the body over the edge.
 
-Note on seed 000's printed eq. (8): it gives θ = +acos(l̂·f*) when (l̂·f*)·â < 0 and -acos
+Note on Zhang et al. 2024's printed eq. (8): it gives θ = +acos(l̂·f*) when (l̂·f*)·â < 0 and -acos
 otherwise. As printed the condition multiplies a scalar by a vector (a dot where Papadopoulos &
 Rey have a cross product); dropping the vector factor, it would make every angle with l̂·f* > 0
 negative, i.e. call a robot standing upright unstable. This module uses Papadopoulos & Rey's rule,
@@ -83,14 +85,15 @@ class FasmResult:
 
 
 def fasm(feet, cog, force, moment=None, up=None) -> FasmResult:
-    """Force-Angle Stability Measure of a body standing on ``feet`` (seed 000, eqs. 5-9).
+    """Force-Angle Stability Measure of a body standing on ``feet`` (Zhang et al. 2024, eqs. 5-9).
 
     Args:
         feet: (k, 3) contact points [m], any order, k >= 3; their convex hull (seen from above)
             is the support polygon, points inside it or on its edges are ignored.
         cog: (3,) centre of gravity [m], same frame as ``feet``.
         force: (3,) net destabilising force on the body at the CoG [N]: gravity + external +
-            inertial (-m a), i.e. minus the sum of the support forces (seed 000 eq. 4). Standing
+            inertial (-m a), i.e. minus the sum of the support forces (Zhang et al. 2024 eq. 4).
+            Standing
             still under gravity only: ``m * g_vector``, e.g. ``(0, 0, -m * 9.81)``.
         moment: (3,) net destabilising moment about the CoG [N m] (gravity contributes none;
             external + inertial moments, = minus the support moments about the CoG). None: zero.
@@ -214,7 +217,8 @@ def fasm_from_feet(
 
     `feet` (n, 3) contact points and `forces` (n, 3) ground reactions on the feet [N], in one
     frame with `cog`; `loaded` (n,) marks the feet that carry load. f_r and n_r are minus the
-    measured support wrench about the CoG (seed 000 eq. 4). Returns (margin_deg, (i, j)) with
+    measured support wrench about the CoG (Zhang et al. 2024 eq. 4). Returns (margin_deg, (i, j))
+    with
     the edge as indices into `feet`, or (0, None) when the loaded feet span no support polygon
     (fewer than three, or collinear): the robot is at the tipping limit.
     """

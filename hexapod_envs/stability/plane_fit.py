@@ -1,4 +1,5 @@
-"""Least-squares ground plane z = a x + b y + c through foot contact points (seed 000 §4.2)."""
+"""Least-squares ground plane z = a x + b y + c through foot contact points (Zhang et al. 2024
+§4.2)."""
 
 from __future__ import annotations
 
@@ -61,7 +62,8 @@ class Plane:
 def fit_plane(points) -> Plane:
     """Linear least-squares plane z = a x + b y + c through ``points`` (k, 3), k >= 3.
 
-    Minimises the vertical residuals sum (a x_i + b y_i + c - z_i)², as seed 000 does for the
+    Minimises the vertical residuals sum (a x_i + b y_i + c - z_i)², as Zhang et al. 2024 does for
+    the
     terrain under the feet; solved from the centred 2x2 normal equations (exact for points on a
     plane, well conditioned for feet metres away from the origin).
 

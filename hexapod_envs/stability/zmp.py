@@ -1,6 +1,8 @@
-"""Zero-moment point estimated from normal foot forces, and its margin (seed 002, eqs. 32-33).
+"""Zero-moment point estimated from normal foot forces, and its margin (Coelho et al. 2024, eqs.
+32-33).
 
-Seed 002 (ATHENA) cannot use the torso acceleration in its simulator and estimates the ZMP as
+Coelho et al. 2024 (ATHENA) cannot use the torso acceleration in its simulator and estimates the
+ZMP as
 the normal-force-weighted mean of the foot positions, in the horizontal (x, y) coordinates of the
 frame the feet are given in (the torso frame in the paper):
 
@@ -55,7 +57,7 @@ def _weighted_mean(loaded) -> tuple[float, float]:
 
 
 def zmp(feet, normal_forces, min_force: float = DEFAULT_MIN_FORCE) -> np.ndarray:
-    """ZMP estimate of seed 002 eq. 32: normal-force-weighted mean of the foot (x, y) [m].
+    """ZMP estimate of Coelho et al. 2024 eq. 32: normal-force-weighted mean of the foot (x, y) [m].
 
     Args:
         feet: (k, 3) or (k, 2) foot positions [m]; only x and y are used (projection along the
@@ -73,7 +75,8 @@ def zmp(feet, normal_forces, min_force: float = DEFAULT_MIN_FORCE) -> np.ndarray
 
 
 def zmp_margin(feet, normal_forces, min_force: float = DEFAULT_MIN_FORCE) -> float:
-    """Seed 002 eq. 33: signed distance [m] of the ZMP (eq. 32) to the loaded feet's polygon.
+    """Coelho et al. 2024 eq. 33: signed distance [m] of the ZMP (eq. 32) to the loaded feet's
+    polygon.
 
     The support polygon is the convex hull of the loaded feet's (x, y); the margin is the smallest
     distance from the ZMP to its edges, positive inside (negative outside, which eq. 32 cannot

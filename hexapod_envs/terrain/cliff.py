@@ -1,4 +1,5 @@
-"""Unilateral cliff of seed 000 §5.1: flat ground whose one side drops away ahead of the robot.
+"""Unilateral cliff of Zhang et al. 2024 §5.1: flat ground whose one side drops away ahead of the
+robot.
 
 The robot walks along +x. For x < `start_x` the ground is flat everywhere; beyond it the ground
 continues only on the safe side of the line y = `edge_y` and drops by `drop` metres on the other

@@ -1,4 +1,4 @@
-"""Flat ground with a ditch across the walking direction (seed 003 §7, Fig. 13).
+"""Flat ground with a ditch across the walking direction (Li et al. 2018 §7, Fig. 13).
 
 The robot walks along +x. The ground is flat (top at z = 0) except for x in
 [start_x, start_x + width], where a flat-bottomed ditch with vertical walls drops to z = -depth.

@@ -1,4 +1,5 @@
-"""Irregular terrain of seed 002 (Section 5.1, Fig. 9): a 10 degree ramp and a test bed of blocks.
+"""Irregular terrain of Coelho et al. 2024 (Section 5.1, Fig. 9): a 10 degree ramp and a test bed
+of blocks.
 
 Both pieces add static box geoms to `spec.worldbody` (collision convention of
 `hexapod_envs.terrain.flat`: terrain geoms only receive contacts) and, by default, a ground plane
@@ -21,7 +22,7 @@ from ..checks import check_number
 from .flat import ground_geom_kwargs
 
 PAPER_FRICTION = 0.9
-"""Kinetic friction coefficient of seed 002's simulations (Section 5.1)."""
+"""Kinetic friction coefficient of Coelho et al. 2024's simulations (Section 5.1)."""
 
 _RAMP_RGBA = [0.62, 0.55, 0.45, 1.0]
 
@@ -109,7 +110,8 @@ def add_ramp(
     thickness: float = 0.05,
     name: str = "ramp",
 ) -> Ramp:
-    """Add a ramp rising along +x (seed 002: 10 degrees) with a flat approach before `start_x`.
+    """Add a ramp rising along +x (Coelho et al. 2024: 10 degrees) with a flat approach before
+    `start_x`.
 
     [slope_deg: degrees, in (0, 45]; start_x, length (horizontal run), top_length, width, y_center,
     thickness (of the sloped slab): m]. With `with_ground` a plane `{name}_ground` at z = 0 forms
@@ -163,7 +165,7 @@ def add_blocks(
     with_ground: bool = True,
     name: str = "blocks",
 ) -> BlockField:
-    """Add a test bed of boxes with heights drawn uniformly from `height_range` (seed 002:
+    """Add a test bed of boxes with heights drawn uniformly from `height_range` (Coelho et al. 2024:
     0.04-0.13 m) by `rng`, so the same generator state gives the same terrain.
 
     [block_size: (x, y) of one block, m; region: ((x_min, x_max), (y_min, y_max)), m]. The region

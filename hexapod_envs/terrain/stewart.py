@@ -1,4 +1,4 @@
-"""The 6-UPS Stewart platform of seed 000 §5.2 as a MuJoCo terrain piece.
+"""The 6-UPS Stewart platform of Zhang et al. 2024 §5.2 as a MuJoCo terrain piece.
 
 The moving platform is a rigid plate whose tilt is driven by two stiff servos about its
 centre (pitch about y, then roll about x, so R = Ry(pitch) Rx(roll) as in `stewart_kinematics`).

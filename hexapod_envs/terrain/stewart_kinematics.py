@@ -1,4 +1,4 @@
-"""Inverse kinematics of the 6-UPS Stewart platform of seed 000 §5.2. Pure numpy.
+"""Inverse kinematics of the 6-UPS Stewart platform of Zhang et al. 2024 §5.2. Pure numpy.
 
 The paper gives the moving platform's radius (3.5 m), the fixed base's (5.5 m) and the actuator
 stroke (9-14 m); the joint layout and neutral height are chosen here (a standard 6-6 layout):
@@ -197,11 +197,11 @@ class StewartPlatform:
 
 
 DEFAULT_PLATFORM = StewartPlatform()
-"""The seed-000 platform with the layout chosen above."""
+"""The Zhang et al. 2024 platform with the layout chosen above."""
 
 
 def actuator_lengths(position, rpy, platform: StewartPlatform = DEFAULT_PLATFORM) -> np.ndarray:
-    """(6,) actuator lengths [m] of ``platform`` (default: seed 000's) for a pose."""
+    """(6,) actuator lengths [m] of ``platform`` (default: Zhang et al. 2024's) for a pose."""
     return platform.actuator_lengths(position, rpy)
 
 

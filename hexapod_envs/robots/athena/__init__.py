@@ -1,4 +1,4 @@
-"""ATHENA, the hexapod of seed 002: parameters, DH kinematics (pure numpy), MuJoCo model.
+"""ATHENA, the hexapod of Coelho et al. 2024: parameters, DH kinematics (pure numpy), MuJoCo model.
 
 `add_athena` and `AthenaHandles` live in `model` (which imports mujoco) and are loaded lazily, so
 that `params` and `kinematics` stay importable without MuJoCo (the gait controller in `agents`

@@ -1,4 +1,4 @@
-"""ATHENA's tripod gait and posture controller (seed 002, Section 4), pure numpy.
+"""ATHENA's tripod gait and posture controller (Coelho et al. 2024, Section 4), pure numpy.
 
 It lives in the robot package because ``HexapodIrregularTerrain-v0`` runs it as the reference
 gait of its "residual" and "gains" action modes (and `hexapod_envs` must not import `agents`);
@@ -205,7 +205,8 @@ class _Plan:
 
 
 class AthenaPostureController:
-    """Seed 002's tripod gait with height/pitch/roll posture control; joint targets at 20 Hz.
+    """Coelho et al. 2024's tripod gait with height/pitch/roll posture control; joint targets at 20
+    Hz.
 
     Call `step(sensors)` once per control tick; it returns (6, 3) joint-angle targets (rad,
     rows `LEG_NAMES`, columns TC, CTr, FTi) for the position servos. A phase lasts

@@ -1,4 +1,4 @@
-"""ATHENA leg kinematics (seed 002, Section 3.2), pure numpy.
+"""ATHENA leg kinematics (Coelho et al. 2024, Section 3.2), pure numpy.
 
 Forward kinematics follows the Denavit-Hartenberg table 3 literally (T = Rz(theta) Tz(d) Tx(a)
 Rx(alpha) per row) with the mounting angle theta_1 of eq. (13); `foot_position_closed_form` is

@@ -1,4 +1,5 @@
-"""MuJoCo model of ATHENA (seed 002, Table 2 simplified model), generated with `mujoco.MjSpec`.
+"""MuJoCo model of ATHENA (Coelho et al. 2024, Table 2 simplified model), generated with
+`mujoco.MjSpec`.
 
 Body tree per leg L in `LEG_NAMES` (frames follow the DH chain of `kinematics`):
 

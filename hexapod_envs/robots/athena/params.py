@@ -1,4 +1,5 @@
-"""ATHENA's numbers from seed 002 (Coelho et al.), in SI units, plus the few choices we made.
+"""ATHENA's numbers from Coelho et al. 2024 (Coelho et al.), in SI units, plus the few choices we
+made.
 
 Sources in the paper: Table 2 (simplified simulation model: sizes, masses, inertias), Section 3.2
 (joint names, ranges, DH table 3, mounting angles eq. 13), Section 2.2 (servo torque 1.89 N·m),
@@ -6,7 +7,8 @@ Section 3.1 (friction 0.9), Section 5.1 (standing posture). Everything the paper
 marked "our choice" with the reason.
 
 Frames. The paper's body frame B has x to the right, y forward (the stride axis of eqs. 20-23),
-z up. Ours (DESIGN.md) has x forward, y left, z up, so (x, y, z)_ours = (y, -x, z)_paper and every
+z up. Ours (docs/architecture.md) has x forward, y left, z up, so (x, y, z)_ours = (y, -x, z)_paper
+and every
 azimuth in ours is the paper's minus pi/2. The DH table does not care which horizontal axis is x:
 it only needs the per-leg mounting angle theta_1, which `mounting_angle` gives in our frame.
 
@@ -27,13 +29,14 @@ from dataclasses import dataclass
 import numpy as np
 
 LEG_NAMES: tuple[str, ...] = ("LF", "LM", "LR", "RF", "RM", "RR")
-"""Project-wide leg order (DESIGN.md): arrays of per-leg data use this row order."""
+"""Project-wide leg order (docs/architecture.md): arrays of per-leg data use this row order."""
 
 JOINT_NAMES: tuple[str, ...] = ("TC", "CTr", "FTi")
 """Thorax-Coxa (yaw), Coxa-Trochanterofemur (pitch), Femur-Tibia (pitch): the paper's names."""
 
 TRIPODS: tuple[tuple[str, ...], tuple[str, ...]] = (("LF", "LR", "RM"), ("LM", "RF", "RR"))
-"""The two tripods (DESIGN.md). In the paper's numbers these are {3, 5, 1} and {4, 2, 6}."""
+"""The two tripods (docs/architecture.md). In the paper's numbers these are {3, 5, 1} and {4, 2,
+6}."""
 
 # --- The one place where the paper's leg numbers are translated -----------------------------
 # Eq. (13) gives the mounting angle theta_1 of leg i in the paper's frame (x right, y forward):
@@ -90,7 +93,7 @@ class SphereLink:
 
 @dataclass(frozen=True)
 class AthenaParams:
-    """ATHENA's simplified simulation model (seed 002), SI units.
+    """ATHENA's simplified simulation model (Coelho et al. 2024), SI units.
 
     The leg is the DH chain of Table 3: l1 (body centre to hip, per leg), l2 = coxa, l3 = femur,
     l4 = tibia; the foot sphere's centre is the chain's end point p_i of eq. (12).

@@ -1,4 +1,5 @@
-"""The 5 t heavy-duty hexapod of seed 000: parameters, pantograph-leg kinematics, MuJoCo model."""
+"""The 5 t heavy-duty hexapod of Zhang et al. 2024: parameters, pantograph-leg kinematics, MuJoCo
+model."""
 
 from .kinematics import (
     foot_in_body,

@@ -1,4 +1,4 @@
-"""Reference tripod gait of seed 000 §5.1, as foot targets in the body frame. Pure numpy.
+"""Reference tripod gait of Zhang et al. 2024 §5.1, as foot targets in the body frame. Pure numpy.
 
 Duty factor beta = 14/24, stroke (foot travel relative to the body during stance) 0.5 m, cycle
 T = 6 s, 3 s of standing first. Stance feet move backwards linearly; a swing foot returns with a

@@ -1,4 +1,4 @@
-"""Leg kinematics of the heavy-duty hexapod, seed 000 eqs. (1)-(2). Pure numpy.
+"""Leg kinematics of the heavy-duty hexapod, Zhang et al. 2024 eqs. (1)-(2). Pure numpy.
 
 Each leg is a pantograph with three joints J = [J_x, J_z, J_theta] (horizontal, vertical, swing).
 In the coxa frame {B_i} (parallel to the body frame, origin at l_i):

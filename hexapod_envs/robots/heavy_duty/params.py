@@ -1,4 +1,5 @@
-"""Parameters of the 5 t heavy-duty hexapod of seed 000 (Zhang et al., Robotica 2024), §2.1.
+"""Parameters of the 5 t heavy-duty hexapod of Zhang et al. 2024 (Zhang et al., Robotica 2024),
+§2.1.
 
 The paper gives the overall size (4.7 x 2.5 x 2 m), the masses (4.4 t body, 0.1 t per leg), the
 pantograph scale factors K_x = 5, K_z = 4 and, through the footholds of §5.2, the standing
@@ -14,7 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 LEG_NAMES: tuple[str, ...] = ("LF", "LM", "LR", "RF", "RM", "RR")
-"""Seed 000 numbers legs 1-3 left front->rear and 4-6 right front->rear."""
+"""Zhang et al. 2024 numbers legs 1-3 left front->rear and 4-6 right front->rear."""
 
 PAPER_LEG_NUMBER: dict[str, int] = {name: i + 1 for i, name in enumerate(LEG_NAMES)}
 
@@ -63,7 +64,7 @@ class HeavyDutyParams:
     foot_stiffness: tuple[float, float, float] = (2.0e6, 4.0e6, 5.0e7)
     """Servo stiffness of each joint expressed at the foot: x [N/m], leg length [N/m],
     swing [N·m/rad]. The force distribution controller uses these "known stiffnesses" to make
-    planned foot forces act (seed 000 §4.3)."""
+    planned foot forces act (Zhang et al. 2024 §4.3)."""
     foot_damping: tuple[float, float, float] = (1.0e5, 1.5e5, 1.0e6)
     """Joint damping at the foot: [N·s/m], [N·s/m], [N·m·s/rad]."""
     force_limit: tuple[float, float, float] = (6.0e4, 1.2e5, 2.0e5)

@@ -1,4 +1,4 @@
-"""The 3-UPU hexapod walking robot of seed 003 (Li et al., Robotics 2018, 7, 48).
+"""The 3-UPU hexapod walking robot of Li et al. 2018 (Li et al., Robotics 2018, 7, 48).
 
 `params` (paper numbers and documented choices), `kinematics` and `workspace` (pure numpy) and
 `model` (MuJoCo, imported lazily so the pure math works without building a model).

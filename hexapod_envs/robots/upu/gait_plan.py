@@ -1,4 +1,4 @@
-"""Gait-planning math of the 3-UPU hexapod's "3-3" gait (seed 003 §5-7), pure numpy.
+"""Gait-planning math of the 3-UPU hexapod's "3-3" gait (Li et al. 2018 §5-7), pure numpy.
 
 The robot walks by moving one platform while the other stands on its three legs (duty factor
 0.5, Fig. 6-7): stage I the upper platform lifts its legs, travels forward along a quadratic

@@ -1,4 +1,4 @@
-"""Timed actuator commands of a 3-UPU gait plan (seed 003 §6, Fig. 7), pure numpy.
+"""Timed actuator commands of a 3-UPU gait plan (Li et al. 2018 §6, Fig. 7), pure numpy.
 
 `GaitSchedule` samples a `GaitPlan` at the control period: each platform step runs six phases,
 

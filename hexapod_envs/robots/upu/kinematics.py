@@ -1,4 +1,4 @@
-"""Kinematics of the 3-UPU translational parallel mechanism (seed 003 §3-4), pure numpy.
+"""Kinematics of the 3-UPU translational parallel mechanism (Li et al. 2018 §3-4), pure numpy.
 
 Positions are of one platform centre relative to the other, in metres, in the paper's frames
 (x forward, z up; see `params`):

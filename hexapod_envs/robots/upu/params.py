@@ -1,4 +1,5 @@
-"""Parameters of the 3-UPU hexapod walking robot of seed 003 (Li et al., Robotics 2018, 7, 48).
+"""Parameters of the 3-UPU hexapod walking robot of Li et al. 2018 (Li et al., Robotics 2018, 7,
+48).
 
 The paper gives the parallel mechanism (Table 2): Hooke-joint circumradii r = 125 mm (upper
 platform) and R = 160 mm (lower), limb length l in [365, 465] mm, Hooke-joint angles within

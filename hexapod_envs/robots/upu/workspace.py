@@ -1,4 +1,4 @@
-"""Workspace of the 3-UPU mechanism by the limit-boundary search of seed 003 §4.2 (Fig. 3).
+"""Workspace of the 3-UPU mechanism by the limit-boundary search of Li et al. 2018 §4.2 (Fig. 3).
 
 The flow chart: (1) take the structure parameters; (2) define a search box of reference-point
 positions; (3) for every point solve the inverse kinematics (eq. 6), the Hooke angles
