@@ -106,3 +106,20 @@ def test_envs_option_keeps_the_suite_kwargs(tmp_path):
     assert metrics["envs"]["HexapodIrregularTerrain-v0"]["kwargs"] == {
         "gait_ground_search": "always"
     }
+
+
+def test_sampled_tasks_are_broken_down_and_run_dirs_give_learning_curves(tmp_path):
+    from test_pipeline_cli import TINY, train
+
+    assert train(tmp_path, "tiny", overrides=TINY) == 0
+    out = tmp_path / "rep"
+    envs = json.dumps([{"id": "HexapodCliffWalk-v0", "kwargs": {"task_distribution": "test"}}])
+    argv = ["--set", f"envs={envs}", "--policies", "zero", f"ppo:{tmp_path / 'tiny'}"]
+    argv += ["--episodes", "4", "--max-episode-steps", "30", "--output-dir", str(out)]
+    assert evaluate_main([*argv, "--no-progress"]) == 0
+    md = (out / "report.md").read_text()
+    assert "By sampled task parameter" in md and "| cliff_x | ≤ " in md
+    assert "figures/HexapodCliffWalk-v0_learning.png" in md
+    episodes = json.loads((out / "metrics.json").read_text())["envs"]["HexapodCliffWalk-v0"]
+    tasks = [e["task"]["cliff_x"] for e in episodes["policies"]["zero"]["episodes"]]
+    assert len(set(tasks)) == 4 and all(3.4 <= x <= 4.0 for x in tasks)

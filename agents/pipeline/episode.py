@@ -175,6 +175,7 @@ class EpisodeRecord:
     energy_j: float | None
     specifics: dict[str, Any] = field(default_factory=dict)
     fasm_trace_deg: list[float] | None = None
+    task: dict[str, Any] = field(default_factory=dict)  # the env's info["task"] (sampled task)
 
     def scalar_metrics(self) -> dict[str, Any]:
         """Flat name -> value of every per-episode metric (for JSON and aggregation)."""
@@ -296,6 +297,7 @@ class EpisodeAccumulator:
             distance_m=None if distance is None else float(distance),
             energy_j=self.energy if self.has_power else None,
             specifics=specifics,
+            task=_plain(dict(info.get("task") or {})),
             fasm_trace_deg=list(self.trace) if self.keep_trace else None,
         )
         self.reset()

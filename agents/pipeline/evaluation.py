@@ -39,6 +39,7 @@ class PolicyRun:
     notes: list[str] = field(default_factory=list)
     frames: list[np.ndarray] | None = None
     video: Path | None = None  # MP4 of the first seed (with --video)
+    model_dir: Path | None = None  # a ppo: policy's model directory (for learning curves)
 
 
 @dataclass
@@ -233,6 +234,8 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, gym.Env, dict
                 continue
             policy, source = build_policy(name, env, suite_env.id, suite)
             run = PolicyRun(name=name, source=source)
+            files = getattr(getattr(policy, "learned", policy), "files", None)
+            run.model_dir = getattr(files, "directory", None)
             note = _kwargs_note(env, suite_env, name, getattr(policy, "train_env_kwargs", None))
             if note:
                 run.notes.append(note)

@@ -154,6 +154,35 @@ def success_bars(result: SuiteResult) -> bytes | None:
     return _png(fig)
 
 
+def learning_curves(result: EnvResult) -> bytes | None:
+    """Evaluation success rate and mean return against env steps for every PPO policy whose
+    run directory holds an ``evaluations.npz`` (shipped model directories do not)."""
+    from .learning_curve import load_learning_curve
+
+    curves = {}
+    for name, run in result.runs.items():
+        directory = getattr(run, "model_dir", None)
+        for candidate in (directory, getattr(directory, "parent", None)):
+            if candidate is not None and (candidate / "evaluations.npz").is_file():
+                curves[result.label(name)] = load_learning_curve(candidate)
+                break
+    if not curves:
+        return None
+    fig, (ax_s, ax_r) = plt.subplots(1, 2, figsize=(9, 3.0))
+    for label, curve in curves.items():
+        rate = curve.success_rate
+        if rate is not None:
+            ax_s.plot(curve.timesteps, rate, marker="o", ms=3, label=_short(label, 40))
+        ax_r.plot(curve.timesteps, curve.mean_return, marker="o", ms=3, label=_short(label, 40))
+    ax_s.set(xlabel="env steps", ylabel="success rate", ylim=(-0.05, 1.05))
+    ax_r.set(xlabel="env steps", ylabel="mean evaluation return")
+    for ax in (ax_s, ax_r):
+        ax.grid(alpha=0.3)
+    ax_r.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.tight_layout()
+    return _png(fig)
+
+
 def frame_strip(frames: list[np.ndarray], gap: int = 4) -> bytes | None:
     """Frames side by side with white gaps, as one PNG."""
     if not frames:

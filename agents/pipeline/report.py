@@ -17,6 +17,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from . import figures
 from .episode import POWER_KEY
 from .eval_config import PPO_PREFIX
@@ -147,6 +149,40 @@ def specifics_table(result: EnvResult, aggs: dict[str, dict]) -> Table | None:
             else:
                 row.append(f"{mean_std(s)}; median {median_range(s)}")
         t.rows.append(row)
+    return t
+
+
+def task_table(result: EnvResult) -> Table | None:
+    """Success and tip-over counts per policy, grouped by each sampled task parameter that
+    varies across the episodes: categories by value, numbers split at their median."""
+    runs = [r for r in result.runs.values() if r.episodes]
+    if not runs:
+        return None
+    tasks = [e.task for e in runs[0].episodes]
+    keys = [k for k in tasks[0] if len({repr(t.get(k)) for t in tasks}) > 1] if tasks else []
+    if not keys:
+        return None
+    t = Table(["task parameter", "group", "episodes", *(result.label(r.name) for r in runs)])
+    for key in keys:
+        values = [t_.get(key) for t_ in tasks]
+        if all(isinstance(v, int | float) and not isinstance(v, bool) for v in values):
+            median = float(np.median(values))
+            groups = {
+                f"≤ {_num(median)}": [v <= median for v in values],
+                f"> {_num(median)}": [v > median for v in values],
+            }
+        else:
+            groups = {str(g): [v == g for v in values] for g in dict.fromkeys(values)}
+        for label, members in groups.items():
+            if not any(members):
+                continue
+            row = [key, label, str(sum(members))]
+            for run in runs:
+                chosen = [e for e, m in zip(run.episodes, members, strict=False) if m]
+                wins = sum(bool(e.success) for e in chosen)
+                tips = sum(e.tipped_over for e in chosen)
+                row.append(f"{wins} ok, {tips} tipped")
+            t.rows.append(row)
     return t
 
 
@@ -326,6 +362,7 @@ def _episode_json(seed: int, record) -> dict[str, Any]:
     out = {"seed": seed, **record.scalar_metrics()}
     out["terminated"], out["truncated"] = record.terminated, record.truncated
     out["specifics"] = record.specifics
+    out["task"] = record.task
     return out
 
 
@@ -510,6 +547,10 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
         table(spread_table(aggs))
         heading("Reward terms (episode sums)", 3)
         table(reward_table(aggs))
+        breakdown = task_table(r)
+        if breakdown is not None:
+            heading("By sampled task parameter (episodes that succeeded / tipped over)", 3)
+            table(breakdown)
         spec_table = specifics_table(r, aggs)
         if spec_table is not None:
             heading("Env-specific metrics", 3)
@@ -520,6 +561,11 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
             f"{r.env_id}: FASM over time on seed {suite.seeds[0]}",
         )
         figure(f"{slug}_boxes.png", figures.metric_boxes(r), f"{r.env_id}: per-episode metrics")
+        figure(
+            f"{slug}_learning.png",
+            figures.learning_curves(r),
+            f"{r.env_id}: learning curves of the PPO runs (evaluation success rate and return)",
+        )
         figure(
             f"{slug}_specific.png", figures.specific_boxes(r), f"{r.env_id}: env-specific metrics"
         )
