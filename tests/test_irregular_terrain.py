@@ -90,7 +90,7 @@ def test_observation_info_and_reward_terms(terrain):
         obs, reward, terminated, truncated, info = env.step(policy(obs))
         assert env.observation_space.contains(obs) and np.all(np.isfinite(obs))
         terms = {k: v for k, v in info.items() if k.startswith("reward_")}
-        assert set(terms) == {f"reward_{n}" for n in base.weights}
+        assert set(terms) == {f"reward_{n}" for n in [*base.weights, "alive"]}
         assert reward == pytest.approx(sum(terms.values()))
         assert info["zmp_margin"] >= 0.0 and info["pitch_rate"] == obs[structure["imu_gyro"]][1]
         if info["cycle_stats"] is not None:

@@ -58,10 +58,15 @@ Crossing the default ditch takes 20 steps, 102 s (1017 control steps); the time 
 
 | Reward term (info key) | meaning |
 |---|---|
-| reward_progress | progress_weight x CoG speed along x [m/s] |
+| reward_progress | progress_weight x CoG speed along x, clipped to ±0.1 m/s [m/s] |
 | reward_stability | stability_weight x clip(static_margin_m / 0.1 m, -1, 1) (0.1 m = rho/2) |
+| reward_alive | the largest cost of a step (the bounds of progress, stability, effort), paid while up |
+| reward_success | on the step that completes the crossing: (horizon_steps - steps taken) x the largest reward of a step |
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
-| reward_effort | -effort_weight x sum of |actuator power| / (robot weight x 0.1 m/s) |
+| reward_effort | -effort_weight x min(sum of |actuator power| / (robot weight x 0.1 m/s), 10) |
+
+Every term is bounded: an episode that ends by tipping over returns less than staying up, and
+one that stands still on the near side until the time limit returns less than crossing.
 
 The episode ends (terminated) when the robot tips over (body tilt > tip_over_angle_deg) or
 succeeds: every foot past the far edge of the ditch (the finish line on flat ground), all six
@@ -156,6 +161,12 @@ def _as_slice(index: np.ndarray):
     return index
 
 
+PROGRESS_CLIP_M_S = 0.1
+"""Bound of the progress term's CoG speed [m/s] (the reference gait peaks near 0.065 m/s)."""
+EFFORT_CAP = 10.0
+"""Bound of the effort term's power ratio [-] (the reference gait peaks near 5.5)."""
+
+
 class DitchCrossingEnv(HexapodEnv):
     """The 3-UPU hexapod crossing a ditch (or walking on flat ground); see the module docstring.
 
@@ -164,7 +175,9 @@ class DitchCrossingEnv(HexapodEnv):
     ditch_depth_range ((low, high) [m] or None): when given, sampled uniformly from np_random at
     every reset; action_mode ("residual" | "joint"), residual_limb_m, residual_leg_m [m],
     residual_filter_tau [s] (0: no filter); control_dt, physics_dt [s];
-    progress_weight, stability_weight, tip_over_penalty, effort_weight; contact_threshold
+    progress_weight, stability_weight, tip_over_penalty, effort_weight; horizon_steps (the
+    episode's step budget, as the registered time limit, that the success bonus counts the
+    remaining steps of); contact_threshold
     (fraction of the weight); tip_over_angle_deg; reset_noise_scale [m] (the robot starts
     shifted by up to this along x and y, and turned so that its feet move up to this much);
     friction; gait_timing (GaitTiming), gait_settings (GaitSettings), params (UpuParams);
@@ -201,6 +214,7 @@ class DitchCrossingEnv(HexapodEnv):
         stability_weight: float = 0.05,
         tip_over_penalty: float = 100.0,
         effort_weight: float = 0.02,
+        horizon_steps: int = 1500,
         contact_threshold: float = 0.005,
         tip_over_angle_deg: float = 20.0,
         reset_noise_scale: float = 0.005,
@@ -258,6 +272,7 @@ class DitchCrossingEnv(HexapodEnv):
             "tip_over": tip_over_penalty,
             "effort": effort_weight,
         }
+        self.horizon_steps = int(horizon_steps)
         self.ditch_ranges = {
             name.removesuffix("_range"): _check_range(name, value)
             for name, value in zip(
@@ -553,7 +568,7 @@ class DitchCrossingEnv(HexapodEnv):
         terms = self._reward_terms(cog_x, tipped)
         self._prev_cog_x = cog_x
         self._last_obs = self._observation()
-        reward = terms["progress"] + terms["stability"] + terms["tip_over"] + terms["effort"]
+        reward = float(sum(terms.values()))
         terminated = self._tipped or self._success
         return self._last_obs, reward, terminated, False, self._info(terms, unstable=False)
 
@@ -638,6 +653,17 @@ class DitchCrossingEnv(HexapodEnv):
             self._add_sensor_noise(b)
         return b.copy()
 
+    def step_cost_bound(self) -> float:
+        """The largest cost one step can carry (bounded negative parts of progress, stability
+        and effort); the ``alive`` term pays it on every step the robot is up."""
+        w = self.weights
+        return w["progress"] * PROGRESS_CLIP_M_S + w["stability"] + w["effort"] * EFFORT_CAP
+
+    def step_reward_bound(self) -> float:
+        """The largest reward one step can earn (alive + the bounded positive terms)."""
+        w = self.weights
+        return self.step_cost_bound() + w["progress"] * PROGRESS_CLIP_M_S + w["stability"]
+
     def _reward_terms(self, cog_x: float, tipped: bool) -> dict[str, float]:
         w = self.weights
         speed = (cog_x - self._prev_cog_x) / self.control_dt
@@ -645,11 +671,16 @@ class DitchCrossingEnv(HexapodEnv):
         margin = min(max(self._static_margin, -r), r) / r
         d = self.data
         power = float(np.abs(d.actuator_force[self._act] * d.actuator_velocity[self._act]).sum())
+        # Crossing ends the episode: the bonus pays what the remaining steps could at most have
+        # earned, so that standing still on the near side never returns more than crossing.
+        remaining = max(self.horizon_steps - self._tick, 0)
         return {
-            "progress": w["progress"] * speed,
+            "progress": w["progress"] * min(max(speed, -PROGRESS_CLIP_M_S), PROGRESS_CLIP_M_S),
             "stability": w["stability"] * margin,
+            "alive": 0.0 if self._tipped else self.step_cost_bound(),
+            "success": remaining * self.step_reward_bound() if self._success else 0.0,
             "tip_over": -w["tip_over"] if tipped else 0.0,
-            "effort": -w["effort"] * power / self._reference_power,
+            "effort": -w["effort"] * min(power / self._reference_power, EFFORT_CAP),
         }
 
     def _info(self, terms: dict[str, float], unstable: bool) -> dict:

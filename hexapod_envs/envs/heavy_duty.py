@@ -27,6 +27,11 @@ from .sensors import RobotSensors
 XI_F_DEG = 20.0
 """Tipping threshold ξ_f of Zhang et al. 2024 §3 [deg]."""
 
+EFFORT_CAP = 20.0
+"""Bound of the effort term's power ratio |power| / (weight x gait speed) [-]: the reference gait
+peaks near 20, random actions reach 150. Bounded costs let the alive term make every upright
+step's reward >= 0, so that tipping over early never pays more than staying up."""
+
 ACTION_MODES = ("joint", "residual")
 
 
@@ -317,8 +322,16 @@ class HeavyDutyEnv(HexapodEnv):
     def _extra_observation_pieces(self) -> dict[str, np.ndarray]:
         return {}
 
+    def step_cost_bound(self) -> float:
+        """The largest cost one step can carry (the sum of the bounded negative parts of the
+        forward, stability and effort terms); the ``alive`` term pays it on every step the robot
+        is up, as Gymnasium's MuJoCo envs pay a healthy reward."""
+        w = self.weights
+        forward = w["forward"] if self.walks else 0.0
+        return forward + w["stability"] * self.tipping_threshold_deg / 45.0 + w["effort"] * EFFORT_CAP
+
     def _reward_terms(self, tipped: bool, cog_x: float) -> dict[str, float]:
-        """Named reward terms; the progress term only in walking scenarios."""
+        """Named reward terms, each bounded; the progress term only in walking scenarios."""
         w = self.weights
         v_ref = self.gait.gait.body_speed
         margin = min(max(self._fasm_deg, -self.tipping_threshold_deg), 45.0)
@@ -327,10 +340,12 @@ class HeavyDutyEnv(HexapodEnv):
             # Progress up to the reference gait's speed: faster is not rewarded, so a policy
             # cannot trade stability for a scramble (PPO did, at 1 m/s with FASM ~ 0).
             speed = (cog_x - self._prev_cog_x) / self.control_dt
-            terms["forward"] = w["forward"] * min(speed, v_ref) / v_ref
+            terms["forward"] = w["forward"] * min(max(speed / v_ref, -1.0), 1.0)
         terms["stability"] = w["stability"] * margin / 45.0
+        terms["alive"] = 0.0 if self._tipped else self.step_cost_bound()
         terms["tip_over"] = -w["tip_over"] if tipped else 0.0
-        terms["effort"] = -w["effort"] * self._power / (self.weight_n * v_ref)
+        ratio = self._power / (self.weight_n * v_ref)
+        terms["effort"] = -w["effort"] * min(ratio, EFFORT_CAP)
         return terms
 
     def _info(self, terms: dict[str, float], unstable: bool) -> dict:

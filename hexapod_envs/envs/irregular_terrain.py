@@ -71,11 +71,15 @@ Action modes (``action_mode=``):
 
 | Reward term (info key) | meaning |
 |---|---|
-| reward_forward | forward_weight x torso CoG speed along +x [m/s] |
-| reward_steadiness_rate | -rate_weight x (pitch rate² + roll rate²) [rad²/s²] (IMU gyro) |
-| reward_steadiness_height | -height_weight x ((torso-height reading - standing) / 0.01 m)² |
+| reward_forward | forward_weight x torso CoG speed along +x, clipped to ±0.1 m/s [m/s] |
+| reward_steadiness_rate | -rate_weight x min(pitch rate² + roll rate², 4) [rad²/s²] (IMU gyro) |
+| reward_steadiness_height | -height_weight x (min(|torso-height reading - standing|, 0.1 m) / 0.01 m)² |
 | reward_torso_collision | -collision_penalty when the torso touched the terrain during the step |
+| reward_alive | the largest cost of a step (the bounds above), paid while the robot is up |
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
+
+Every term is bounded and the alive term makes an upright step's reward >= 0, so an episode that
+ends by tipping over returns less than staying up, however unsteadily the robot walks.
 
 `info` keys: the reward terms; ``fasm_margin_deg``, ``fasm_edge``, ``stance_legs`` (feet in
 contact), ``is_tipping`` (FASM below ``tipping_threshold_deg``), ``is_tipped_over`` (torso up axis
@@ -166,6 +170,13 @@ def _uniform_in(rng: np.random.Generator, ranges: tuple[tuple[float, float], ...
     low, high = ranges[int(rng.integers(len(ranges)))]
     return float(rng.uniform(low, high))
 
+
+SPEED_CLIP_M_S = 0.1
+"""Bound of the forward term's speed [m/s] (the reference gait walks about 0.06 m/s)."""
+RATE_CAP = 4.0
+"""Bound of the steadiness term's pitch² + roll² rate [rad²/s²] (random actions reach 20)."""
+HEIGHT_CLIP_M = 0.1
+"""Bound of the steadiness term's torso-height deviation [m]."""
 
 _CONTACT_CHECKS = 5
 """Torso-terrain contact is looked for this many times per control period (every 10 ms)."""
@@ -673,16 +684,29 @@ class IrregularTerrainEnv(HexapodEnv):
             pieces["posture_gains"] = self.controller.gains
         return pieces
 
+    def step_cost_bound(self) -> float:
+        """The largest cost one step can carry (the bounded negative parts of every term but
+        tip_over); the ``alive`` term pays it on every step the robot is up."""
+        w = self.weights
+        height = (HEIGHT_CLIP_M / 0.01) ** 2
+        return (
+            w["forward"] * SPEED_CLIP_M_S
+            + w["steadiness_rate"] * RATE_CAP
+            + w["steadiness_height"] * height
+            + w["torso_collision"]
+        )
+
     def _reward_terms(self, touched: bool, tipped: bool) -> dict[str, float]:
         w = self.weights
         speed = (self._cog[0] - self._prev_cog_x) / self.control_dt
         rates = float(self._gyro[0] ** 2 + self._gyro[1] ** 2)
-        dz = min(abs(self._height_deviation()), 0.1) / 0.01
+        dz = min(abs(self._height_deviation()), HEIGHT_CLIP_M) / 0.01
         return {
-            "forward": w["forward"] * speed,
-            "steadiness_rate": -w["steadiness_rate"] * rates,
+            "forward": w["forward"] * min(max(speed, -SPEED_CLIP_M_S), SPEED_CLIP_M_S),
+            "steadiness_rate": -w["steadiness_rate"] * min(rates, RATE_CAP),
             "steadiness_height": -w["steadiness_height"] * dz * dz,
             "torso_collision": -w["torso_collision"] if touched else 0.0,
+            "alive": 0.0 if self._tipped else self.step_cost_bound(),
             "tip_over": -w["tip_over"] if tipped else 0.0,
         }
 
