@@ -103,28 +103,27 @@ def test_untrained_hybrid_is_the_analytical_controller_in_evaluate(runs, tmp_pat
     assert len(hybrid) == 2
 
 
-def test_hybrid_in_another_action_mode_is_refused(tmp_path, capsys):
+def test_evaluate_runs_a_hybrid_in_its_trained_action_mode(tmp_path):
+    """The cliff hybrid trains in the residual mode with residual_scale 2: evaluate.py builds
+    that env for it (the suite's env keeps the defaults), and a direct load into an env in
+    another action mode is refused with both modes named."""
     run = train(tmp_path, "cliff", config=str(ROOT / "configs" / "cliff_walk_hybrid.yaml"))
-    code = evaluate(tmp_path / "rep", f"ppo:{run}", env="HexapodCliffWalk-v0")
-    assert code == 2
-    err = capsys.readouterr().err
-    assert "trained with action_mode='joint' but the env has action_mode='residual'" in err
-    ok = evaluate(
-        tmp_path / "rep2",
-        f"ppo:{run}",
-        env="HexapodCliffWalk-v0",
-        env_kwargs={"action_mode": "joint"},
-    )
-    assert ok == 0
+    assert evaluate(tmp_path / "rep", "zero", f"ppo:{run}", env="HexapodCliffWalk-v0") == 0
+    metrics = json.loads((tmp_path / "rep" / "metrics.json").read_text())
+    assert metrics["envs"]["HexapodCliffWalk-v0"]["policies"][f"ppo:{run}"]["episodes"]
+    env = gym.make("HexapodCliffWalk-v0", action_mode="joint")
+    with pytest.raises(ValueError, match="action_mode='residual' but the env has action_mode"):
+        PPOPolicy.load(run, env)
 
 
 def test_training_writes_a_learning_curve(runs):
     curve = load_learning_curve(runs["learning"])
-    np.testing.assert_array_equal(curve.timesteps, [128, 256])
-    assert curve.returns.shape == (2, 2) and curve.successes.shape == (2, 2)
+    # step 0 is the initial policy (here: the analytical controller), then every eval.freq
+    np.testing.assert_array_equal(curve.timesteps, [0, 128, 256])
+    assert curve.returns.shape == (3, 2) and curve.successes.shape == (3, 2)
     assert set(np.unique(curve.successes)) <= {0.0, 1.0}
     rows = curve.rows()
-    assert [r["timesteps"] for r in rows] == [128, 256]
+    assert [r["timesteps"] for r in rows] == [0, 128, 256]
     assert all(0.0 <= r["success_rate"] <= 1.0 for r in rows)
 
 

@@ -13,6 +13,7 @@ import yaml
 
 from agents.pipeline import callbacks
 from agents.pipeline.cli import evaluate_main, train_main
+from agents.ppo import PPOPolicy
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = str(ROOT / "configs" / "cliff_walk_ppo.yaml")
@@ -189,11 +190,19 @@ def test_evaluate_smoke_writes_json_markdown_and_html_rows(run, tmp_path, capsys
 
 
 def test_identical_seeds_give_identical_episodes_across_policies(tmp_path):
-    """analytical and zero both walk the reference gait (residual mode): same seeds, same data."""
-    assert evaluate(tmp_path / "rep", "analytical", "zero") == 0
+    """Before the cliff, analytical (joint mode, its own env) and zero (the reference gait in the
+    default residual mode) walk the same gait: same seeds, same tasks, the same episodes up to
+    the joint mode's rounding of the gait's targets."""
+    extra = ("--set", "envs=[{id: HexapodCliffWalk-v0, kwargs: {task_distribution: train}}]")
+    assert evaluate(tmp_path / "rep", "analytical", "zero", extra=extra) == 0
     metrics = json.loads((tmp_path / "rep" / "metrics.json").read_text())
     policies = metrics["envs"]["HexapodCliffWalk-v0"]["policies"]
-    assert policies["analytical"]["episodes"] == policies["zero"]["episodes"]
+    analytical, zero = policies["analytical"]["episodes"], policies["zero"]["episodes"]
+    assert [e["task"] for e in analytical] == [e["task"] for e in zero]
+    assert analytical[0]["task"] != analytical[1]["task"]  # sampled per seed
+    for a, z in zip(analytical, zero, strict=True):
+        assert a["episode_return"] == pytest.approx(z["episode_return"], rel=1e-4)
+        assert a["distance_m"] == pytest.approx(z["distance_m"], abs=1e-4)
 
 
 def test_missing_model_path_is_a_clear_error(tmp_path, capsys):
@@ -296,3 +305,27 @@ def test_env_specific_metrics_reach_metrics_json_and_report(tmp_path):
     assert "skipped analytical - no analytical controller registered" in md
     assert "### Env-specific metrics" in md and "height_m (lowest torso height)" in md
     assert "figures/PipelineToy-v0_specific.png" in md
+
+
+def test_zero_initialised_action_net_starts_at_the_reference_and_is_evaluated_at_step_0(tmp_path):
+    """policy.zero_init_action_net: the untrained policy is the zero action (the reference gait
+    in the residual mode), and the learning curve starts with its evaluation at step 0."""
+    extra = [*TINY, "train.total_timesteps=256", "policy.zero_init_action_net=true"]
+    extra += ["eval.freq=256", "eval.n_episodes=1", "ppo.learning_rate=1e-12"]
+    assert train(tmp_path, "zero", overrides=extra) == 0
+    env = gym.make("HexapodCliffWalk-v0")
+    policy = PPOPolicy.load(tmp_path / "zero" / "final", env)
+    obs, _ = env.reset(seed=0)
+    np.testing.assert_allclose(policy(obs), np.zeros(18), atol=1e-6)
+    with np.load(tmp_path / "zero" / "evaluations.npz") as log:
+        assert list(log["timesteps"]) == [0, 256]
+
+
+def test_each_policy_is_evaluated_in_the_action_mode_it_was_built_for(run):
+    from agents.pipeline.evaluation import policy_env_kwargs
+
+    assert policy_env_kwargs("analytical", "HexapodCliffWalk-v0") == {"action_mode": "joint"}
+    assert policy_env_kwargs("analytical", "HexapodStewartTilt-v0") == {}
+    assert policy_env_kwargs("zero", "HexapodCliffWalk-v0") == {}
+    trained = policy_env_kwargs(f"ppo:{run[0]}", "HexapodCliffWalk-v0")
+    assert trained == {"action_mode": "residual", "residual_scale": 0.25}

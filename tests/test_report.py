@@ -104,7 +104,8 @@ def test_envs_option_keeps_the_suite_kwargs(tmp_path):
     assert evaluate_main(argv) == 0
     metrics = json.loads((out / "metrics.json").read_text())
     assert metrics["envs"]["HexapodIrregularTerrain-v0"]["kwargs"] == {
-        "gait_ground_search": "always"
+        "task_distribution": "test",
+        "gait_ground_search": "always",
     }
 
 

@@ -126,6 +126,14 @@ class StatsEvalCallback(EvalCallback):
         )
         self._accumulators: dict[int, EpisodeAccumulator] = {}
 
+    def _on_training_start(self) -> None:
+        """Evaluate the initial policy too (step 0 of the learning curve): with a zero-initialised
+        action net it is the analytical controller or the reference motion, and ``best/`` then
+        only holds a trained policy that scored higher than where training started."""
+        super()._on_training_start()
+        if self.eval_freq > 0 and self.num_timesteps == 0 and not self.evaluations_timesteps:
+            self._on_step()
+
     def _on_step(self) -> bool:
         self._accumulators = {}
         return super()._on_step()

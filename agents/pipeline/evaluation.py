@@ -40,6 +40,7 @@ class PolicyRun:
     frames: list[np.ndarray] | None = None
     video: Path | None = None  # MP4 of the first seed (with --video)
     model_dir: Path | None = None  # a ppo: policy's model directory (for learning curves)
+    env_kwargs: dict[str, Any] = field(default_factory=dict)  # on top of the suite's (action mode)
 
 
 @dataclass
@@ -110,6 +111,35 @@ def run_episode(
 
 def _env_spec(suite: EvaluationSuite, env: SuiteEnv, **extra: Any) -> EnvSpec:
     return EnvSpec(env.id, {**env.kwargs, **extra}, suite.env_time_limit(env), suite.gym_packages)
+
+
+ACTION_SETTINGS = (
+    "action_mode",
+    "residual_scale",
+    "residual_filter_tau",
+    "residual_limb_m",
+    "residual_leg_m",
+    "gait_ground_search",
+)
+"""Env kwargs that say how an action is read (not which task is posed): a policy is evaluated
+with the ones it was built for, on the suite's task."""
+
+
+def policy_env_kwargs(name: str, env_id: str) -> dict[str, Any]:
+    """The env kwargs `name` needs on top of the suite's: the analytical controller's action mode
+    (`agents.registry.ANALYTICAL_ENV_KWARGS`), a PPO run's trained action settings; none for the
+    zero and random actions (the env's default mode: zero is the reference motion)."""
+    if name == "analytical":
+        from ..registry import ANALYTICAL_ENV_KWARGS
+
+        return dict(ANALYTICAL_ENV_KWARGS.get(env_id, {}))
+    if name.startswith(PPO_PREFIX):
+        from .artifacts import find_model
+
+        config = find_model(_ppo_path(name, env_id)).training_config() or {}
+        trained = (config.get("env") or {}).get("kwargs") or {}
+        return {k: trained[k] for k in ACTION_SETTINGS if k in trained}
+    return {}
 
 
 def _ppo_path(name: str, env_id: str) -> Path:
@@ -195,9 +225,10 @@ def _kwargs_note(
     if trained is None:
         return None
     defaults = _constructor_defaults(env)
-    evaluated = suite_env.kwargs
+    evaluated = {**suite_env.kwargs, **policy_env_kwargs(name, suite_env.id)}
     differing = {}
-    for key in sorted(set(trained) | set(evaluated)):
+    # a held-out task distribution is the point of the evaluation, not a mismatch
+    for key in sorted((set(trained) | set(evaluated)) - {"task_distribution"}):
         a = trained.get(key, defaults.get(key))
         b = evaluated.get(key, defaults.get(key))
         if a != b:
@@ -211,13 +242,16 @@ def _kwargs_note(
     )
 
 
-def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, gym.Env, dict]], list[str]]:
-    """Make every env and policy (all checks happen here); returns them and warning lines."""
+def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[str]]:
+    """Make every env and policy (all checks happen here). Returns, per suite env, its result
+    and ``{policy name: (policy, env)}`` (policies that read actions alike share one env), and
+    warning lines."""
     _check_env_ids(suite)
     warnings: list[str] = []
     prepared = []
     for suite_env in suite.envs:
         env = _env_spec(suite, suite_env).make()
+        envs: dict[tuple, gym.Env] = {(): env}
         result = EnvResult(
             env_id=suite_env.id,
             kwargs=dict(suite_env.kwargs),
@@ -232,17 +266,21 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, gym.Env, dict
             if missing and suite.missing_models == "skip":
                 warnings.append(f"{suite_env.id}: skipped {name} - {missing}")
                 continue
-            policy, source = build_policy(name, env, suite_env.id, suite)
-            run = PolicyRun(name=name, source=source)
+            extra = policy_env_kwargs(name, suite_env.id)
+            key = tuple(sorted(extra.items()))
+            if key not in envs:
+                envs[key] = _env_spec(suite, suite_env, **extra).make()
+            policy, source = build_policy(name, envs[key], suite_env.id, suite)
+            run = PolicyRun(name=name, source=source, env_kwargs=extra)
             files = getattr(getattr(policy, "learned", policy), "files", None)
             run.model_dir = getattr(files, "directory", None)
             note = _kwargs_note(env, suite_env, name, getattr(policy, "train_env_kwargs", None))
             if note:
                 run.notes.append(note)
                 warnings.append(note)
-            policies[name] = (policy, run)
-        result.runs = {name: run for name, (_, run) in policies.items()}
-        prepared.append((result, env, {n: p for n, (p, _) in policies.items()}))
+            result.runs[name] = run
+            policies[name] = (policy, envs[key])
+        prepared.append((result, policies))
     return prepared, warnings
 
 
@@ -254,8 +292,8 @@ def run_suite(
 
     start = time.perf_counter()
     prepared, warnings = prepare(suite)
-    for result, env, policies in prepared:
-        for name, policy in policies.items():
+    for result, policies in prepared:
+        for name, (policy, env) in policies.items():
             run = result.runs[name]
             # one bar (with its ETA) per env x policy; it stays on screen when done
             with tqdm(
@@ -271,10 +309,11 @@ def run_suite(
                     )
                     run.episodes.append(run_episode(env, policy, seed, acc))
                     bar.update(1)
-        env.close()
+        for env in {id(e): e for _, e in policies.values()}.values():
+            env.close()
         if suite.frames or video_dir is not None:
             warnings.extend(_render(suite, result, policies, video_dir))
-    return SuiteResult(suite, [r for r, _, _ in prepared], warnings, time.perf_counter() - start)
+    return SuiteResult(suite, [r for r, _ in prepared], warnings, time.perf_counter() - start)
 
 
 CAMERA = "track"
@@ -288,23 +327,34 @@ def _render(suite: EvaluationSuite, result: EnvResult, policies: dict, video_dir
     width, height = suite.frame_size
     suite_env = next(e for e in suite.envs if e.id == result.env_id)
     render_kwargs = {"render_mode": "rgb_array", "width": width, "height": height}
-    try:
-        env = _env_spec(suite, suite_env, **render_kwargs, camera_name=CAMERA).make()
-    except UserError:  # envs of other packages: no size or camera keywords
-        env = _env_spec(suite, suite_env, render_mode="rgb_array").make()
+    envs: dict[tuple, gym.Env] = {}
+
+    def render_env(extra: dict[str, Any]) -> gym.Env:
+        key = tuple(sorted(extra.items()))
+        if key not in envs:
+            try:
+                spec = _env_spec(suite, suite_env, **extra, **render_kwargs, camera_name=CAMERA)
+                envs[key] = spec.make()
+            except UserError:  # envs of other packages: no size or camera keywords
+                envs[key] = _env_spec(suite, suite_env, **extra, render_mode="rgb_array").make()
+        return envs[key]
+
     warnings = []
     slug = result.env_id.replace("/", "_")
     steps_per_s = 1.0 / result.dt if result.dt else 50.0
     stride = max(1, round(steps_per_s / suite.video_fps))
     try:
-        for name, policy in policies.items():
+        for name in policies:
             run = result.runs[name]
+            env = render_env(run.env_kwargs)
+            # a new policy on the render env: controllers read their env's state
+            policy, _ = build_policy(name, env, result.env_id, suite)
             length = run.episodes[0].length
             wanted = set(np.linspace(0, length, suite.frame_count).round().astype(int).tolist())
             frames: list[np.ndarray] = []
             movie: list[np.ndarray] = []
 
-            def grab(step: int, wanted=wanted, frames=frames, movie=movie) -> None:
+            def grab(step: int, env=env, wanted=wanted, frames=frames, movie=movie) -> None:
                 keep_frame = suite.frames and step in wanted
                 keep_movie = video_dir is not None and step % stride == 0
                 if keep_frame or keep_movie:
@@ -327,7 +377,8 @@ def _render(suite: EvaluationSuite, result: EnvResult, policies: dict, video_dir
                 run.video = video_dir / f"{slug}_{safe}.mp4"
                 _write_mp4(run.video, movie, steps_per_s / stride)
     finally:
-        env.close()
+        for env in envs.values():
+            env.close()
     return warnings
 
 

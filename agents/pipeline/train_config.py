@@ -109,6 +109,10 @@ class PolicyConfig:
     activation: Literal["tanh", "relu", "elu", "leaky_relu", "gelu", "silu"] = "tanh"
     log_std_init: float = 0.0
     ortho_init: bool = True
+    zero_init_action_net: bool = False
+    """Zero the last layer of the action mean, so that training starts at the zero action (in a
+    residual action mode: the reference motion) instead of a random one. A hybrid run's
+    ``hybrid.zero_init_action_net`` does the same (default there: true)."""
 
     def __post_init__(self):
         for name in ("pi", "vf"):

@@ -158,10 +158,12 @@ def start_training(
             verbose=config.logging.verbose,
             **config.ppo.sb3_kwargs(),
         )
-        if config.hybrid is not None and config.hybrid.zero_init_action_net:
+        hybrid_zero = config.hybrid is not None and config.hybrid.zero_init_action_net
+        if hybrid_zero or config.policy.zero_init_action_net:
             from ..hybrid import zero_init_action_net
 
-            zero_init_action_net(model)  # start exactly at the analytical controller
+            # start exactly at the analytical controller (hybrid) or the reference motion
+            zero_init_action_net(model)
     except BaseException:
         shutil.rmtree(run_dir, ignore_errors=True)
         raise
