@@ -21,12 +21,13 @@ recovery controller, the robot tips over.
 |---|---|
 | reward_forward | forward_weight x clip(CoG speed along x / gait speed, -1, 1) |
 | reward_stability | stability_weight x clip(FASM, -20, 45) / 45 |
-| reward_alive | the largest cost of a step (forward_weight + stability_weight x 20/45 + effort_weight x 20), paid while the robot is up |
+| reward_alive | the largest cost of a step, paid while the robot is up (see below) |
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
 | reward_effort | -effort_weight x min(sum of |joint power| / (weight x gait speed), 20) |
 
-Every term is bounded and the alive term makes an upright step's reward >= 0, so an episode that
-ends by tipping over returns less than staying up, however badly the robot moves.
+Every term is bounded and the alive term (forward_weight + stability_weight x 20/45 +
+effort_weight x 20) makes an upright step's reward >= 0, so an episode that ends by tipping over
+returns less than staying up, however badly the robot moves.
 
 Task distributions (``task_distribution=``): "paper" (default) is the scenario above;
 "train" / "test" draw cliff distance, side, edge offset, drop, ground friction and a payload

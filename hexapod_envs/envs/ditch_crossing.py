@@ -60,8 +60,8 @@ Crossing the default ditch takes 20 steps, 102 s (1017 control steps); the time 
 |---|---|
 | reward_progress | progress_weight x CoG speed along x, clipped to ±0.1 m/s [m/s] |
 | reward_stability | stability_weight x clip(static_margin_m / 0.1 m, -1, 1) (0.1 m = rho/2) |
-| reward_alive | the largest cost of a step (the bounds of progress, stability, effort), paid while up |
-| reward_success | on the step that completes the crossing: (horizon_steps - steps taken) x the largest reward of a step |
+| reward_alive | the largest cost of a step (bounds of progress, stability, effort), while up |
+| reward_success | on crossing: (horizon_steps - steps taken) x the largest reward of a step |
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
 | reward_effort | -effort_weight x min(sum of |actuator power| / (robot weight x 0.1 m/s), 10) |
 

@@ -328,7 +328,8 @@ class HeavyDutyEnv(HexapodEnv):
         is up, as Gymnasium's MuJoCo envs pay a healthy reward."""
         w = self.weights
         forward = w["forward"] if self.walks else 0.0
-        return forward + w["stability"] * self.tipping_threshold_deg / 45.0 + w["effort"] * EFFORT_CAP
+        stability = w["stability"] * self.tipping_threshold_deg / 45.0
+        return forward + stability + w["effort"] * EFFORT_CAP
 
     def _reward_terms(self, tipped: bool, cog_x: float) -> dict[str, float]:
         """Named reward terms, each bounded; the progress term only in walking scenarios."""

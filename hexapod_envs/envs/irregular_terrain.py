@@ -73,7 +73,7 @@ Action modes (``action_mode=``):
 |---|---|
 | reward_forward | forward_weight x torso CoG speed along +x, clipped to ±0.1 m/s [m/s] |
 | reward_steadiness_rate | -rate_weight x min(pitch rate² + roll rate², 4) [rad²/s²] (IMU gyro) |
-| reward_steadiness_height | -height_weight x (min(|torso-height reading - standing|, 0.1 m) / 0.01 m)² |
+| reward_steadiness_height | -height_weight x (min(|torso height - standing|, 0.1 m) / 0.01 m)² |
 | reward_torso_collision | -collision_penalty when the torso touched the terrain during the step |
 | reward_alive | the largest cost of a step (the bounds above), paid while the robot is up |
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |

@@ -29,8 +29,9 @@ Observation: as HexapodCliffWalk-v0 without the gait phase (joint_pos, joint_vel
 foot_contact, fasm_margin_deg, imu_gyro, imu_accel, imu_quat). Action: 18 values in [-1, 1];
 ``"residual"`` (default) offsets the hold posture by residual_scale x half range (default 2, so
 any joint target is reachable), ``"joint"`` gives targets directly. Reward terms as
-HexapodCliffWalk-v0 without forward: stability, alive, tip_over, effort. `info` adds platform_tilt_deg, platform_rpy, actuator_lengths (6, m),
-adjustment_leg (the first lifted leg to land after tipping was flagged) and recovery_time [s].
+HexapodCliffWalk-v0 without forward: stability, alive, tip_over, effort. `info` adds
+platform_tilt_deg, platform_rpy, actuator_lengths (6, m), adjustment_leg (the first lifted leg
+to land after tipping was flagged) and recovery_time [s].
 """
 
 from __future__ import annotations
