@@ -125,21 +125,46 @@ ACTION_SETTINGS = (
 with the ones it was built for, on the suite's task."""
 
 
-def policy_env_kwargs(name: str, env_id: str) -> dict[str, Any]:
-    """The env kwargs `name` needs on top of the suite's: the analytical controller's action mode
-    (`agents.registry.ANALYTICAL_ENV_KWARGS`), a PPO run's trained action settings; none for the
-    zero and random actions (the env's default mode: zero is the reference motion)."""
+def policy_env_kwargs(name: str, env_id: str, suite_kwargs: dict | None = None) -> dict[str, Any]:
+    """The env kwargs `name` needs on top of the suite's (`suite_kwargs`): the analytical
+    controller's action mode (`agents.registry.ANALYTICAL_ENV_KWARGS`); a PPO run's trained action
+    settings (a setting the suite sets but the run left at its default goes back to the default);
+    none for the zero and random actions (the env's default mode: zero is the reference motion)."""
     if name == "analytical":
         from ..registry import ANALYTICAL_ENV_KWARGS
 
         return dict(ANALYTICAL_ENV_KWARGS.get(env_id, {}))
-    if name.startswith(PPO_PREFIX):
-        from .artifacts import find_model
+    if not name.startswith(PPO_PREFIX):
+        return {}
+    from .artifacts import find_model
 
-        config = find_model(_ppo_path(name, env_id)).training_config() or {}
-        trained = (config.get("env") or {}).get("kwargs") or {}
-        return {k: trained[k] for k in ACTION_SETTINGS if k in trained}
-    return {}
+    config = find_model(_ppo_path(name, env_id)).training_config() or {}
+    trained = (config.get("env") or {}).get("kwargs") or {}
+    extra = {k: trained[k] for k in ACTION_SETTINGS if k in trained}
+    reset = [k for k in ACTION_SETTINGS if k in (suite_kwargs or {}) and k not in trained]
+    if reset:
+        defaults = _registered_defaults(env_id)
+        extra.update({k: defaults[k] for k in reset if k in defaults})
+    return extra
+
+
+def _registered_defaults(env_id: str) -> dict[str, Any]:
+    """Keyword defaults of the registered env class (its constructors along the MRO) and the
+    registration's kwargs."""
+    spec = gym.spec(env_id)
+    creator = gym.envs.registration.load_env_creator(spec.entry_point)
+    defaults: dict[str, Any] = {}
+    for klass in reversed(getattr(creator, "__mro__", (creator,))):
+        init = klass.__dict__.get("__init__") if isinstance(klass, type) else klass
+        if init is None:
+            continue
+        try:
+            params = inspect.signature(init).parameters.values()
+        except (TypeError, ValueError):
+            continue
+        defaults.update({p.name: p.default for p in params if p.default is not p.empty})
+    defaults.update(spec.kwargs)
+    return defaults
 
 
 def _ppo_path(name: str, env_id: str) -> Path:
@@ -225,7 +250,7 @@ def _kwargs_note(
     if trained is None:
         return None
     defaults = _constructor_defaults(env)
-    evaluated = {**suite_env.kwargs, **policy_env_kwargs(name, suite_env.id)}
+    evaluated = {**suite_env.kwargs, **policy_env_kwargs(name, suite_env.id, suite_env.kwargs)}
     differing = {}
     # a held-out task distribution is the point of the evaluation, not a mismatch
     for key in sorted((set(trained) | set(evaluated)) - {"task_distribution"}):
@@ -266,7 +291,7 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[
             if missing and suite.missing_models == "skip":
                 warnings.append(f"{suite_env.id}: skipped {name} - {missing}")
                 continue
-            extra = policy_env_kwargs(name, suite_env.id)
+            extra = policy_env_kwargs(name, suite_env.id, suite_env.kwargs)
             key = tuple(sorted(extra.items()))
             if key not in envs:
                 envs[key] = _env_spec(suite, suite_env, **extra).make()
