@@ -357,6 +357,14 @@ def report_title(suite: Any) -> str:
     return f"{suite.title}: " + " vs ".join(kinds)
 
 
+def _action_settings(kwargs: dict[str, Any]) -> str:
+    """" (with action_mode=joint, ...)" for a policy run in other action settings than the
+    suite's env (each policy runs in the action mode it was built for)."""
+    if not kwargs:
+        return ""
+    return " (with " + ", ".join(f"{k}={v}" for k, v in kwargs.items()) + ")"
+
+
 # --- assembling -----------------------------------------------------------------------------
 def _episode_json(seed: int, record) -> dict[str, Any]:
     out = {"seed": seed, **record.scalar_metrics()}
@@ -383,6 +391,7 @@ def build_metrics(result: SuiteResult) -> dict[str, Any]:
                 n: {
                     "label": r.label(n),
                     "source": run.source,
+                    "env_kwargs": dict(run.env_kwargs),
                     "notes": run.notes,
                     "aggregate": aggs[n],
                     "episodes": [
@@ -528,7 +537,10 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
         aggs = {r.label(n): aggregate(run.episodes) for n, run in r.runs.items()}
         para(verdict_paragraph(r, aggs))
         limit = r.max_episode_steps
-        sources = "; ".join(f"`{r.label(n)}`: {run.source}" for n, run in r.runs.items())
+        sources = "; ".join(
+            f"`{r.label(n)}`: {run.source}{_action_settings(run.env_kwargs)}"
+            for n, run in r.runs.items()
+        )
         xi = "no ξ" if r.xi_deg is None else f"ξ = {r.xi_deg:g}°"
         para(
             f"Env kwargs: `{r.kwargs or {}}`; time limit {limit} steps"
