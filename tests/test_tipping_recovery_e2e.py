@@ -96,3 +96,27 @@ def test_gait_with_recovery_stops_at_the_cliff_instead_of_tipping():
     assert d["adjustment_leg"] == "RF" and d["phase"] == "holding"
     assert "no ground under RF" in d["failure"]
     assert info["fasm_margin_deg"] > 20.0
+
+
+def test_support_feet_in_a_line_skip_the_force_distribution_instead_of_crashing(monkeypatch):
+    """A learned residual can put the loaded feet on a line in (x, y): the terrain plane is then
+    undetermined, and the supported phase reports degenerate geometry instead of raising (a
+    hybrid training run crashed on it)."""
+    import agents.tipping.controller as controller
+
+    def no_plane(feet):
+        raise ValueError("the 3 points' (x, y) are collinear")
+
+    monkeypatch.setattr(controller, "terrain_plane", no_plane)
+    env = gym.make("HexapodStewartTilt-v0", scenario="side")
+    policy = TippingRecoveryPolicy(env)
+    obs, _ = env.reset(seed=0)
+    policy.reset()
+    statuses = set()
+    while True:
+        obs, _, terminated, truncated, _ = env.step(policy(obs))
+        if policy.diagnostics["phase"] == "supported":
+            statuses.add(policy.diagnostics["qp_status"])
+        if terminated or truncated:
+            break
+    assert "degenerate_geometry" in statuses

@@ -358,7 +358,7 @@ def report_title(suite: Any) -> str:
 
 
 def _action_settings(kwargs: dict[str, Any]) -> str:
-    """" (with action_mode=joint, ...)" for a policy run in other action settings than the
+    """ " (with action_mode=joint, ...)" for a policy run in other action settings than the
     suite's env (each policy runs in the action mode it was built for)."""
     if not kwargs:
         return ""

@@ -572,8 +572,13 @@ class TippingRecoveryController:
                 omega=self._gyro_f,
                 omega_dot=(self._gyro_f - self._gyro_prev) / self.control_dt,
             )
-            normal = terrain_plane(feet_k).normal
-            result, cone_ratio = self._solve_qp(feet_k, cog, wrench, normal)
+            try:
+                normal = terrain_plane(feet_k).normal
+            except ValueError:  # the loaded feet lie on a line in (x, y): no plane to fit
+                normal = None
+            result, cone_ratio = (
+                (None, None) if normal is None else self._solve_qp(feet_k, cog, wrench, normal)
+            )
             self._last_qp = result
             d["qp_cone_ratio"] = cone_ratio
             if result is None:
