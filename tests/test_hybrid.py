@@ -13,8 +13,7 @@ from agents.pipeline.train_config import load_train_config
 from agents.registry import analytical_policy
 
 CONFIGS = Path(__file__).resolve().parents[1] / "configs"
-HYBRID_CONFIGS = [
-    "cliff_walk_hybrid.yaml",
+HYBRID_CONFIGS = [  # residual mode: a zero learned action is the analytical controller
     "stewart_tilt_hybrid.yaml",
     "irregular_terrain_hybrid.yaml",
     "irregular_terrain_gains.yaml",
@@ -63,6 +62,33 @@ def test_zero_residual_reproduces_the_analytical_controller(name):
     assert len(observed) == len(expected)
     for step, (a, b) in enumerate(zip(expected, observed, strict=True)):
         np.testing.assert_array_equal(a, b, err_msg=f"{name}: step {step}")
+
+
+def test_cliff_safety_filter_walks_the_reference_and_hands_over_to_the_recovery():
+    """configs/cliff_walk_hybrid.yaml (safety mode): with a zero learned action the env action
+    is the reference gait (zero) while the FASM is at or above ξ_f, the recovery's action while
+    it is overriding; on the paper's cliff the hand-over happens and the robot does not tip."""
+    name = "cliff_walk_hybrid.yaml"
+    settings = load_train_config(CONFIGS / name).hybrid
+    assert settings.mode == "safety"
+    env = config_env(name)
+    core = HybridCore(env, HybridSettings(mode="safety", scale=settings.scale))
+    obs, _ = env.reset(seed=0)
+    core.reset()
+    recovery, computed = core.base, []
+    core.base = lambda o: computed.append(np.asarray(recovery(o), dtype=np.float32)) or computed[-1]
+    overrides = 0
+    while True:
+        action, override = core(obs, np.zeros(18, dtype=np.float32))
+        if override:
+            overrides += 1
+            np.testing.assert_array_equal(action, np.clip(computed[-1], -1.0, 1.0))
+        else:
+            np.testing.assert_array_equal(action, np.zeros(18))
+        obs, _, terminated, truncated, info = env.step(action)
+        if terminated or truncated:
+            break
+    assert overrides > 0 and not info["is_tipped_over"]
 
 
 def test_controller_is_reset_at_every_env_reset():

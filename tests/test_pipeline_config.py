@@ -37,7 +37,18 @@ def test_shipped_training_configs_load_with_their_env_ids(name, env_id):
 def test_default_suite_names_all_four_envs_and_shipped_models():
     suite = load_suite(CONFIGS / "evaluate_default.yaml")
     assert [e.id for e in suite.envs] == list(TRAIN_CONFIGS.values())
-    assert suite.policies == ["analytical", "zero", "ppo:models/{env_id}"]
+    assert suite.policies == [
+        "analytical",
+        "zero",
+        "random",
+        "ppo:models/{env_id}/ppo",
+        "ppo:models/{env_id}/hybrid",
+        "ppo:models/{env_id}/gains",
+    ]
+    assert all(e.kwargs["task_distribution"] == "test" for e in suite.envs)
+    full = load_suite(CONFIGS / "evaluate_full.yaml")
+    assert full.policies == suite.policies and full.envs == suite.envs
+    assert full.episodes >= 20 and full.output_dir == "reports/shipped"
     assert suite.output_dir == "reports/default" and suite.missing_models == "skip"
 
 
@@ -281,7 +292,7 @@ def test_zoo_hyperparameter_file_is_generated_from_the_configs():
     assert (CONFIGS / "rl_zoo_hyperparams.yaml").read_text() == expected
     entries = yaml.safe_load(expected)
     assert set(entries) == set(TRAIN_CONFIGS.values())
-    assert entries["HexapodCliffWalk-v0"]["learning_rate"] == "lin_0.0003"
+    assert entries["HexapodCliffWalk-v0"]["learning_rate"] == "lin_0.0001"
 
 
 def test_zoo_cannot_express_a_linear_schedule_to_a_nonzero_value():
