@@ -109,16 +109,23 @@ def test_run_saves_statistics_without_pickle(run):
 
 
 def test_shipped_models_load_without_pickle():
-    for model_dir in sorted((ROOT / "models").iterdir()):
-        assert not list(model_dir.glob("*.pkl")), model_dir
-        env_id = model_dir.name
-        import yaml
+    """Every shipped agent (models/<env id>/<ppo|hybrid|gains>/) loads without unpickling, in
+    the action settings it was trained with, and acts inside the action space."""
+    import yaml
 
+    import hexapod_envs  # noqa: F401  (registers the env ids)
+
+    model_dirs = sorted(p.parent for p in (ROOT / "models").glob("*/*/model.zip"))
+    assert {d.name for d in model_dirs} >= {"ppo", "hybrid", "gains"}
+    for model_dir in model_dirs:
+        assert not list(model_dir.glob("*.pkl")), model_dir
+        env_id = model_dir.parent.name
         kwargs = yaml.safe_load((model_dir / "config.yaml").read_text())["env"]["kwargs"] or {}
         env = gym.make(env_id, **kwargs)
         policy = PPOPolicy.load(model_dir, env)  # trust_pickle=False
         obs, _ = env.reset(seed=0)
-        assert env.action_space.contains(np.asarray(policy(obs), dtype=np.float32))
+        policy.reset()
+        assert env.action_space.contains(np.asarray(policy(obs), dtype=np.float32)), model_dir
 
 
 # --- crafted files -------------------------------------------------------------------------

@@ -18,7 +18,7 @@ ENVS = ["HexapodStewartTilt-v0", "HexapodDitchCrossing-v0"]
 @pytest.fixture(scope="module")
 def report(tmp_path_factory):
     out = tmp_path_factory.mktemp("report") / "rep"
-    argv = ["--envs", *ENVS, "--policies", "analytical", "zero", "ppo:models/{env_id}"]
+    argv = ["--envs", *ENVS, "--policies", "analytical", "zero", "ppo:models/{env_id}/hybrid"]
     argv += ["--episodes", "2", "--max-episode-steps", "40", "--output-dir", str(out)]
     assert evaluate_main([*argv, "--no-progress"]) == 0
     return out
@@ -33,7 +33,7 @@ def test_report_has_no_placeholder_a_verdict_per_env_and_the_reading_guide(repor
     for env_id in ENVS:
         section = md.split(f"## {env_id}\n", 1)[1].split("\n## ", 1)[0]
         assert section.count("**Verdict:**") == 1
-        assert f"| ppo:models/{env_id} |" in section
+        assert f"| ppo:models/{env_id}/hybrid |" in section
         assert "\n| zero |" in section  # the reference-motion row
         assert "vs the reference motion (`zero`)" in section
     assert "static margin > 0 mm" in md
