@@ -1,0 +1,44 @@
+"""benchmarks/physics_settings.py: the sweep's rows on one tiny setting (no timing assertions)."""
+
+import math
+import sys
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the benchmarks package
+
+from benchmarks.physics_settings import PhysicsSetting, sweep  # noqa: E402
+
+SPEED_KEYS = {
+    "kind",
+    "robot",
+    "setting",
+    "env",
+    "actions",
+    "physics_dt",
+    "substeps",
+    "sim_s",
+    "wall_s",
+    "sim_per_wall",
+    "episodes_ended",
+    "unstable",
+}
+
+
+def test_sweep_speed_rows_have_expected_keys_and_finite_numbers():
+    # ATHENA: its block bed is rebuilt at every reset, so the sweep's check that the model still
+    # carries the integrator and tolerance after a reset is exercised too (it raises if not).
+    setting = PhysicsSetting(2.0, "euler", tolerance=1e-6)
+    rows = sweep("athena", [setting], seconds=0.2, repeats=1, fidelity=False)
+    assert len(rows) == 4  # ramp and blocks, zero and random actions
+    assert {(r["env"], r["actions"]) for r in rows} == {
+        (t, a) for t in ("ramp", "blocks") for a in ("zero", "random")
+    }
+    for r in rows:
+        assert set(r) == SPEED_KEYS
+        assert r["kind"] == "speed" and r["robot"] == "athena" and r["setting"] == setting
+        for key in ("physics_dt", "sim_s", "wall_s", "sim_per_wall"):
+            assert math.isfinite(r[key]) and r[key] > 0, key
+        # x2 of 2 ms is not allowed (25 substeps must stay a multiple of 5): 15 substeps
+        assert r["substeps"] == 15 and math.isclose(r["physics_dt"], 0.05 / 15)
+        assert math.isclose(r["sim_s"], 0.2)
+        assert r["unstable"] == 0
