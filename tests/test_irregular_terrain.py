@@ -272,3 +272,21 @@ def test_policy_rejects_gains_outside_the_unit_interval():
     env = gym.make(ENV_ID, action_mode="gains")
     with pytest.raises(ValueError, match="kz"):
         AthenaPosturePolicy(env, kz=1.2)
+
+
+def test_standing_still_is_not_a_success():
+    """Success needs progress (half the gait's nominal distance), not only no tip-over and no
+    torso contact: a robot holding its start posture fails, the reference gait succeeds."""
+    env = gym.make("HexapodIrregularTerrain-v0", terrain="flat", action_mode="joint")
+    obs, _ = env.reset(seed=0)
+    base = env.unwrapped
+    hold = base.action_map.to_action(obs[base.observation_structure["joint_pos"]])
+    for _ in range(100):
+        obs, _, terminated, truncated, info = env.step(hold)
+    assert not terminated and not info["is_tipped_over"] and info["torso_collisions"] == 0
+    assert abs(info["distance"]) < 0.05 and not info["is_success"]
+    walker = gym.make("HexapodIrregularTerrain-v0", terrain="flat")
+    walker.reset(seed=0)
+    for _ in range(100):
+        *_, info = walker.step(np.zeros(18, dtype=np.float32))
+    assert info["is_success"]

@@ -84,7 +84,8 @@ ends by tipping over returns less than staying up, however unsteadily the robot 
 `info` keys: the reward terms; ``fasm_margin_deg``, ``fasm_edge``, ``stance_legs`` (feet in
 contact), ``is_tipping`` (FASM below ``tipping_threshold_deg``), ``is_tipped_over`` (torso up axis
 more than ``tip_over_angle_deg`` from vertical), ``is_success`` (no tip-over, no torso contact so
-far, simulation stable), ``sim_unstable``, ``time``, ``cog``, ``distance`` (CoG x travelled);
+far, simulation stable, and at least `MIN_PROGRESS` of the gait's nominal distance walked:
+stride / phase_time x time), ``sim_unstable``, ``time``, ``cog``, ``distance`` (CoG x travelled);
 ``zmp`` and ``zmp_margin`` (eqs. 32-33 in the torso frame from the feet's vertical forces,
 `hexapod_envs.stability.zmp_margin`, m), ``torso_contact`` (this step), ``torso_collisions``
 (steps with torso contact so far), ``torso_height`` (sensor, m), ``torso_clearance`` (true
@@ -175,6 +176,9 @@ SPEED_CLIP_M_S = 0.1
 """Bound of the forward term's speed [m/s] (the reference gait walks about 0.06 m/s)."""
 RATE_CAP = 4.0
 """Bound of the steadiness term's pitch² + roll² rate [rad²/s²] (random actions reach 20)."""
+MIN_PROGRESS = 0.5
+"""Share of the gait's nominal distance (stride / phase_time x time) a successful episode walks
+(the heavy-duty envs' ``min_progress``); the reference gait walks 0.7-1.0 of it."""
 HEIGHT_CLIP_M = 0.1
 """Bound of the steadiness term's torso-height deviation [m]."""
 
@@ -710,6 +714,13 @@ class IrregularTerrainEnv(HexapodEnv):
             "tip_over": -w["tip_over"] if tipped else 0.0,
         }
 
+    def _made_progress(self) -> bool:
+        """At least `MIN_PROGRESS` of the distance the gait's nominal speed (stride per phase)
+        covers in the elapsed time: standing still or walking backwards is not a success."""
+        speed = self.gait_config["stride"] / self.gait_config["phase_time"]
+        walked = float(self._cog[0] - self._start_cog[0])
+        return walked >= MIN_PROGRESS * speed * self._step_count * self.control_dt
+
     def _info(self, terms: dict[str, float], unstable: bool, cycle_stats: dict | None) -> dict:
         stance = tuple(leg for leg, on in zip(LEG_NAMES, self._loaded, strict=True) if on)
         edge = None
@@ -722,7 +733,10 @@ class IrregularTerrainEnv(HexapodEnv):
             stance_legs=stance,
             is_tipping=self._fasm_deg < self.tipping_threshold_deg,
             is_tipped_over=self._tipped,
-            is_success=not self._tipped and not unstable and self._collisions == 0,
+            is_success=not self._tipped
+            and not unstable
+            and self._collisions == 0
+            and self._made_progress(),
             sim_unstable=unstable,
             actuator_power_w=float(
                 np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
