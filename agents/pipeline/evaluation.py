@@ -149,13 +149,18 @@ def policy_env_kwargs(name: str, env_id: str, suite_kwargs: dict | None = None) 
 
 
 def _registered_defaults(env_id: str) -> dict[str, Any]:
-    """Keyword defaults of the registered env class (its constructors along the MRO) and the
-    registration's kwargs."""
+    """Keyword defaults of the registered env class and the registration's kwargs."""
     spec = gym.spec(env_id)
     creator = gym.envs.registration.load_env_creator(spec.entry_point)
+    defaults = _class_defaults(creator) if isinstance(creator, type) else {}
+    return {**defaults, **spec.kwargs}
+
+
+def _class_defaults(cls: type) -> dict[str, Any]:
+    """Keyword defaults of `cls`'s constructors along its MRO (subclasses win)."""
     defaults: dict[str, Any] = {}
-    for klass in reversed(getattr(creator, "__mro__", (creator,))):
-        init = klass.__dict__.get("__init__") if isinstance(klass, type) else klass
+    for klass in reversed(cls.__mro__):
+        init = klass.__dict__.get("__init__")
         if init is None:
             continue
         try:
@@ -163,7 +168,6 @@ def _registered_defaults(env_id: str) -> dict[str, Any]:
         except (TypeError, ValueError):
             continue
         defaults.update({p.name: p.default for p in params if p.default is not p.empty})
-    defaults.update(spec.kwargs)
     return defaults
 
 
@@ -228,16 +232,7 @@ def _missing_reason(name: str, env_id: str) -> str | None:
 
 def _constructor_defaults(env: gym.Env) -> dict[str, Any]:
     """Keyword defaults of the env class's constructors along its MRO, plus registered kwargs."""
-    defaults: dict[str, Any] = {}
-    for klass in reversed(type(env.unwrapped).__mro__):
-        init = klass.__dict__.get("__init__")
-        if init is None:
-            continue
-        try:
-            params = inspect.signature(init).parameters.values()
-        except (TypeError, ValueError):
-            continue
-        defaults.update({p.name: p.default for p in params if p.default is not p.empty})
+    defaults = _class_defaults(type(env.unwrapped))
     if env.spec is not None and env.spec.id in gym.registry:
         defaults.update(gym.spec(env.spec.id).kwargs)
     return defaults
@@ -305,6 +300,9 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[
                 warnings.append(note)
             result.runs[name] = run
             policies[name] = (policy, envs[key])
+        used = {id(e) for _, e in policies.values()}
+        for unused in (e for e in envs.values() if id(e) not in used):
+            unused.close()
         prepared.append((result, policies))
     return prepared, warnings
 
