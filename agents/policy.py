@@ -57,3 +57,21 @@ class ObservationReader:
 
     def __call__(self, observation: np.ndarray) -> dict[str, np.ndarray]:
         return {name: observation[..., sl] for name, sl in self.structure.items()}
+
+
+def episode_infos(
+    env: gym.Env, policy: Policy, seed: int = 0, max_steps: int | None = None
+) -> list[dict]:
+    """Run `policy` for one episode from ``env.reset(seed=seed)`` (at most `max_steps` steps)
+    and return the infos: the reset's first, then one per step."""
+    obs, info = env.reset(seed=seed)
+    policy.reset()
+    infos = [info]
+    steps = 0
+    while max_steps is None or steps < max_steps:
+        obs, _, terminated, truncated, info = env.step(policy(obs))
+        infos.append(info)
+        steps += 1
+        if terminated or truncated:
+            break
+    return infos

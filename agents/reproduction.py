@@ -39,21 +39,14 @@ def cliff_flat_walk_rows(cycles: int = 5) -> list[dict]:
     import gymnasium as gym
 
     import hexapod_envs  # noqa: F401  (registers the env ids)
+    from agents.policy import episode_infos
     from agents.tripod_gait import TripodGaitPolicy
 
     steps = 150 + cycles * 300 + 10
     env = gym.make(
         "HexapodCliffWalk-v0", terrain="flat", action_mode="joint", max_episode_steps=steps
     )
-    policy = TripodGaitPolicy(env)
-    obs, info = env.reset(seed=0)
-    policy.reset()
-    infos = [info]
-    for _ in range(steps):
-        obs, _, terminated, truncated, info = env.step(policy(obs))
-        infos.append(info)
-        if terminated or truncated:
-            break
+    infos = episode_infos(env, TripodGaitPolicy(env), seed=0, max_steps=steps)
     env.close()
     standing = float(np.median([i["fasm_margin_deg"] for i in infos[10:150]]))
     switches = [
@@ -285,16 +278,14 @@ def ditch_episode(seed: int = 0, **env_kwargs) -> dict:
     import gymnasium as gym
 
     import hexapod_envs  # noqa: F401  (registers the env ids)
+    from agents.policy import episode_infos
     from agents.upu_gait import UpuGaitPolicy
 
     env = gym.make("HexapodDitchCrossing-v0", **env_kwargs)
     policy = UpuGaitPolicy(env)
-    obs, info = env.reset(seed=seed)
-    policy.reset()
-    margins, terminated, truncated = [], False, False
-    while not (terminated or truncated):
-        obs, _, terminated, truncated, info = env.step(policy(obs))
-        margins.append(info["static_margin_m"])
+    infos = episode_infos(env, policy, seed=seed)[1:]  # the steps' infos
+    info = infos[-1]
+    margins = [i["static_margin_m"] for i in infos]
     env.close()
     return {
         "status": policy.status,

@@ -5,19 +5,12 @@ import numpy as np
 import pytest
 
 import hexapod_envs  # noqa: F401  (registers the env ids)
+from agents.policy import episode_infos
 from agents.tripod_gait import TripodGaitPolicy
 
 
 def run(env, policy, steps):
-    obs, info = env.reset(seed=0)
-    policy.reset()
-    infos = [info]
-    for _ in range(steps):
-        obs, _, terminated, truncated, info = env.step(policy(obs))
-        infos.append(info)
-        if terminated or truncated:
-            break
-    return infos
+    return episode_infos(env, policy, seed=0, max_steps=steps)
 
 
 @pytest.fixture(scope="module")

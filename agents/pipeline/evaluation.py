@@ -239,13 +239,18 @@ def _constructor_defaults(env: gym.Env) -> dict[str, Any]:
 
 
 def _kwargs_note(
-    env: gym.Env, suite_env: SuiteEnv, name: str, trained: dict[str, Any] | None
+    env: gym.Env,
+    suite_env: SuiteEnv,
+    name: str,
+    trained: dict[str, Any] | None,
+    policy_kwargs: dict[str, Any],
 ) -> str | None:
-    """A warning when a model was trained with env kwargs (defaults filled in) other than these."""
+    """A warning when a model was trained with env kwargs (defaults filled in) other than the
+    suite's with `policy_kwargs` (its action settings) on top."""
     if trained is None:
         return None
     defaults = _constructor_defaults(env)
-    evaluated = {**suite_env.kwargs, **policy_env_kwargs(name, suite_env.id, suite_env.kwargs)}
+    evaluated = {**suite_env.kwargs, **policy_kwargs}
     differing = {}
     # a held-out task distribution is the point of the evaluation, not a mismatch
     for key in sorted((set(trained) | set(evaluated)) - {"task_distribution"}):
@@ -294,7 +299,8 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[
             run = PolicyRun(name=name, source=source, env_kwargs=extra)
             files = getattr(getattr(policy, "learned", policy), "files", None)
             run.model_dir = getattr(files, "directory", None)
-            note = _kwargs_note(env, suite_env, name, getattr(policy, "train_env_kwargs", None))
+            trained = getattr(policy, "train_env_kwargs", None)
+            note = _kwargs_note(env, suite_env, name, trained, extra)
             if note:
                 run.notes.append(note)
                 warnings.append(note)

@@ -124,9 +124,7 @@ class CliffWalkEnv(HeavyDutyEnv):
             "cliff_drop": float(self._paper_cliff["drop"]),
             "cliff_edge_y": float(self._paper_cliff["edge_y"]),
             "friction": float(self._paper_friction),
-            "payload_mass": 0.0,
-            "payload_offset_x": 0.0,
-            "payload_offset_y": 0.0,
+            **self.NO_PAYLOAD,
         }
 
     def sample_task(self, rng: np.random.Generator, distribution: str) -> dict:

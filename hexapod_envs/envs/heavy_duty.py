@@ -231,6 +231,9 @@ class HeavyDutyEnv(HexapodEnv):
     """Payload on the body per distribution: (mass range [kg], max CoG offset in x and y [m]).
     The test payload is heavier (extrapolated) and may sit farther off centre."""
 
+    NO_PAYLOAD = {"payload_mass": 0.0, "payload_offset_x": 0.0, "payload_offset_y": 0.0}
+    """The paper's scenarios carry no payload (task keys as `_sample_payload`'s)."""
+
     def _sample_payload(self, rng: np.random.Generator, distribution: str) -> dict:
         (m_lo, m_hi), off = self.PAYLOAD_RANGES[distribution]
         return {

@@ -229,9 +229,7 @@ class StewartTiltEnv(HeavyDutyEnv):
             **axis,
             "tilt_rate_deg": float(np.degrees(self.tilt_rate)),
             "platform_friction": float(self._paper_friction),
-            "payload_mass": 0.0,
-            "payload_offset_x": 0.0,
-            "payload_offset_y": 0.0,
+            **self.NO_PAYLOAD,
         }
 
     def sample_task(self, rng: np.random.Generator, distribution: str) -> dict:
