@@ -3,12 +3,13 @@
 
 `AthenaPosturePolicy(env, kz=..., ka=..., kb=...)` is the analytical controller of the env, in
 any of its action modes, reading the observation by name (``joint_pos``, ``foot_force``,
-``torso_height``) through ``env.unwrapped.observation_structure``:
+``torso_height``) through the layout of the env's task description
+(``env.unwrapped.task_description.observation_structure``):
 
 - ``"gains"``: the env runs the controller itself; the policy just returns (k_z, k_α, k_β).
-- ``"joint"``: the policy runs its own `AthenaPostureController` (same gait settings as the env,
-  from ``env.unwrapped.gait_config``) on the observed sensors and returns its joint targets,
-  normalised to the action space.
+- ``"joint"``: the policy runs its own `AthenaPostureController` (same gait settings as the
+  env, from the task description's ``reference["gait_config"]``) on the observed sensors and
+  returns its joint targets, normalised to the action space.
 - ``"residual"``: the env adds the action to its own reference gait (the same controller with the
   env's ``reference_gains``). The policy runs two controllers on the same observations, one with
   its gains and one with the env's reference gains, and returns the difference of their targets
@@ -26,6 +27,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
+from hexapod_envs.envs.base import JointActionMap
 from hexapod_envs.robots.athena.gait import AthenaPostureController, AthenaSensors
 
 from .policy import ObservationReader
@@ -35,23 +37,24 @@ class AthenaPosturePolicy:
     """The posture controller of Coelho et al. 2024 with gains (k_z, k_α, k_β) in [0, 1]."""
 
     def __init__(self, env: gym.Env, kz: float = 0.0, ka: float = 0.0, kb: float = 0.0):
-        base = env.unwrapped
-        self.action_mode = base.action_mode
-        self.read = ObservationReader(base.observation_structure)
+        task = env.unwrapped.task_description  # what the env declares a controller may know
+        ref = task.reference
+        self.action_mode = task.action_mode
+        self.read = ObservationReader(task.observation_structure)
         self.gains = (float(kz), float(ka), float(kb))
         self._dtype = env.action_space.dtype
+        self.action_map = JointActionMap(np.column_stack([task.joint_low, task.joint_high]))
         # Validates the gains (ValueError outside [0, 1]) in every mode.
         self.controller = AthenaPostureController(
-            base.robot, **base.gait_config, kz=kz, k_alpha=ka, k_beta=kb
+            task.robot, **ref["gait_config"], kz=kz, k_alpha=ka, k_beta=kb
         )
         self.reference = None
         if self.action_mode == "residual":
-            kz0, ka0, kb0 = base.reference_gains
+            kz0, ka0, kb0 = ref["reference_gains"]
             self.reference = AthenaPostureController(
-                base.robot, **base.gait_config, kz=kz0, k_alpha=ka0, k_beta=kb0
+                task.robot, **ref["gait_config"], kz=kz0, k_alpha=ka0, k_beta=kb0
             )
-            self._residual_gain = base.residual_scale * base.action_map.half
-        self.action_map = base.action_map
+            self._residual_gain = ref["residual_scale"] * self.action_map.half
 
     def reset(self) -> None:
         self.controller.reset()
@@ -99,5 +102,5 @@ PAPER_GAINS = {"ramp": (0.8, 0.6, 0.0), "blocks": (0.6, 0.4, 0.4), "flat": (0.0,
 
 def analytical_policy(env: gym.Env) -> AthenaPosturePolicy:
     """The registry's analytical controller: the paper's tuned gains for the env's terrain."""
-    kz, ka, kb = PAPER_GAINS[env.unwrapped.terrain]
+    kz, ka, kb = PAPER_GAINS[env.unwrapped.task_description.reference["terrain"]]
     return AthenaPosturePolicy(env, kz=kz, ka=ka, kb=kb)

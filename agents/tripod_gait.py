@@ -23,7 +23,7 @@ class TripodGaitPolicy:
         task = base.task_description  # what the env declares a controller may know
         self.action_mode = task.action_mode
         self.action_map = JointActionMap(np.column_stack([task.joint_low, task.joint_high]))
-        self.read = ObservationReader(base.observation_structure)
+        self.read = ObservationReader(task.observation_structure)
         self.gait = TripodGait(task.robot, task.reference["gait"])
         self._steps = task.reference["steps_per_cycle"]
         self._zero = np.zeros(env.action_space.shape, dtype=env.action_space.dtype)

@@ -1,12 +1,13 @@
 """The 3-3 gait of the 3-UPU hexapod (Li et al. 2018 §6-7) as a policy for HexapodDitchCrossing-v0.
 
 The policy plans the walk the way the paper's robot does, knowing the ditch: it reads the
-ditch geometry the env exposes (`env.unwrapped.ditch`, `terrain`, `start_x`; the robot's
-`params`) and calls the planner of `hexapod_envs.robots.upu.gait_plan` (strides <= l_max1 =
-160 mm, eq. 17; strides shortened so that no foot lands on a ditch edge; legs extended into
-the ditch, §7). `hexapod_envs.robots.upu.gait_schedule` times the steps: the moving platform's
-legs retract (lift), the platform travels along its quadratic path (eqs. 19-21), the legs
-extend until the feet are down (land), and the platforms swap roles.
+env's declared task description (`env.unwrapped.task_description`: the course's terrain and
+ditch geometry, the reference's start x, gait settings and timing, the robot's parameters) on
+its first call of an episode and calls the planner of `hexapod_envs.robots.upu.gait_plan`
+(strides <= l_max1 = 160 mm, eq. 17; strides shortened so that no foot lands on a ditch edge;
+legs extended into the ditch, §7). `hexapod_envs.robots.upu.gait_schedule` times the steps:
+the moving platform's legs retract (lift), the platform travels along its quadratic path
+(eqs. 19-21), the legs extend until the feet are down (land), and the platforms swap roles.
 
 Closed loop through the foot contact switches (observation piece ``foot_contact``, the
 paper's per-leg pressure sensors): the transfer starts only once the moving feet are off the
@@ -63,18 +64,21 @@ class UpuGaitPolicy:
         timing: GaitTiming | None = None,
     ):
         base = env.unwrapped
-        for name in ("ditch", "terrain", "start_x", "params", "command_low", "command_high"):
-            if not hasattr(base, name):
-                raise ValueError(
-                    f"UpuGaitPolicy needs a HexapodDitchCrossing env; {type(base).__name__} has "
-                    f"no attribute {name!r}"
-                )
+        task = getattr(base, "task_description", None)
+        if task is None or "gait_settings" not in task.reference:
+            raise ValueError(
+                f"UpuGaitPolicy needs a HexapodDitchCrossing env; {type(base).__name__} declares "
+                "no UPU gait in its task description"
+            )
         self.env = base
-        self.settings = settings or base.gait_settings
-        self.timing = timing or base.gait_timing
-        self.read = ObservationReader(base.observation_structure)
-        self._center = (base.command_low + base.command_high) / 2
-        self._half = (base.command_high - base.command_low) / 2
+        self.task = task
+        """The env's declared task description, read again on the first call of an episode."""
+        self.settings = settings or task.reference["gait_settings"]
+        self.timing = timing or task.reference["gait_timing"]
+        self.read = ObservationReader(task.observation_structure)
+        low, high = np.array(task.joint_low), np.array(task.joint_high)
+        self._center = (low + high) / 2
+        self._half = (high - low) / 2
         self._dtype = env.action_space.dtype
         self._planned_for: tuple | None = None
         self._cache: dict[tuple, tuple[GaitPlan, GaitSchedule]] = {}
@@ -84,27 +88,29 @@ class UpuGaitPolicy:
 
     # --- planning ----------------------------------------------------------------------
     def _course(self) -> tuple:
-        e = self.env
-        d = e.ditch
-        return (e.terrain, d.start_x, d.width, d.depth, e.start_x, e.control_dt)
+        """The episode's course from the env's task description (terrain, ditch, start x)."""
+        self.task = task = self.env.task_description
+        c = task.course
+        geometry = (c["ditch_start_x"], c["ditch_width"], c["ditch_depth"])
+        return (c["terrain"], *geometry, task.reference["start_x"], task.control_dt)
 
     def _ensure_plan(self) -> None:
-        """(Re)plan when the env's course differs from the one planned for (ditch geometry is
+        """Plan for the episode's course on the first call after reset() (the ditch geometry is
         sampled at env.reset(), which may come before or after this policy's reset())."""
-        course = self._course()
-        if course == self._planned_for:
+        if self._planned_for is not None:
             return
-        e = self.env
+        course = self._course()
+        params = self.task.robot
         terrain, start_x, width, depth, x0, control_dt = course
         ditch = Ditch(start_x, width, depth)
         if course not in self._cache:
             if terrain == "flat":
-                plan = plan_flat_past(e.params, ditch.end_x, x0, self.settings)
+                plan = plan_flat_past(params, ditch.end_x, x0, self.settings)
             else:
-                plan = plan_ditch_crossing(e.params, ditch, x0, self.settings)
+                plan = plan_ditch_crossing(params, ditch, x0, self.settings)
             if len(self._cache) >= 64:  # randomised ditches: keep the cache bounded
                 self._cache.clear()
-            self._cache[course] = (plan, GaitSchedule(plan, e.params, control_dt, self.timing))
+            self._cache[course] = (plan, GaitSchedule(plan, params, control_dt, self.timing))
         self._plan, self._schedule = self._cache[course]
         self._planned_for = course
         self.tick = 0
@@ -157,14 +163,14 @@ class UpuGaitPolicy:
         else:
             command = sched.command(self.tick)
             self.tick += 1
-        if self.env.action_mode == "residual":
-            e = self.env
+        if self.task.action_mode == "residual":
+            ref = self.task.reference
             reference = self._center + self._half * obs["reference_action"]
-            gain = e.residual_gain
+            gain = np.array(ref["residual_gain"])
             current = obs["residual_state"] * gain
             # The env filters: r <- r + alpha (gain a - r); choose a so that r becomes the wanted
             # offset (as far as |a| <= 1 allows).
-            wanted = current + (command - reference - current) / e.residual_filter_alpha
+            wanted = current + (command - reference - current) / ref["residual_filter_alpha"]
             action = np.divide(wanted, gain, out=np.zeros_like(wanted), where=gain > 0)
         else:
             action = (command - self._center) / self._half

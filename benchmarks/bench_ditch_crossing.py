@@ -57,7 +57,7 @@ def main() -> None:
     for _ in range(300):
         env.step(np.zeros(9))
     rows = (
-        ("stability update (forces, FASM, static margin)", env._update_stability, ()),
+        ("stability update (forces, FASM, static margin)", env._measure, ()),
         ("observation vector", env._observation, ()),
         ("info dict", env._info, ({}, False)),
     )

@@ -36,13 +36,10 @@ The env defaults are not changed: settings are applied to the envs this script m
 How a setting is applied (`make_env`): the timestep through the ``physics_dt`` kwarg (the env
 checks that it divides ``control_dt``; ATHENA also needs a multiple of 5 substeps, so its "x2"
 and "x4" are the nearest allowed timesteps, 3.33 and 10 ms; the table prints the timestep
-used); the integrator and solver options by writing ``env.unwrapped.model.opt`` after
-``gym.make``. An env that rebuilds its model at reset (ATHENA on blocks at every reset, every
-env whose sampled training task changes the terrain or friction) compiles a new model with the
-defaults of `hexapod_envs.envs.base.set_physics_options`, which silently drops such writes
-(checked: the integrator is back to implicitfast after the reset). `make_env` therefore also
-wraps the env's ``_compile`` so that every new model gets the options, and every reset here is
-followed by `check_options`, which raises if the model does not carry the setting.
+used); the integrator and solver options through the env's ``integrator``, ``solver_iterations``,
+``solver_ls_iterations`` and ``solver_tolerance`` settings, so that a model rebuilt at reset
+(ATHENA on blocks, a sampled task) gets them too; every reset here is followed by
+`check_options`, which raises if the model does not carry the setting.
 
 Run: python benchmarks/physics_settings.py [--quick] [--robot heavy-duty|athena|3-upu]
 (about 2-3 minutes on one shared core; ``--quick``: 4 settings, shorter runs, about 20 s).
@@ -65,14 +62,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run as a script from anywhere
 
 import hexapod_envs  # noqa: E402, F401  (registers the env ids)
-
-INTEGRATORS = {
-    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
-    "euler": mujoco.mjtIntegrator.mjINT_EULER,
-    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
-    "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
-}
-"""Integrators by name (the envs compile with implicitfast, see `set_physics_options`)."""
+from hexapod_envs.envs.base import INTEGRATOR_IDS as INTEGRATORS  # noqa: E402
 
 
 @dataclasses.dataclass(frozen=True)
@@ -161,15 +151,6 @@ def physics_dt_for(env_id: str, factor: float) -> float:
     return chosen
 
 
-def _write_options(model: mujoco.MjModel, setting: PhysicsSetting) -> None:
-    opt = model.opt
-    opt.integrator = INTEGRATORS[setting.integrator]
-    for name in ("iterations", "ls_iterations", "tolerance"):
-        value = getattr(setting, name)
-        if value is not None:
-            setattr(opt, name, value)
-
-
 def check_options(env: gym.Env, setting: PhysicsSetting) -> None:
     """Raise if the env's current model does not carry `setting` (e.g. lost in a rebuild)."""
     base = env.unwrapped
@@ -187,17 +168,13 @@ def make_env(env_id: str, setting: PhysicsSetting, **kwargs) -> gym.Env:
     """`gym.make(env_id, **kwargs)` with `setting` applied (see the module docstring)."""
     if setting.factor != 1.0:
         kwargs["physics_dt"] = physics_dt_for(env_id, setting.factor)
-    env = gym.make(env_id, **kwargs)
-    base = env.unwrapped
-    _write_options(base.model, setting)
-    compile_ = base._compile
-
-    def _compile(spec: mujoco.MjSpec) -> None:  # models rebuilt at reset get the options too
-        compile_(spec)
-        _write_options(base.model, setting)
-
-    base._compile = _compile
-    return env
+    kwargs.update(
+        integrator=setting.integrator,
+        solver_iterations=setting.iterations,
+        solver_ls_iterations=setting.ls_iterations,
+        solver_tolerance=setting.tolerance,
+    )
+    return gym.make(env_id, **kwargs)
 
 
 def reset_checked(env: gym.Env, setting: PhysicsSetting, seed: int):

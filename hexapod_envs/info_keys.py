@@ -10,6 +10,8 @@ from __future__ import annotations
 FASM_MARGIN_DEG = "fasm_margin_deg"
 """Force-angle stability margin from the measured foot forces [deg]; 0 without a support
 polygon (fewer than two loaded feet), never NaN."""
+FASM_EDGE = "fasm_edge"
+"""(leg, leg): the support-polygon edge that sets the FASM, or None without a polygon."""
 STANCE_LEGS = "stance_legs"
 """Tuple of the leg names whose foot carries more than the contact threshold."""
 IS_TIPPING = "is_tipping"
@@ -28,12 +30,16 @@ COG = "cog"
 """Centre of mass of the robot, world frame [m] (a fresh array every step)."""
 DISTANCE = "distance"
 """CoG travel along +x since reset [m]."""
+ACTUATOR_POWER_W = "actuator_power_w"
+"""Sum over the actuators of |force x velocity| [W] (mechanical power the servos deliver or
+absorb)."""
 TASK = "task"
 """Flat dict of the episode's task parameters (plain floats, ints, strings): the paper
 scenario's values with ``task_distribution="paper"``, the sampled ones with "train"/"test"."""
 
 COMMON_INFO_KEYS: tuple[str, ...] = (
     FASM_MARGIN_DEG,
+    FASM_EDGE,
     STANCE_LEGS,
     IS_TIPPING,
     IS_TIPPED_OVER,
@@ -42,9 +48,15 @@ COMMON_INFO_KEYS: tuple[str, ...] = (
     TIME,
     COG,
     DISTANCE,
+    ACTUATOR_POWER_W,
     TASK,
 )
 """Keys present in the info of every reset and step of every hexapod env."""
+
+UNDEFINED_AS_NAN: tuple[str, ...] = ("zmp",)
+"""Env-specific keys that are NaN by contract when undefined (the ZMP of HexapodIrregularTerrain
+with no loaded foot); every other numeric info value is finite (e.g. ``zmp_margin`` is 0 then,
+like ``fasm_margin_deg`` without a support polygon)."""
 
 REWARD_PREFIX = "reward_"
 """Each reward term is reported as ``info["reward_<term>"]``; the reward is their sum."""

@@ -183,13 +183,13 @@ def test_reward_is_the_sum_of_named_terms_and_progress_follows_the_cog():
     for _ in range(120):  # the first upper step carries the CoG forward
         _, reward, _, _, info = env.step(ZERO)
         terms = {k[len("reward_") :]: v for k, v in info.items() if k.startswith("reward_")}
-        assert set(terms) == {"progress", "stability", "alive", "success", "tip_over", "effort"}
+        assert set(terms) == {"forward", "stability", "alive", "success", "tip_over", "effort"}
         assert reward == pytest.approx(sum(terms.values()))
         assert terms["tip_over"] == 0.0 and terms["effort"] <= 0.0
-        total_progress += terms["progress"]
+        total_progress += terms["forward"]
     moved = env.data.subtree_com[env._torso][0] - x0
     assert moved > 0.05
-    assert total_progress == pytest.approx(env.weights["progress"] * moved / env.control_dt)
+    assert total_progress == pytest.approx(env.weights["forward"] * moved / env.control_dt)
 
 
 def test_residual_is_filtered_and_observed():
@@ -208,7 +208,7 @@ def test_residual_is_filtered_and_observed():
     # The servo targets follow reference + residual [m] (limb gain 2 mm, leg gain 5 mm).
     np.testing.assert_allclose(env.residual_gain, [0.002] * 3 + [0.005] * 6)
     # (clamped to the actuator ranges, as MuJoCo clamps the activation)
-    target = env.reference_command(env._tick - 1) + expected * env.residual_gain
+    target = env.reference_command(env._step_count - 1) + expected * env.residual_gain
     target = np.clip(target, env.command_low, env.command_high)
     np.testing.assert_allclose(env.data.act[env._act_state], target, atol=1e-12)
     joint = DitchCrossingEnv(action_mode="joint")

@@ -84,11 +84,6 @@ def test_docstring_tables_name_every_observation_piece_and_reward_term(env_id):
 
 
 # --- the episode skeleton --------------------------------------------------------------------
-@pytest.mark.xfail(
-    strict=True,
-    reason="issue 10 item 1 not done yet: HeavyDutyEnv, IrregularTerrainEnv and DitchCrossingEnv "
-    "still implement reset/step themselves instead of hooks of HexapodEnv",
-)
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_reset_and_step_come_from_the_base(env_id):
     from hexapod_envs.envs.base import HexapodEnv

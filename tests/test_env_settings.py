@@ -1,16 +1,14 @@
 """Settings checked by name at `gym.make`, and the train/test task distributions."""
 
-import inspect
+import dataclasses
 import math
-import numbers
 
 import gymnasium as gym
 import numpy as np
 import pytest
 
 import hexapod_envs  # noqa: F401
-from hexapod_envs.envs.base import _settings_signature
-from hexapod_envs.envs.cliff_walk import CLIFF_TEST, CLIFF_TRAIN
+from hexapod_envs.envs.cliff_walk import CLIFF_TEST, CLIFF_TRAIN, CliffTaskRanges
 from hexapod_envs.envs.ditch_crossing import DITCH_TEST, DITCH_TRAIN
 from hexapod_envs.envs.irregular_terrain import TERRAIN_TEST, TERRAIN_TRAIN
 from hexapod_envs.envs.stewart_tilt import TILT_TEST, TILT_TRAIN
@@ -18,23 +16,13 @@ from hexapod_envs.envs.stewart_tilt import TILT_TEST, TILT_TRAIN
 ENV_IDS = sorted(k for k in gym.registry if k.startswith("Hexapod"))
 
 
-def _is_numeric(p: inspect.Parameter) -> bool:
-    """Numeric by default value (a real number or a tuple of them) or by its float/int type."""
-    d = p.default
-    if isinstance(d, tuple):
-        flat = [x for v in d for x in (v if isinstance(v, tuple) else (v,))]
-        return bool(flat) and all(isinstance(x, numbers.Real) for x in flat)
-    if isinstance(d, numbers.Real) and not isinstance(d, bool):
-        return True
-    ann = str(p.annotation)
-    return d is None and (ann in ("float | None", "int | None") or ann.startswith("tuple["))
+def _settings_class(env_id):
+    module, name = gym.spec(env_id).entry_point.split(":")
+    return getattr(__import__(module, fromlist=[name]), name).Settings
 
 
 def _numeric_settings(env_id):
-    cls = gym.spec(env_id).entry_point
-    module, name = cls.split(":")
-    klass = getattr(__import__(module, fromlist=[name]), name)
-    return [n for n, p in _settings_signature(klass).items() if _is_numeric(p)]
+    return _settings_class(env_id).numeric_names()
 
 
 def _unnamed(env_id, names, bad):
@@ -62,10 +50,59 @@ def test_every_numeric_setting_names_itself_when_bad(env_id, bad):
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_negative_values_are_named_where_meaningless(env_id):
-    from hexapod_envs.envs.base import SIGNED_SETTINGS
-
-    names = [n for n in _numeric_settings(env_id) if n not in SIGNED_SETTINGS]
+    signed = _settings_class(env_id).signed_names()
+    names = [n for n in _numeric_settings(env_id) if n not in signed]
     assert not _unnamed(env_id, names, -1.0)
+    assert len(signed) <= 4, signed  # positions and offsets only
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_unknown_and_renamed_keys_list_the_valid_ones(env_id):
+    with pytest.raises(TypeError, match=r"unknown keyword argument\(s\) \['speed'\].*valid"):
+        gym.make(env_id, speed=1.0)
+    with pytest.raises(TypeError, match="progress_weight is now forward_weight"):
+        gym.make(env_id, progress_weight=1.0)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_reward_scales_are_a_nested_record_given_flat_or_nested(env_id):
+    env = gym.make(env_id).unwrapped
+    reward = env.settings.reward
+    assert dataclasses.is_dataclass(reward) and reward.tip_over_penalty > 0
+    flat = gym.make(env_id, tip_over_penalty=7.0).unwrapped.settings.reward
+    nested = gym.make(env_id, reward={"tip_over_penalty": 7.0}).unwrapped.settings.reward
+    assert flat == nested == dataclasses.replace(reward, tip_over_penalty=7.0)
+    with pytest.raises(ValueError, match="tip_over_penalty"):
+        gym.make(env_id, reward={"tip_over_penalty": math.nan})
+    with pytest.raises(TypeError, match="unknown reward scale"):
+        gym.make(env_id, reward={"bonus": 1.0})
+
+
+def test_one_vocabulary_across_envs():
+    """The same name means the same thing in every env: a contact threshold is a fraction of
+    the weight, ξ a setting of its own, the settle time the physics run before an episode,
+    and the progress term is "forward"."""
+    for env_id in ENV_IDS:
+        env = gym.make(env_id).unwrapped
+        s = env.settings
+        assert 0 < s.contact_threshold < 0.1
+        assert env.tipping_threshold_deg == s.tipping_threshold_deg
+        assert s.settle_time == 0.5
+        assert "forward_weight" in {f.name for f in dataclasses.fields(s.reward)}
+    athena = gym.make("HexapodIrregularTerrain-v0").unwrapped
+    assert athena.contact_force == pytest.approx(0.5)  # the paper robot's 0.5 N
+    assert athena.gait_config["contact_threshold"] == pytest.approx(0.5)
+
+
+def test_task_ranges_are_settings_a_user_can_widen():
+    wide = CliffTaskRanges(
+        cliff_x=(3.0, 6.0), edge_y=(-1.3, -0.7), drop=(1.0, 5.0), friction=(0.5, 1.5)
+    )
+    env = gym.make("HexapodCliffWalk-v0", task_distribution="train", train_ranges=wide)
+    xs = [env.reset(seed=k)[1]["task"]["cliff_x"] for k in range(12)]
+    assert max(xs) > CLIFF_TRAIN.cliff_x[1] and all(3.0 <= x <= 6.0 for x in xs)
+    with pytest.raises(ValueError, match="drop"):
+        CliffTaskRanges(cliff_x=(3.0, 4.0), edge_y=(-1.0, -0.8), drop=(2.0, 1.0), friction=(1, 1))
 
 
 @pytest.mark.parametrize(

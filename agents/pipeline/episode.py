@@ -45,13 +45,15 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from hexapod_envs import info_keys as keys
+
 XI_F_DEG = 20.0
 """Tipping threshold ξ_f of Zhang et al. 2024 [deg]: time below it is reported."""
 
 STEP_REDUCTIONS = ("last", "first", "min", "max", "mean", "sum", "rms", "any", "all")
 REDUCTIONS = (*STEP_REDUCTIONS, "episode")
 DIRECTIONS = ("higher", "lower")
-POWER_KEY = "actuator_power_w"
+POWER_KEY = keys.ACTUATOR_POWER_W
 EPISODE_METRICS_KEY = "episode_metrics"
 
 
@@ -243,10 +245,10 @@ class EpisodeAccumulator:
         self.length += 1
         self.episode_return += float(reward)
         for key, value in info.items():
-            if key.startswith("reward_"):
-                name = key[7:]
+            if key.startswith(keys.REWARD_PREFIX):
+                name = key[len(keys.REWARD_PREFIX) :]
                 self.terms[name] = self.terms.get(name, 0.0) + float(value)
-        margin = info.get("fasm_margin_deg")
+        margin = info.get(keys.FASM_MARGIN_DEG)
         if margin is not None:
             m = float(margin)
             self.fasm_min = min(self.fasm_min, m)
@@ -259,7 +261,7 @@ class EpisodeAccumulator:
         if power is not None and self.dt is not None:
             self.energy += abs(float(power)) * self.dt
             self.has_power = True
-        if info.get("is_tipped_over"):
+        if info.get(keys.IS_TIPPED_OVER):
             self.tipped = True
         episode_metrics = info.get(EPISODE_METRICS_KEY)
         if episode_metrics:
@@ -277,8 +279,8 @@ class EpisodeAccumulator:
             name: _plain(r.result()) for name, r in self.reducers.items() if r.count
         }
         specifics.update({k: _plain(v) for k, v in self.episode_metrics.items()})
-        success = info.get("is_success")
-        distance = info.get("distance")
+        success = info.get(keys.IS_SUCCESS)
+        distance = info.get(keys.DISTANCE)
         record = EpisodeRecord(
             length=self.length,
             duration_s=self.length * self.dt if self.dt is not None else None,
@@ -297,7 +299,7 @@ class EpisodeAccumulator:
             distance_m=None if distance is None else float(distance),
             energy_j=self.energy if self.has_power else None,
             specifics=specifics,
-            task=_plain(dict(info.get("task") or {})),
+            task=_plain(dict(info.get(keys.TASK) or {})),
             fasm_trace_deg=list(self.trace) if self.keep_trace else None,
         )
         self.reset()

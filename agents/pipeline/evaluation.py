@@ -6,6 +6,7 @@ kwargs, missing or mismatched models), so a typo fails in seconds with one clear
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import time
 from dataclasses import dataclass, field
@@ -157,7 +158,15 @@ def _registered_defaults(env_id: str) -> dict[str, Any]:
 
 
 def _class_defaults(cls: type) -> dict[str, Any]:
-    """Keyword defaults of `cls`'s constructors along its MRO (subclasses win)."""
+    """Default settings of an env class: the fields of its settings dataclass (the hexapod
+    envs' ``Settings``), else the keyword defaults of its constructors along its MRO."""
+    settings = getattr(cls, "Settings", None)
+    if dataclasses.is_dataclass(settings):
+        return {
+            f.name: f.default
+            for f in dataclasses.fields(settings)
+            if f.default is not dataclasses.MISSING
+        }
     defaults: dict[str, Any] = {}
     for klass in reversed(cls.__mro__):
         init = klass.__dict__.get("__init__")

@@ -89,6 +89,7 @@ from agents.tipping.trajectory import (
     zero_crossing_time,
 )
 from hexapod_envs.checks import check_number
+from hexapod_envs.envs.base import JointActionMap
 from hexapod_envs.robots.heavy_duty.kinematics import joints_for_foot
 from hexapod_envs.robots.heavy_duty.params import LEG_NAMES, HeavyDutyParams
 from hexapod_envs.stability import fasm_from_feet
@@ -609,9 +610,12 @@ class TippingRecoveryPolicy:
 
     Works in either action mode: the joint targets of :class:`TippingRecoveryController` become
     normalised targets ("joint") or offsets from the env's reference posture ("residual"; the
-    Stewart env's default residual_scale 2 reaches every target). The nominal posture is the
-    env's reference (``env.unwrapped.reference_joints()``, the definition of the residual
-    action); everything else comes from the observation.
+    Stewart env's default residual_scale 2 reaches every target). Everything comes from the
+    env's declared task description (robot, action mapping, timing, and the reference: the
+    Stewart env's ``hold_posture`` of the episode, or the walking envs' gait table at the
+    observed ``gait_phase``, the definition of the residual action) and from the observation.
+    The description is read again on the first call after `reset` (the held tripod is drawn
+    at the env's reset, which may come before or after the policy's).
 
     Args:
         env: a heavy-duty hexapod env (e.g. HexapodStewartTilt-v0).
@@ -622,18 +626,20 @@ class TippingRecoveryPolicy:
     def __init__(self, env: gym.Env, config: RecoveryConfig | None = None, **overrides):
         self.env = env
         base = env.unwrapped
-        for name in ("observation_structure", "action_map", "action_mode", "robot"):
-            if not hasattr(base, name):
-                raise ValueError(f"{type(base).__name__} is not a heavy-duty hexapod env")
+        task = getattr(base, "task_description", None)
+        if task is None or not isinstance(task.robot, HeavyDutyParams):
+            raise ValueError(f"{type(base).__name__} is not a heavy-duty hexapod env")
         self.config = _config_with(config, overrides)
-        self.read = ObservationReader(base.observation_structure)
-        self.action_map = base.action_map
-        self.action_mode = base.action_mode
-        self.control_dt = float(base.control_dt)
+        self.read = ObservationReader(task.observation_structure)
+        self.action_map = JointActionMap(np.column_stack([task.joint_low, task.joint_high]))
+        self.action_mode = task.action_mode
+        self.control_dt = float(task.control_dt)
         if self.action_mode == "residual":
-            self._gain = base.residual_scale * self.action_map.half
+            self._gain = task.reference["residual_scale"] * self.action_map.half
         self._dtype = env.action_space.dtype
-        self.controller = TippingRecoveryController(base.robot, self.config, self.control_dt)
+        self._reference_gait = TripodGaitReference(task)
+        self._hold: np.ndarray | None = None
+        self.controller = TippingRecoveryController(task.robot, self.config, self.control_dt)
         self.reset()
 
     def reset(self) -> None:
@@ -647,15 +653,20 @@ class TippingRecoveryPolicy:
         plus ``saturated``: a target was clipped by the action's residual range."""
         return {**self.controller.diagnostics, "saturated": self._saturated}
 
+    def reference(self, observation: np.ndarray) -> np.ndarray:
+        """(18,) joint targets of the env's reference (the zero residual action) now."""
+        if self._hold is not None:
+            return self._hold
+        return self._reference_gait(self.read(observation))
+
     def nominal(self, observation: np.ndarray) -> np.ndarray:
         """Joint targets without recovery: the env's reference posture."""
-        return self.env.unwrapped.reference_joints().reshape(6, 3)
+        return self.reference(observation).reshape(6, 3)
 
-    def to_action(self, targets: np.ndarray) -> np.ndarray:
+    def to_action(self, targets: np.ndarray, observation: np.ndarray) -> np.ndarray:
         joints = np.asarray(targets).reshape(-1)
         if self.action_mode == "residual":
-            reference = self.env.unwrapped.reference_joints()
-            raw = (joints - reference) / self._gain
+            raw = (joints - self.reference(observation)) / self._gain
             self._saturated = self._saturated or bool(np.any(np.abs(raw) > 1.0 + 1e-9))
             action = np.clip(raw, -1.0, 1.0)
         else:
@@ -663,11 +674,30 @@ class TippingRecoveryPolicy:
         return action.astype(self._dtype)
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:
+        if self._steps == 0:  # the episode's reference (the env has been reset by now)
+            hold = self.env.unwrapped.task_description.reference.get("hold_posture")
+            self._hold = None if hold is None else np.asarray(hold, dtype=float)
         reading = SensorReading.from_observation(self.read(observation))
         time = self._steps * self.control_dt
         self._steps += 1
         targets = self.controller.step(reading, self.nominal(observation), time)
-        return self.to_action(targets)
+        return self.to_action(targets, observation)
+
+
+class TripodGaitReference:
+    """The walking heavy-duty envs' reference joint targets at the observed gait phase: the
+    row of the declared ``reference_table`` that the env's gait clock points at."""
+
+    def __init__(self, task):
+        self._table = task.reference.get("reference_table")
+        self._steps = task.reference.get("steps_per_cycle")
+
+    def __call__(self, pieces: dict[str, np.ndarray]) -> np.ndarray:
+        if self._table is None or "gait_phase" not in pieces:
+            raise ValueError("this env declares neither a hold posture nor a gait phase")
+        s, c, _ = pieces["gait_phase"]
+        k = round(float(np.arctan2(s, c)) / (2 * np.pi) * self._steps) % self._steps
+        return self._table[k]
 
 
 def _config_with(config: RecoveryConfig | None, overrides: dict[str, Any]) -> RecoveryConfig:

@@ -47,7 +47,8 @@ class GaitWithRecoveryPolicy(TippingRecoveryPolicy):
 
     def __init__(self, env: gym.Env, config: RecoveryConfig | None = None, **overrides):
         base = env.unwrapped
-        if "gait_phase" not in getattr(base, "observation_structure", {}):
+        task = getattr(base, "task_description", None)
+        if task is None or "gait_phase" not in task.observation_structure:
             raise ValueError(
                 f"{type(base).__name__} has no gait_phase observation; GaitWithRecoveryPolicy "
                 "needs a walking heavy-duty hexapod env such as HexapodCliffWalk-v0"
@@ -55,7 +56,8 @@ class GaitWithRecoveryPolicy(TippingRecoveryPolicy):
         self.gait = TripodGaitPolicy(env)
         super().__init__(env, config, **overrides)
         self.full_authority = (
-            self.action_mode == "joint" or base.residual_scale >= FULL_AUTHORITY_RESIDUAL_SCALE
+            self.action_mode == "joint"
+            or task.reference["residual_scale"] >= FULL_AUTHORITY_RESIDUAL_SCALE
         )
 
     def reset(self) -> None:

@@ -1,18 +1,18 @@
-"""Shared machinery of every hexapod env: model building, fixed control timing, stepping with
-instability detection, observations from named pieces, reward from named terms, rendering.
+"""The episode skeleton every hexapod env shares (`HexapodEnv`), and its small helpers.
 
-Subclasses provide the model (`_build_spec`), the action mapping (`_ctrl_from_action`), the
-observation pieces (`_observation_pieces`), the reward terms and the termination rule.
+`HexapodEnv` owns `reset` and `step`: typed settings, seeding, task draws, building and
+rebuilding the model, the settle phase, the step counter and time, action validation, physics
+with instability detection, termination and truncation, ``reward = sum of the named terms`` and
+the common `info` keys (`hexapod_envs.info_keys`). A concrete env supplies the hooks listed in
+`HexapodEnv`'s docstring; docs/architecture.md explains the layering.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import inspect
 import math
-import numbers
-import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from itertools import compress
 from types import MappingProxyType
 from typing import Any, ClassVar
 
@@ -21,116 +21,19 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
+from .. import info_keys as keys
+from .settings import RENDER_MODES, TASK_DISTRIBUTIONS, EnvSettings, check_choice
+
+__all__ = [
+    "TASK_DISTRIBUTIONS",
+    "HexapodEnv",
+    "JointActionMap",
+    "ObservationLayout",
+    "TaskDescription",
+    "check_choice",
+]
+
 DEFAULT_CAMERA = {"distance": 14.0, "elevation": -20.0, "azimuth": 135.0, "trackbodyid": 1}
-
-
-def check_kwargs(cls: type, kwargs: Mapping[str, Any]) -> None:
-    """Raise a TypeError naming unknown keyword arguments and listing the valid ones."""
-    valid: set[str] = set()
-    for klass in cls.__mro__:
-        init = klass.__dict__.get("__init__")
-        if init is None:
-            continue
-        params = inspect.signature(init).parameters.values()
-        valid |= {p.name for p in params if p.kind is p.KEYWORD_ONLY}
-        if not any(p.kind is p.VAR_KEYWORD for p in params):
-            break
-    unknown = sorted(set(kwargs) - set(valid))
-    if unknown:
-        raise TypeError(
-            f"{cls.__name__} got unknown keyword argument(s) {unknown}; valid: {sorted(valid)}"
-        )
-
-
-TASK_DISTRIBUTIONS = ("paper", "train", "test")
-"""``task_distribution`` values: the paper's scenario (plus small reset noise), or task and
-physical parameters sampled at every reset from the env's training or held-out test ranges."""
-
-SIGNED_SETTINGS = frozenset(
-    {
-        "cliff_x",
-        "cliff_edge_y",
-        "ramp_start_x",
-        "block_region",
-        "ditch_start_x",
-        "ditch_start_x_range",
-    }
-)
-"""Numeric settings for which a negative value is meaningful (positions, signed offsets)."""
-
-
-def _settings_signature(cls: type) -> dict[str, inspect.Parameter]:
-    """Keyword-only parameters of `cls.__init__` and of the bases it forwards **kwargs to."""
-    params: dict[str, inspect.Parameter] = {}
-    for klass in cls.__mro__:
-        init = klass.__dict__.get("__init__")
-        if init is None:
-            continue
-        sig = inspect.signature(init).parameters.values()
-        for p in sig:
-            if p.kind is p.KEYWORD_ONLY:
-                params.setdefault(p.name, p)
-        if not any(p.kind is p.VAR_KEYWORD for p in sig):
-            break
-    return params
-
-
-def _numbers_in(value: Any):
-    if isinstance(value, (tuple, list)):
-        for v in value:
-            yield from _numbers_in(v)
-    else:
-        yield value
-
-
-def check_settings(cls: type, kwargs: Mapping[str, Any]) -> None:
-    """Check every numeric setting passed to `cls` by name: a real number (not a string, bool
-    or complex), finite, and >= 0 unless the setting is signed (`SIGNED_SETTINGS`). Numeric
-    settings are those whose annotation is int/float or a tuple of them. Raises ValueError
-    naming the setting, so a bad value never reaches the physics (NaN gains, inf drops)."""
-    params = _settings_signature(cls)
-    for name, value in kwargs.items():
-        p = params.get(name)
-        if p is None or value is None:
-            continue
-        ann = str(p.annotation)
-        if not re.match(r"^(int|float|tuple\[[\w\[\], .]*\])( \| None)?$", ann):
-            continue
-        if ann.startswith("tuple") and not isinstance(value, (tuple, list)):
-            raise ValueError(f"{name} must be a tuple of numbers, got {value!r}")
-        for x in _numbers_in(value):
-            if isinstance(x, bool) or not isinstance(x, numbers.Real):
-                kind = type(x).__name__
-                raise ValueError(f"{name} must be a real number, got {value!r} ({kind})")
-            if not math.isfinite(float(x)):
-                raise ValueError(f"{name} must be finite, got {value!r}")
-            if name not in SIGNED_SETTINGS and x < 0:
-                raise ValueError(f"{name} must be >= 0, got {value!r}")
-    if "task_distribution" in kwargs:
-        check_choice("task_distribution", kwargs["task_distribution"], TASK_DISTRIBUTIONS)
-
-
-_SETTINGS_CLASSES: dict[type, type] = {}
-
-
-def settings_class(cls: type) -> type:
-    """A frozen dataclass with one field per keyword setting of `cls` (its name, annotation and
-    default), built once per env class: ``env.unwrapped.settings`` is an instance of it."""
-    if cls not in _SETTINGS_CLASSES:
-        fields = [
-            (name, p.annotation, dataclasses.field(default=p.default))
-            for name, p in _settings_signature(cls).items()
-        ]
-        _SETTINGS_CLASSES[cls] = dataclasses.make_dataclass(
-            f"{cls.__name__}Settings", fields, frozen=True
-        )
-    return _SETTINGS_CLASSES[cls]
-
-
-def check_choice(name: str, value: Any, choices) -> None:
-    """Raise a ValueError naming `name`, the bad value and the valid choices."""
-    if value not in choices:
-        raise ValueError(f"{name} must be one of {sorted(choices)}, got {value!r}")
 
 
 class JointActionMap:
@@ -161,32 +64,69 @@ def substeps_for(control_dt: float, physics_dt: float) -> int:
     return n
 
 
-class ObservationLayout:
-    """An ordered list of named pieces laid out in one flat vector (name -> slice)."""
+Reader = Callable[[], Any]
+"""Returns one observation piece's current value (an array, a float or a tuple of floats)."""
 
-    def __init__(self, sizes: Mapping[str, int]):
+
+class ObservationLayout:
+    """Named pieces laid out in one flat vector: name -> (size, reader) in order.
+
+    The layout is the single table of the observation: it gives the slices
+    (`observation_structure`, the docs, the policies' readers) and writes the vector, each
+    piece by its reader, straight into a preallocated buffer (`write`).
+    """
+
+    def __init__(self, pieces: Mapping[str, tuple[int, Reader]]):
         self.slices: dict[str, slice] = {}
         start = 0
-        for name, size in sizes.items():
+        for name, (size, _) in pieces.items():
             self.slices[name] = slice(start, start + size)
             start += size
         self.size = start
+        self._writers = [(self.slices[name], read) for name, (_, read) in pieces.items()]
 
-    def pack(self, pieces: Mapping[str, np.ndarray], out: np.ndarray) -> np.ndarray:
-        for name, sl in self.slices.items():
-            out[sl] = pieces[name]
+    def write(self, out: np.ndarray) -> np.ndarray:
+        """Write every piece's current value into `out` (size `size`) and return it."""
+        for sl, read in self._writers:
+            out[sl] = read()
         return out
 
     def unpack(self, observation: np.ndarray) -> dict[str, np.ndarray]:
         return {name: observation[..., sl] for name, sl in self.slices.items()}
 
 
-def set_physics_options(spec: mujoco.MjSpec, timestep: float) -> None:
-    """The solver options every env uses: `timestep` [s], implicit-fast integration, and
-    elliptic friction cones with a high impedance ratio (the default pyramidal cone lets a
-    loaded foot creep down a slope at several cm/s, far below its friction limit)."""
+INTEGRATOR_IDS = {
+    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+    "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+    "euler": mujoco.mjtIntegrator.mjINT_EULER,
+    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+}
+"""MuJoCo integrators by the names of the ``integrator`` setting."""
+
+
+def set_physics_options(
+    spec: mujoco.MjSpec,
+    timestep: float,
+    integrator: str = "implicitfast",
+    iterations: int | None = None,
+    ls_iterations: int | None = None,
+    tolerance: float | None = None,
+) -> None:
+    """The solver options of an env: `timestep` [s], the `integrator` (`INTEGRATOR_IDS`), the
+    constraint solver's `iterations`, `ls_iterations` and `tolerance` (None: MuJoCo's 100, 50
+    and 1e-8), and elliptic friction cones with a high impedance ratio (the default pyramidal
+    cone lets a loaded foot creep down a slope at several cm/s, far below its friction limit).
+    The envs pass their settings of the same names (``physics_dt``, ``integrator``,
+    ``solver_*``)."""
     spec.option.timestep = timestep
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.option.integrator = INTEGRATOR_IDS[integrator]
+    for name, value in (
+        ("iterations", iterations),
+        ("ls_iterations", ls_iterations),
+        ("tolerance", tolerance),
+    ):
+        if value is not None:
+            setattr(spec.option, name, value)
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
     spec.option.impratio = 10.0
 
@@ -195,7 +135,10 @@ def set_physics_options(spec: mujoco.MjSpec, timestep: float) -> None:
 class TaskDescription:
     """What a controller may know about the env's task, declared by the env (instead of reading
     its attributes): robot, action mapping, timing, stability criterion, the episode's course
-    and the reference gait. Per-step information comes through the observation."""
+    and the reference gait. Per-step information comes through the observation.
+
+    The course (and for some envs the reference) changes at every reset with a sampled task:
+    a controller reads ``env.unwrapped.task_description`` on its first call after a reset."""
 
     robot: Any
     """The robot's parameters (frozen dataclass of its `params` module)."""
@@ -212,62 +155,105 @@ class TaskDescription:
     """The episode's task parameters (`info["task"]`, read-only)."""
     reference: Mapping[str, Any]
     """Env-specific reference gait and timing (see the env's `_reference_description`)."""
+    observation_structure: Mapping[str, slice]
+    """Name -> slice of every piece of the flat observation (what a controller reads)."""
 
 
 class HexapodEnv(gym.Env):
-    """Base class; see the module docstring. Keyword arguments are checked by name."""
+    """The episode skeleton: `reset` and `step` live here; a concrete env supplies hooks.
+
+    Construction (``gym.make(id, **kwargs)``): the keyword arguments build ``self.settings``, an
+    instance of the env's `Settings` dataclass (checked by name, see
+    `hexapod_envs.envs.settings`); then `_setup()` (robot, action space, first model through
+    `_build_model`) and the observation layout from `_observation_pieces()`.
+
+    `reset`: seed ``np_random``; draw the task (`paper_task` or `sample_task`, also
+    ``info["task"]``); `_apply_task` (may rebuild the model); reset MuJoCo's data;
+    `_set_initial_state` (start pose, reset noise); settle for ``settings.settle_time``;
+    `_start_episode` (controller clocks, counters); `_measure`; first observation and info.
+
+    `step`: validate the action (clear errors, clipped into the space); `_apply_action` (servo
+    commands); physics for one control period with instability detection (`_run_physics`, a
+    MuJoCo warning or a clock that did not advance truncates with ``info["sim_unstable"]``,
+    reward 0 and the last good observation); `_measure`; tip-over (`_is_tipped_over`, the
+    penalty paid once, termination sticky); success (`_is_success`); the named reward terms
+    (`_reward_terms`, the reward is their sum); `_end_step`; observation and info (common keys
+    here, `_extra_info` for the env's own).
+
+    Hooks with a default here: `_apply_task`, `_set_initial_state`, `_start_episode`,
+    `_run_physics`, `_end_step`, `_is_tipped_over`, `_is_tipping`, `_extra_info`,
+    `_reference_description`. Hooks every env defines: `_setup`, `_build_spec`, `_bind_model`,
+    `_observation_pieces`, `_apply_action`, `_measure` (sets ``_forces``, ``_loaded``,
+    ``_fasm_deg``, ``_fasm_edge``, ``_cog``), `_is_success`, `_reward_terms`,
+    `step_cost_bound`, `paper_task`, `sample_task`.
+    """
+
+    Settings: ClassVar[type[EnvSettings]] = EnvSettings
+    """The env's settings dataclass."""
 
     metadata: ClassVar[dict[str, Any]] = {
-        "render_modes": ["human", "rgb_array", "depth_array"],
+        "render_modes": list(RENDER_MODES),
         "render_fps": 50,
     }
 
-    def __new__(cls, *args: Any, **kwargs: Any):
-        check_kwargs(cls, kwargs)
-        check_settings(cls, kwargs)
-        env = super().__new__(cls)
-        env.settings = settings_class(cls)(**kwargs)
+    ends_on_success: ClassVar[bool] = False
+    """Whether a successful step terminates the episode (a crossing) or success is a running
+    status (walking on, staying up)."""
+
+    stability_criterion: str = "FASM >= ξ"
+    """The stability criterion in words, for reports."""
+
+    def __init__(self, **kwargs: Any):
+        self.settings = s = self.Settings.from_kwargs(type(self).__name__, kwargs)
         """Every setting of this env (the defaults and the keyword arguments given), frozen:
         ``gym.make(id, **vars(env.unwrapped.settings))`` rebuilds the same env."""
-        return env
-
-    def __init__(
-        self,
-        *,
-        control_dt: float,
-        physics_dt: float,
-        render_mode: str | None = None,
-        width: int = 640,
-        height: int = 480,
-        camera_name: str | None = None,
-        task_distribution: str = "paper",
-        sensor_noise: float = 0.0,
-    ):
-        check_choice("task_distribution", task_distribution, TASK_DISTRIBUTIONS)
-        self.sensor_noise = float(sensor_noise)
+        self.control_dt = float(s.control_dt)
+        self.physics_dt = float(s.physics_dt)
+        self.n_substeps = substeps_for(self.control_dt, self.physics_dt)
+        self.settle_steps = int(round(s.settle_time / self.control_dt))
+        """Control periods of physics run in `reset` before the episode starts."""
+        self.task_distribution = s.task_distribution
+        self.sensor_noise = float(s.sensor_noise)
         """Relative std of the Gaussian noise added to the observed foot forces and IMU
         (`_add_sensor_noise`); 0 (default) observes the true values."""
-        self.task_distribution = task_distribution
+        self.reset_noise_scale = float(s.reset_noise_scale)
+        self.tipping_threshold_deg = float(s.tipping_threshold_deg)
+        """The robot's tipping threshold ξ on the FASM [deg]: `info["is_tipping"]` below it."""
+        self.tip_over_cos = math.cos(math.radians(s.tip_over_angle_deg))
         self.task: dict[str, Any] = {}
         """The episode's task parameters (plain floats/ints/strings), also `info["task"]`."""
         self._needs_reset = True
-        if render_mode is not None:
-            check_choice("render_mode", render_mode, self.metadata["render_modes"])
-        self.control_dt = control_dt
-        self.physics_dt = physics_dt
-        self.n_substeps = substeps_for(control_dt, physics_dt)
-        self.render_mode = render_mode
-        self.metadata = {**self.metadata, "render_fps": int(round(1.0 / control_dt))}
-        self._render_size = (width, height)
-        self._camera_name = camera_name
+        self.render_mode = s.render_mode
+        self.metadata = {**self.metadata, "render_fps": int(round(1.0 / self.control_dt))}
+        self._render_size = (int(s.width), int(s.height))
+        self._camera_name = s.camera_name
         self._renderer = None
         self.model: mujoco.MjModel | None = None
         self.data: mujoco.MjData | None = None
+        self._setup()
+        self.observation_layout = ObservationLayout(self._observation_pieces())
+        self.observation_space = spaces.Box(
+            -np.inf, np.inf, shape=(self.observation_layout.size,), dtype=np.float64
+        )
+        self._obs_buffer = np.zeros(self.observation_layout.size)
 
     # --- model ---------------------------------------------------------------------------
-    def _compile(self, spec: mujoco.MjSpec) -> None:
-        """Compile `spec` with the env's physics timestep and (re)create data."""
-        set_physics_options(spec, self.physics_dt)
+    def _build_model(self) -> None:
+        """Build the MjSpec (`_build_spec`), compile it with the env's physics options and
+        resolve the ids the env reads (`_bind_model`)."""
+        spec = mujoco.MjSpec()
+        spec.compiler.degree = False  # MjSpec defaults to degrees like MJCF; we use radians
+        spec.modelname = type(self).__name__
+        self._build_spec(spec)
+        s = self.settings
+        set_physics_options(
+            spec,
+            s.physics_dt,
+            s.integrator,
+            s.solver_iterations,
+            s.solver_ls_iterations,
+            s.solver_tolerance,
+        )
         spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
         spec.visual.headlight.diffuse = [0.65, 0.65, 0.65]
         spec.worldbody.add_light(
@@ -280,13 +266,7 @@ class HexapodEnv(gym.Env):
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
-
-    def _set_observation_layout(self, sizes: Mapping[str, int]) -> None:
-        self.observation_layout = ObservationLayout(sizes)
-        self.observation_space = spaces.Box(
-            -np.inf, np.inf, shape=(self.observation_layout.size,), dtype=np.float64
-        )
-        self._obs_buffer = np.zeros(self.observation_layout.size)
+        self._bind_model()
 
     @property
     def observation_structure(self) -> dict[str, slice]:
@@ -294,7 +274,7 @@ class HexapodEnv(gym.Env):
         return dict(self.observation_layout.slices)
 
     def _observation(self) -> np.ndarray:
-        self.observation_layout.pack(self._observation_pieces(), self._obs_buffer)
+        self.observation_layout.write(self._obs_buffer)
         if self.sensor_noise:
             self._add_sensor_noise(self._obs_buffer)
         return self._obs_buffer.copy()
@@ -318,21 +298,115 @@ class HexapodEnv(gym.Env):
         q /= max(float(np.linalg.norm(q)), 1e-9)
 
     # --- episode ---------------------------------------------------------------------------
-    tipping_threshold_deg: float = 20.0
-    """The robot's tipping threshold ξ on the FASM [deg]: `info["is_tipping"]` below it."""
-    stability_criterion: str = "FASM >= 20 deg"
-    """The stability criterion in words, for reports."""
+    @property
+    def time(self) -> float:
+        """Episode time [s] (the settle phase is not counted)."""
+        return self._step_count * self.control_dt
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        """Seed `np_random` and draw the episode's task (`sample_task`); subclasses extend it."""
         super().reset(seed=seed, options=options)
         self._needs_reset = False
         if self.task_distribution == "paper":
             self.task = self.paper_task()
         else:
             self.task = self.sample_task(self.np_random, self.task_distribution)
-        return None
+        self._apply_task(self.task)
+        mujoco.mj_resetData(self.model, self.data)
+        self._set_initial_state()
+        mujoco.mj_forward(self.model, self.data)
+        for _ in range(self.settle_steps):  # the robot settles onto its feet: not episode time
+            self._simulate()
+        self._step_count = 0
+        self._tipped = False
+        self._start_episode()
+        self._measure()
+        self._start_cog_x = self._prev_cog_x = float(self._cog[0])
+        self._success = self._is_success()
+        self._last_obs = self._observation()
+        return self._last_obs, self._info({}, unstable=False)
 
+    def step(self, action):
+        action = self._validate_action(action)
+        self._apply_action(action)
+        stable = self._simulate()
+        self._step_count += 1
+        if not stable:
+            # Keep training runs alive: end the episode with a flag, return the last good obs.
+            return self._last_obs.copy(), 0.0, False, True, self._info({}, unstable=True)
+        self._measure()
+        # The penalty is paid once, on the step the robot tips over; stepping on after the
+        # episode terminated keeps `terminated` True and never pays it again.
+        tipped = not self._tipped and self._is_tipped_over()
+        self._tipped = self._tipped or tipped
+        self._success = not self._tipped and self._is_success()
+        terms = self._reward_terms(tipped)
+        self._end_step()
+        self._prev_cog_x = float(self._cog[0])
+        self._last_obs = self._observation()
+        reward = float(sum(terms.values()))
+        terminated = self._tipped or (self.ends_on_success and self._success)
+        return self._last_obs, reward, terminated, False, self._info(terms, unstable=False)
+
+    def _info(self, terms: dict[str, float], unstable: bool) -> dict:
+        """The common info keys (`hexapod_envs.info_keys`) plus the env's `_extra_info`."""
+        legs = self.sensors.legs
+        edge = None
+        if self._fasm_edge is not None:
+            edge = (legs[self._fasm_edge[0]], legs[self._fasm_edge[1]])
+        info = {f"{keys.REWARD_PREFIX}{name}": value for name, value in terms.items()}
+        info[keys.FASM_MARGIN_DEG] = self._fasm_deg
+        info[keys.FASM_EDGE] = edge
+        info[keys.STANCE_LEGS] = tuple(compress(legs, self._loaded.tolist()))
+        info[keys.IS_TIPPING] = self._is_tipping()
+        info[keys.IS_TIPPED_OVER] = self._tipped
+        info[keys.IS_SUCCESS] = self._success and not unstable
+        info[keys.SIM_UNSTABLE] = unstable
+        info[keys.TIME] = self.time
+        info[keys.COG] = self._cog.copy()
+        info[keys.DISTANCE] = float(self._cog[0]) - self._start_cog_x
+        info[keys.TASK] = dict(self.task)
+        info.update(self._extra_info(unstable))
+        return info
+
+    # --- hooks with defaults ---------------------------------------------------------------
+    def _apply_task(self, task: dict[str, Any]) -> None:
+        """Set the episode's task (terrain, friction, payload...); rebuild the model if the
+        task changes its geometry (`_build_model`)."""
+
+    def _set_initial_state(self) -> None:
+        """Write the start pose into the freshly reset data (qpos, ctrl, act); the seed-dependent
+        reset noise is drawn here from `np_random`."""
+
+    def _start_episode(self) -> None:
+        """Reset the episode's own state after the settle phase (clocks, filters, counters)."""
+
+    def _end_step(self) -> None:
+        """Bookkeeping after the reward of a step (e.g. per-gait-cycle statistics)."""
+
+    def _is_tipped_over(self) -> bool:
+        """True when the body's up axis leans more than ``tip_over_angle_deg`` from vertical."""
+        return bool(self.data.xmat[self.sensors.torso_id, 8] < self.tip_over_cos)
+
+    def _is_tipping(self) -> bool:
+        """The stability criterion fails: FASM below the robot's ξ."""
+        return self._fasm_deg < self.tipping_threshold_deg
+
+    def _extra_info(self, unstable: bool) -> dict[str, Any]:
+        """The env's own info keys (documented in its module docstring)."""
+        return {}
+
+    def _reference_description(self) -> dict[str, Any]:
+        return {}
+
+    def paper_task(self) -> dict[str, Any]:
+        """The task parameters of the paper's scenario (from the constructor's settings)."""
+        return {}
+
+    def sample_task(self, rng: np.random.Generator, distribution: str) -> dict[str, Any]:
+        """Task parameters drawn from the `distribution` ("train" or "test") ranges."""
+        return self.paper_task()
+
+    # --- task description ------------------------------------------------------------------
     @property
     def task_description(self) -> TaskDescription:
         """The declared task description of the current episode (see `TaskDescription`)."""
@@ -347,6 +421,7 @@ class HexapodEnv(gym.Env):
             stability_criterion=self.stability_criterion,
             course=MappingProxyType(dict(self.task)),
             reference=MappingProxyType(self._reference_description()),
+            observation_structure=MappingProxyType(self.observation_structure),
         )
 
     def _robot_params(self) -> Any:
@@ -355,23 +430,13 @@ class HexapodEnv(gym.Env):
     def _joint_limits(self) -> tuple[np.ndarray, np.ndarray]:
         return self.action_map.low, self.action_map.high
 
-    def _reference_description(self) -> dict[str, Any]:
-        return {}
-
-    def paper_task(self) -> dict[str, Any]:
-        """The task parameters of the paper's scenario (from the constructor's settings)."""
-        return {}
-
-    def sample_task(self, rng: np.random.Generator, distribution: str) -> dict[str, Any]:
-        """Task parameters drawn from the `distribution` ("train" or "test") ranges."""
-        return self.paper_task()
-
     # --- stepping ------------------------------------------------------------------------
-    def _validate_action(self, action: Any, space: spaces.Box) -> np.ndarray:
+    def _validate_action(self, action: Any) -> np.ndarray:
         """Check that an episode is running, the dtype is real, shape and finiteness (clear
         errors), then clip into the action space."""
         if self._needs_reset:
             raise RuntimeError(f"{type(self).__name__}: call reset() first, before step()")
+        space = self.action_space
         a = np.asarray(action)
         if a.dtype.kind not in "fiu":
             raise ValueError(
@@ -395,22 +460,21 @@ class HexapodEnv(gym.Env):
     ]
     """MuJoCo warnings that count as instability (`info["sim_unstable"]`, truncation)."""
 
-    def _simulate(self, ctrl: np.ndarray | None = None) -> bool:
+    def _simulate(self) -> bool:
         """Run the physics for one control period; False if the simulation went unstable.
 
         MuJoCo resets the state when it meets NaN/huge values and counts a warning; either sign
         (a warning or a clock that did not advance by one control period) means unstable.
         """
-        if ctrl is not None:
-            self.data.ctrl[:] = ctrl
         t_expected = self.data.time + self.control_dt
-        mujoco.mj_step(self.model, self.data, nstep=self.n_substeps)
+        self._run_physics()
         if abs(self.data.time - t_expected) > 1e-6:
             return False
         return not self.data.warning.number[self._UNSTABLE_WARNINGS].any()
 
-    def _observation_pieces(self) -> dict[str, np.ndarray]:  # pragma: no cover - abstract
-        raise NotImplementedError
+    def _run_physics(self) -> None:
+        """One control period of MuJoCo steps (an env may split it to sample contacts)."""
+        mujoco.mj_step(self.model, self.data, nstep=self.n_substeps)
 
     # --- rendering -----------------------------------------------------------------------
     def render(self):

@@ -29,10 +29,11 @@ Every term is bounded and the alive term (forward_weight + stability_weight x 20
 effort_weight x 20) makes an upright step's reward >= 0, so an episode that ends by tipping over
 returns less than staying up, however badly the robot moves.
 
-Task distributions (``task_distribution=``): "paper" (default) is the scenario above;
-"train" / "test" draw cliff distance, side, edge offset, drop, ground friction and a payload
-(mass, CoG offset) at every reset from `CLIFF_TRAIN` / `CLIFF_TEST` (held out: farther, deeper,
-nearer the centre line, lower friction, heavier payload). ``info["task"]`` holds the values.
+Task distributions (``task_distribution=``): "paper" (default) is the scenario above; "train" /
+"test" draw cliff distance, side, edge offset, drop, ground friction and a payload (mass, CoG
+offset) at every reset from the ``train_ranges`` / ``test_ranges`` settings (defaults
+`CLIFF_TRAIN` / `CLIFF_TEST`) (held out: farther, deeper, nearer the centre line, lower
+friction, heavier payload). ``info["task"]`` holds the values.
 
 Action: see `HeavyDutyEnv` (``action_mode="joint"`` or ``"residual"``, 18 values in [-1, 1]).
 """
@@ -46,14 +47,14 @@ import numpy as np
 
 from ..terrain.cliff import CLIFF_SIDES, add_cliff
 from ..terrain.flat import add_flat
-from .base import check_choice
-from .heavy_duty import HeavyDutyEnv
+from .heavy_duty import HeavyDutyEnv, HeavyDutySettings
+from .settings import TaskRanges, choice, number, option
 
 TERRAINS = ("cliff", "flat")
 
 
 @dataclasses.dataclass(frozen=True)
-class CliffTaskRanges:
+class CliffTaskRanges(TaskRanges):
     """Ranges of one task distribution (uniform draws; `side` is drawn from `sides`).
 
     Held-out test ranges (the defaults of `CLIFF_TEST`) extrapolate beyond training: the cliff
@@ -73,41 +74,55 @@ CLIFF_TRAIN = CliffTaskRanges(
 CLIFF_TEST = CliffTaskRanges(
     cliff_x=(3.4, 4.0), edge_y=(-0.9, -0.7), drop=(3.0, 5.0), friction=(0.6, 0.8)
 )
-CLIFF_RANGES = {"train": CLIFF_TRAIN, "test": CLIFF_TEST}
+
+
+FRONT_FEET_X = 2.4 + 0.25
+"""x of the farthest foot at the start (hip x + half the stroke) [m]."""
+
+
+@dataclasses.dataclass(frozen=True)
+class CliffWalkSettings(HeavyDutySettings):
+    """Settings of HexapodCliffWalk-v0 (the cliff of the "paper" task, and the ranges)."""
+
+    terrain: str = choice("cliff", TERRAINS)
+    cliff_x: float = number(2.8, low=None)
+    """x of the cliff's near edge [m] (ahead of the front feet)."""
+    cliff_side: str = choice("right", CLIFF_SIDES)
+    cliff_drop: float = number(3.0, strict=True)
+    """Depth of the drop [m]."""
+    cliff_edge_y: float = number(-1.0, low=None)
+    """y of the cliff's side edge [m] (signed: toward the cliff side)."""
+    friction: float = number(1.0)
+    """Ground friction coefficient."""
+    train_ranges: CliffTaskRanges = option(CLIFF_TRAIN, kind=CliffTaskRanges)
+    test_ranges: CliffTaskRanges = option(CLIFF_TEST, kind=CliffTaskRanges)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.terrain == "cliff" and self.cliff_x <= FRONT_FEET_X:
+            raise ValueError(
+                f"cliff_x={self.cliff_x} m places the cliff at or behind the robot's front feet "
+                f"(x <= {FRONT_FEET_X} m); the robot walks along +x, put the cliff ahead of it"
+            )
 
 
 class CliffWalkEnv(HeavyDutyEnv):
     """Tripod walking toward a unilateral cliff (set ``terrain="flat"`` for plain ground)."""
 
-    def __init__(
-        self,
-        *,
-        terrain: str = "cliff",
-        cliff_x: float = 2.8,
-        cliff_side: str = "right",
-        cliff_drop: float = 3.0,
-        cliff_edge_y: float = -1.0,
-        friction: float = 1.0,
-        **kwargs,
-    ):
-        check_choice("terrain", terrain, TERRAINS)
-        check_choice("cliff_side", cliff_side, CLIFF_SIDES)
-        front_feet_x = 2.4 + 0.25  # hip_x + half the stroke: the farthest a foot starts
-        if terrain == "cliff" and cliff_x <= front_feet_x:
-            raise ValueError(
-                f"cliff_x={cliff_x} m places the cliff at or behind the robot's front feet "
-                f"(x <= {front_feet_x} m); the robot walks along +x, put the cliff ahead of it"
-            )
-        self.terrain = terrain
+    Settings = CliffWalkSettings
+
+    def _setup(self) -> None:
+        s = self.settings
+        self.terrain = s.terrain
         self.cliff = {
-            "start_x": cliff_x,
-            "side": cliff_side,
-            "drop": cliff_drop,
-            "edge_y": cliff_edge_y,
+            "start_x": s.cliff_x,
+            "side": s.cliff_side,
+            "drop": s.cliff_drop,
+            "edge_y": s.cliff_edge_y,
         }
-        self.friction = friction
-        self._paper_cliff, self._paper_friction = dict(self.cliff), friction
-        super().__init__(**kwargs)
+        self.friction = s.friction
+        self.task_ranges = {"train": s.train_ranges, "test": s.test_ranges}
+        super()._setup()
 
     def _add_terrain(self, spec: mujoco.MjSpec) -> None:
         if self.terrain == "flat":
@@ -117,18 +132,19 @@ class CliffWalkEnv(HeavyDutyEnv):
 
     # --- task distribution -----------------------------------------------------------------
     def paper_task(self) -> dict:
+        s = self.settings
         return {
             "terrain": self.terrain,
-            "cliff_x": float(self._paper_cliff["start_x"]),
-            "cliff_side": self._paper_cliff["side"],
-            "cliff_drop": float(self._paper_cliff["drop"]),
-            "cliff_edge_y": float(self._paper_cliff["edge_y"]),
-            "friction": float(self._paper_friction),
+            "cliff_x": float(s.cliff_x),
+            "cliff_side": s.cliff_side,
+            "cliff_drop": float(s.cliff_drop),
+            "cliff_edge_y": float(s.cliff_edge_y),
+            "friction": float(s.friction),
             **self.NO_PAYLOAD,
         }
 
     def sample_task(self, rng: np.random.Generator, distribution: str) -> dict:
-        r = CLIFF_RANGES[distribution]
+        r = self.task_ranges[distribution]
         return {
             "terrain": self.terrain,
             "cliff_x": float(rng.uniform(*r.cliff_x)),

@@ -15,9 +15,10 @@ reference stands still and ``info["planner_status"]`` says why ("too_deep", "too
 
 Task distributions (``task_distribution=``): "paper" (default) is the ditch above (or the
 ``ditch_*_range`` draws); "train" / "test" draw the ditch's start, width, depth and the ground
-friction at every reset from `DITCH_TRAIN` / `DITCH_TEST` (held out: wider, deeper, farther,
-lower friction). ``info["task"]`` holds the values; the stability criterion is a positive
-static margin (`tipping_threshold_deg` = 0 on the FASM).
+friction at every reset from the ``train_ranges`` / ``test_ranges`` settings (defaults
+`DITCH_TRAIN` / `DITCH_TEST`) (held out: wider, deeper, farther, lower friction).
+``info["task"]`` holds the values; the stability criterion is a positive static margin
+(`tipping_threshold_deg` = 0 on the FASM).
 
 | Observation piece | size | unit |
 |---|---|---|
@@ -58,9 +59,9 @@ Crossing the default ditch takes 20 steps, 102 s (1017 control steps); the time 
 
 | Reward term (info key) | meaning |
 |---|---|
-| reward_progress | progress_weight x CoG speed along x, clipped to ±0.1 m/s [m/s] |
+| reward_forward | forward_weight x CoG speed along x, clipped to ±0.1 m/s [m/s] |
 | reward_stability | stability_weight x clip(static_margin_m / 0.1 m, -1, 1) (0.1 m = rho/2) |
-| reward_alive | the largest cost of a step (bounds of progress, stability, effort), while up |
+| reward_alive | the largest cost of a step (bounds of forward, stability, effort), while up |
 | reward_success | on crossing: (horizon_steps - steps taken) x the largest reward of a step |
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
 | reward_effort | -effort_weight x min(sum of |actuator power| / (robot weight x 0.1 m/s), 10) |
@@ -81,13 +82,11 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from itertools import compress
 
 import mujoco
 import numpy as np
 from gymnasium import spaces
 
-from ..checks import check_number
 from ..robots.upu.gait_plan import (
     Ditch,
     GaitPlan,
@@ -108,17 +107,17 @@ from ..stability import fasm_from_feet
 from ..stability._geometry import hull_2d, signed_distance_2d
 from ..terrain.ditch import add_ditch
 from ..terrain.flat import add_flat
-from .base import HexapodEnv, check_choice
+from .base import HexapodEnv
 from .sensors import RobotSensors
+from .settings import EnvSettings, RewardScales, TaskRanges, choice, number, numbers, option
 
 TERRAINS = ("ditch", "flat")
 ACTION_MODES = ("joint", "residual")
 GRAVITY = 9.81
-_RANGE_KWARGS = ("ditch_start_x_range", "ditch_width_range", "ditch_depth_range")
 
 
 @dataclasses.dataclass(frozen=True)
-class DitchTaskRanges:
+class DitchTaskRanges(TaskRanges):
     """Ranges of one task distribution (uniform draws) [m], friction coefficient.
 
     Held-out test ranges (`DITCH_TEST`) extrapolate beyond training: wider ditches (0.40-0.50
@@ -138,19 +137,6 @@ DITCH_TRAIN = DitchTaskRanges(
 DITCH_TEST = DitchTaskRanges(
     start_x=(0.9, 1.1), width=(0.40, 0.50), depth=(0.12, 0.15), friction=(0.5, 0.8)
 )
-DITCH_RANGES = {"train": DITCH_TRAIN, "test": DITCH_TEST}
-
-
-def _check_range(name: str, value) -> tuple[float, float] | None:
-    if value is None:
-        return None
-    try:
-        lo, hi = (float(v) for v in value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be None or a (low, high) pair [m], got {value!r}") from None
-    if not (math.isfinite(lo) and math.isfinite(hi) and lo <= hi):
-        raise ValueError(f"{name} must be a finite (low, high) pair with low <= high, got {value}")
-    return (lo, hi)
 
 
 def _as_slice(index: np.ndarray):
@@ -161,27 +147,74 @@ def _as_slice(index: np.ndarray):
     return index
 
 
-PROGRESS_CLIP_M_S = 0.1
-"""Bound of the progress term's CoG speed [m/s] (the reference gait peaks near 0.065 m/s)."""
+FORWARD_CLIP_M_S = 0.1
+"""Bound of the forward term's CoG speed [m/s] (the reference gait peaks near 0.065 m/s)."""
 EFFORT_CAP = 10.0
 """Bound of the effort term's power ratio [-] (the reference gait peaks near 5.5)."""
 
 
-class DitchCrossingEnv(HexapodEnv):
-    """The 3-UPU hexapod crossing a ditch (or walking on flat ground); see the module docstring.
+@dataclasses.dataclass(frozen=True)
+class DitchCrossingRewardScales(RewardScales):
+    """Weights of HexapodDitchCrossing-v0's reward terms (see the module docstring)."""
 
-    Keyword arguments (SI units): terrain ("ditch" | "flat"); ditch_start_x, ditch_width,
-    ditch_depth [m] (defaults 0.6, 0.35, 0.14); ditch_start_x_range, ditch_width_range,
-    ditch_depth_range ((low, high) [m] or None): when given, sampled uniformly from np_random at
-    every reset; action_mode ("residual" | "joint"), residual_limb_m, residual_leg_m [m],
-    residual_filter_tau [s] (0: no filter); control_dt, physics_dt [s];
-    progress_weight, stability_weight, tip_over_penalty, effort_weight; horizon_steps (the
-    episode's step budget, as the registered time limit, that the success bonus counts the
-    remaining steps of); contact_threshold
-    (fraction of the weight); tip_over_angle_deg; reset_noise_scale [m] (the robot starts
-    shifted by up to this along x and y, and turned so that its feet move up to this much);
-    friction; gait_timing (GaitTiming), gait_settings (GaitSettings), params (UpuParams);
-    rendering: render_mode, width, height, camera_name (default the tracking camera "track").
+    forward_weight: float = number(20.0)
+    stability_weight: float = number(0.05)
+    tip_over_penalty: float = number(100.0)
+    effort_weight: float = number(0.02)
+
+
+@dataclasses.dataclass(frozen=True)
+class DitchCrossingSettings(EnvSettings):
+    """Settings of HexapodDitchCrossing-v0 (SI units; see the module docstring)."""
+
+    reward_class = DitchCrossingRewardScales
+    control_dt: float = number(0.1, strict=True)
+    physics_dt: float = number(0.002, strict=True)
+    contact_threshold: float = number(0.005, strict=True, high=1.0)
+    """A foot's pressure switch reads loaded above this fraction of the weight."""
+    tipping_threshold_deg: float = number(0.0, high=90.0)
+    """The paper judges this robot by its static margin (observation ``static_margin_m``), not
+    by a FASM threshold; 0 deg only marks a net force outside the support polygon."""
+    reset_noise_scale: float = number(0.005)
+    """The robot starts shifted by up to this along x and y, and turned so that its feet move
+    up to this much [m]."""
+    camera_name: str | None = option("track", kind=str)
+    terrain: str = choice("ditch", TERRAINS)
+    ditch_start_x: float = number(0.6, low=None)
+    """x of the ditch's near edge [m]."""
+    ditch_width: float = number(0.35, strict=True)
+    ditch_depth: float = number(0.14, strict=True)
+    ditch_start_x_range: tuple[float, float] | None = numbers(
+        None, size=2, low=None, ordered=True, optional=True
+    )
+    """(low, high) [m]: with the "paper" task, the start is drawn from it at every reset."""
+    ditch_width_range: tuple[float, float] | None = numbers(
+        None, size=2, ordered=True, optional=True
+    )
+    ditch_depth_range: tuple[float, float] | None = numbers(
+        None, size=2, ordered=True, optional=True
+    )
+    action_mode: str = choice("residual", ACTION_MODES)
+    residual_limb_m: float = number(0.002)
+    """Residual action 1 on a limb [m]."""
+    residual_leg_m: float = number(0.005)
+    """Residual action 1 on a leg [m]."""
+    residual_filter_tau: float = number(0.5)
+    """Time constant of the residual's first-order filter [s] (0: no filter)."""
+    horizon_steps: int = number(1500, strict=True, integer=True)
+    """The episode's step budget (the registered time limit) whose remaining steps the
+    success bonus pays for."""
+    friction: float = number(1.0)
+    gait_timing: GaitTiming | None = option(None, kind=GaitTiming)
+    gait_settings: GaitSettings | None = option(None, kind=GaitSettings)
+    params: UpuParams | None = option(None, kind=UpuParams)
+    train_ranges: DitchTaskRanges = option(DITCH_TRAIN, kind=DitchTaskRanges)
+    test_ranges: DitchTaskRanges = option(DITCH_TEST, kind=DitchTaskRanges)
+
+
+class DitchCrossingEnv(HexapodEnv):
+    """The 3-UPU hexapod crossing a ditch (or walking on flat ground); see the module docstring
+    and `DitchCrossingSettings`.
 
     Public attributes for controllers that know the course (as the paper's robot knows the
     ditch): ``ditch`` (the episode's `Ditch`), ``terrain``, ``start_x``, ``params``,
@@ -189,121 +222,60 @@ class DitchCrossingEnv(HexapodEnv):
     ``schedule`` (the reference gait), ``gait_settings``, ``gait_timing``.
     """
 
-    tipping_threshold_deg = 0.0
-    """The paper judges this robot by its static margin (observation ``static_margin_m``), not
-    by a FASM threshold; 0 deg only marks a net force outside the support polygon."""
+    Settings = DitchCrossingSettings
+    ends_on_success = True
     stability_criterion = "static margin > 0 mm (CoG projection inside the support triangle)"
 
-    def __init__(
-        self,
-        *,
-        terrain: str = "ditch",
-        ditch_start_x: float = 0.6,
-        ditch_width: float = 0.35,
-        ditch_depth: float = 0.14,
-        ditch_start_x_range: tuple[float, float] | None = None,
-        ditch_width_range: tuple[float, float] | None = None,
-        ditch_depth_range: tuple[float, float] | None = None,
-        action_mode: str = "residual",
-        residual_limb_m: float = 0.002,
-        residual_leg_m: float = 0.005,
-        residual_filter_tau: float = 0.5,
-        control_dt: float = 0.1,
-        physics_dt: float = 0.002,
-        progress_weight: float = 20.0,
-        stability_weight: float = 0.05,
-        tip_over_penalty: float = 100.0,
-        effort_weight: float = 0.02,
-        horizon_steps: int = 1500,
-        contact_threshold: float = 0.005,
-        tip_over_angle_deg: float = 20.0,
-        reset_noise_scale: float = 0.005,
-        friction: float = 1.0,
-        gait_timing: GaitTiming | None = None,
-        gait_settings: GaitSettings | None = None,
-        params: UpuParams | None = None,
-        render_mode: str | None = None,
-        width: int = 640,
-        height: int = 480,
-        camera_name: str | None = "track",
-        task_distribution: str = "paper",
-        sensor_noise: float = 0.0,
-    ):
-        super().__init__(
-            control_dt=control_dt,
-            physics_dt=physics_dt,
-            render_mode=render_mode,
-            width=width,
-            height=height,
-            camera_name=camera_name,
-            task_distribution=task_distribution,
-            sensor_noise=sensor_noise,
-        )
-        check_choice("terrain", terrain, TERRAINS)
-        check_choice("action_mode", action_mode, ACTION_MODES)
-        for name, value in (
-            ("residual_limb_m", residual_limb_m),
-            ("residual_leg_m", residual_leg_m),
-            ("residual_filter_tau", residual_filter_tau),
-        ):
-            check_number(name, value)
-        if not 0 < contact_threshold < 1:
-            raise ValueError(f"contact_threshold must be in (0, 1), got {contact_threshold}")
-        if not 0 < tip_over_angle_deg < 90:
-            raise ValueError(f"tip_over_angle_deg must be in (0, 90), got {tip_over_angle_deg}")
-        check_number("reset_noise_scale", reset_noise_scale)
-        self.terrain = terrain
-        self.action_mode = action_mode
-        self.residual_gain = np.array([residual_limb_m] * 3 + [residual_leg_m] * 6)
+    def _setup(self) -> None:
+        s = self.settings
+        self.terrain = s.terrain
+        self.action_mode = s.action_mode
+        self.residual_gain = np.array([s.residual_limb_m] * 3 + [s.residual_leg_m] * 6)
         """Residual per unit action [m] (limbs, then legs)."""
-        self.residual_filter_alpha = control_dt / (residual_filter_tau + control_dt)
+        self.residual_filter_alpha = self.control_dt / (s.residual_filter_tau + self.control_dt)
         """Weight of a new residual action in the first-order filter (1: no filter)."""
         gain = self.residual_gain
         self._inv_residual_gain = np.divide(1.0, gain, out=np.zeros(9), where=gain > 0)
-        self.params = params or UpuParams()
-        self.gait_timing = gait_timing or GaitTiming()
-        self.gait_settings = gait_settings or GaitSettings()
-        self.friction = friction
-        self._paper_friction = friction
-        self.reset_noise_scale = reset_noise_scale
+        self.params = s.params or UpuParams()
+        self.gait_timing = s.gait_timing or GaitTiming()
+        self.gait_settings = s.gait_settings or GaitSettings()
+        self.friction = s.friction
+        r = s.reward
         self.weights = {
-            "progress": progress_weight,
-            "stability": stability_weight,
-            "tip_over": tip_over_penalty,
-            "effort": effort_weight,
+            "forward": r.forward_weight,
+            "stability": r.stability_weight,
+            "tip_over": r.tip_over_penalty,
+            "effort": r.effort_weight,
         }
-        self.horizon_steps = int(horizon_steps)
+        self.horizon_steps = int(s.horizon_steps)
+        self.task_ranges = {"train": s.train_ranges, "test": s.test_ranges}
         self.ditch_ranges = {
-            name.removesuffix("_range"): _check_range(name, value)
-            for name, value in zip(
-                _RANGE_KWARGS,
-                (ditch_start_x_range, ditch_width_range, ditch_depth_range),
-                strict=True,
-            )
+            "ditch_start_x": s.ditch_start_x_range,
+            "ditch_width": s.ditch_width_range,
+            "ditch_depth": s.ditch_depth_range,
         }
         self.ditch_defaults = {
-            "ditch_start_x": ditch_start_x,
-            "ditch_width": ditch_width,
-            "ditch_depth": ditch_depth,
+            "ditch_start_x": s.ditch_start_x,
+            "ditch_width": s.ditch_width,
+            "ditch_depth": s.ditch_depth,
         }
         self.start_x = 0.0
         """World x of both platform centres at the start [m]."""
-        self._check_geometry(ditch_start_x, ditch_width, ditch_depth)
+        self._check_geometry(s.ditch_start_x, s.ditch_width, s.ditch_depth)
         for key, rng in self.ditch_ranges.items():
             if rng is not None:
                 values = dict(self.ditch_defaults)
                 for v in rng:
                     values[key] = v
                     self._check_geometry(**values)
-        self.ditch = Ditch(ditch_start_x, ditch_width, ditch_depth)
+        self.ditch = Ditch(s.ditch_start_x, s.ditch_width, s.ditch_depth)
         """The episode's ditch geometry (public: a controller that knows the ditch, as the
         paper's robot does, plans from it). On flat ground it marks the finish line only."""
 
         p = self.params
         self.weight_n = p.total_mass * GRAVITY
-        self.contact_force = contact_threshold * self.weight_n
+        self.contact_force = s.contact_threshold * self.weight_n
         """Normal force above which a foot counts as in contact [N]."""
-        self.tip_over_cos = math.cos(math.radians(tip_over_angle_deg))
         self.inradius = p.support_inradius
         low = np.array([p.limb_min] * 3 + [p.extension_range[0]] * 6)
         high = np.array([p.limb_max] * 3 + [p.extension_range[1]] * 6)
@@ -312,37 +284,11 @@ class DitchCrossingEnv(HexapodEnv):
         self._half = (high - low) / 2
         self.action_space = spaces.Box(-1.0, 1.0, shape=(len(COMMAND_NAMES),), dtype=np.float32)
         self._reference_power = self.weight_n * 0.1
-        self._inv_dt = 1.0 / control_dt
+        self._inv_dt = 1.0 / self.control_dt
         self._plans: dict[tuple, GaitPlan] = {}
         self._built_for: tuple | None = None
         self._build(self.ditch)
-        self._set_observation_layout(
-            {
-                "joint_pos": 9,
-                "joint_vel": 9,
-                "foot_force": 18,
-                "foot_contact": 6,
-                "fasm_margin_deg": 1,
-                "static_margin_m": 1,
-                "imu_gyro": 3,
-                "imu_accel": 3,
-                "imu_quat": 4,
-                "reference_action": 9,
-                "residual_state": 9,
-            }
-        )
         self._set_plan(self.ditch)
-        # The three IMU pieces are adjacent in the observation and in sensordata: one copy.
-        o = self.observation_layout.slices
-        self._imu_obs = slice(o["imu_gyro"].start, o["imu_quat"].stop)
-        sensors = self.sensors
-        self._imu_sensors = slice(sensors._gyro.start, sensors._quat.stop)
-        if not (
-            sensors._accel.start == sensors._gyro.stop
-            and sensors._quat.start == sensors._accel.stop
-            and o["imu_accel"].start == o["imu_gyro"].stop
-        ):  # pragma: no cover - the model builder adds the IMU sensors in this order
-            raise RuntimeError("IMU sensors are expected to be adjacent in sensordata")
 
     # --- geometry, model, plan -----------------------------------------------------------------
     def _check_geometry(self, ditch_start_x: float, ditch_width: float, ditch_depth: float):
@@ -367,12 +313,16 @@ class DitchCrossingEnv(HexapodEnv):
         return (*geometry, self.friction)
 
     def _build(self, ditch: Ditch) -> None:
+        """Build the model for `ditch` unless the current one already has its geometry."""
         key = self._geometry_key(ditch)
         if key == self._built_for:
             return
-        spec = mujoco.MjSpec()
-        spec.compiler.degree = False  # MjSpec defaults to degrees; the builders use radians
-        spec.modelname = type(self).__name__
+        self._build_ditch = ditch
+        self._build_model()
+        self._built_for = key
+
+    def _build_spec(self, spec: mujoco.MjSpec) -> None:
+        ditch = self._build_ditch
         if self.terrain == "ditch":
             add_ditch(spec, ditch.start_x, ditch.width, ditch.depth, friction=self.friction)
         else:
@@ -381,8 +331,8 @@ class DitchCrossingEnv(HexapodEnv):
         self.handles = add_upu(
             spec, p, pos=(self.start_x, 0.0, p.lower_leg_length + 0.001), command="interpolated"
         )
-        self._compile(spec)
-        self._built_for = key
+
+    def _bind_model(self) -> None:
         m = self.model
         self.sensors = RobotSensors(m, self.data, LEG_NAMES, COMMAND_NAMES)
         self._act = _as_slice(np.array([m.actuator(name).id for name in COMMAND_NAMES]))
@@ -392,9 +342,8 @@ class DitchCrossingEnv(HexapodEnv):
         self._force_idx = np.array(
             [m.sensor_adr[m.sensor(f"{leg}_foot_force").id] + np.arange(3) for leg in LEG_NAMES]
         )
-        self._foot_weight = np.array(
-            [0.0, 0.0, p.foot_mass * GRAVITY]
-        )  # added to -sensor (see model.py)
+        # Added to -sensor (see model.py): the foot's own weight.
+        self._foot_weight = np.array([0.0, 0.0, self.params.foot_mass * GRAVITY])
         self._leg_qpos = np.array(
             [m.jnt_qposadr[m.joint(self.handles.leg_joint(leg)).id] for leg in LEG_NAMES]
         )
@@ -452,7 +401,7 @@ class DitchCrossingEnv(HexapodEnv):
 
     def _reference_description(self) -> dict:
         """The reference gait: plan and timed schedule for this episode's ditch, timing and
-        planner settings, start and finish x [m], residual gains [m]."""
+        planner settings, start and finish x [m], residual gains [m] and filter weight."""
         return {
             "plan": self.plan,
             "schedule": self.schedule,
@@ -461,6 +410,7 @@ class DitchCrossingEnv(HexapodEnv):
             "start_x": self.start_x,
             "finish_x": self.finish_x,
             "residual_gain": tuple(float(g) for g in self.residual_gain),
+            "residual_filter_alpha": float(self.residual_filter_alpha),
         }
 
     def paper_task(self) -> dict:
@@ -469,11 +419,11 @@ class DitchCrossingEnv(HexapodEnv):
             "ditch_start_x": float(self.ditch_defaults["ditch_start_x"]),
             "ditch_width": float(self.ditch_defaults["ditch_width"]),
             "ditch_depth": float(self.ditch_defaults["ditch_depth"]),
-            "friction": float(self._paper_friction),
+            "friction": float(self.settings.friction),
         }
 
     def sample_task(self, rng: np.random.Generator, distribution: str) -> dict:
-        r = DITCH_RANGES[distribution]
+        r = self.task_ranges[distribution]
         return {
             "terrain": self.terrain,
             "ditch_start_x": float(rng.uniform(*r.start_x)),
@@ -482,27 +432,26 @@ class DitchCrossingEnv(HexapodEnv):
             "friction": float(rng.uniform(*r.friction)),
         }
 
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed, options=options)
+    def _apply_task(self, task: dict) -> None:
         if self.task_distribution != "paper":
-            t = self.task
-            self.friction = t["friction"]
-            self.ditch = Ditch(t["ditch_start_x"], t["ditch_width"], t["ditch_depth"])
-            self._build(self.ditch)
-            self._set_plan(self.ditch)
+            self.friction = task["friction"]
+            self.ditch = Ditch(task["ditch_start_x"], task["ditch_width"], task["ditch_depth"])
         elif any(r is not None for r in self.ditch_ranges.values()):
             self.ditch = self._sample_ditch()
-            self.task.update(
+            task.update(
                 ditch_start_x=self.ditch.start_x,
                 ditch_width=self.ditch.width,
                 ditch_depth=self.ditch.depth,
             )
-            self._build(self.ditch)
-            self._set_plan(self.ditch)
-        m, d = self.model, self.data
-        mujoco.mj_resetData(m, d)
+        else:
+            return
+        self._build(self.ditch)
+        self._set_plan(self.ditch)
+
+    def _set_initial_state(self) -> None:
         # Start in the standing pose with the servo targets at it, so nothing jumps: a limb
         # started a few mm off its target would hit the 400 N force limit and throw the robot.
+        d = self.data
         stand = standing_command(self.params)
         d.act[self._act_state] = stand
         d.ctrl[self._act] = 0.0
@@ -519,63 +468,38 @@ class DitchCrossingEnv(HexapodEnv):
                 0.0,
                 np.sin(yaw / 2),
             )
-        mujoco.mj_forward(m, d)
-        # Settle onto the feet under the standing command (not part of the episode).
-        for _ in range(int(round(0.5 / self.control_dt))):
-            self._simulate()
+
+    def _start_episode(self) -> None:
         self._residual = np.zeros(len(COMMAND_NAMES))
         self._episode_info = {  # info entries fixed for the episode
             "planner_status": self.plan.status,
             "planner_reason": self.plan.reason,
             "finish_x": self.finish_x,
         }
-        self._tick = 0
-        self._tipped = False
-        self._success = False
-        self._prev_cog_x = float(self.sensors.cog()[0])
-        self._start_cog_x = self._prev_cog_x
-        self._update_stability()
-        self._last_obs = self._observation()
-        return self._last_obs, self._info({}, unstable=False)
 
     def reference_command(self, tick: int | None = None) -> np.ndarray:
         """The reference gait's command (`COMMAND_NAMES`, [m]) at control step `tick` (default:
         the current one)."""
-        return self.schedule.command(self._tick if tick is None else tick)
+        return self.schedule.command(self._step_count if tick is None else tick)
 
-    def step(self, action):
-        action = self._validate_action(action, self.action_space)
+    def _apply_action(self, action: np.ndarray) -> None:
         if self.action_mode == "joint":
             target = self._center + self._half * action
         else:
             r = self._residual
             r += self.residual_filter_alpha * (self.residual_gain * action - r)
-            target = self.schedule.command(self._tick) + r
+            target = self.schedule.command(self._step_count) + r
         # Interpolated commands: the servo targets (act) move linearly to `target` during the
         # control period; MuJoCo clamps the rate to the speed limits, the target to the ranges.
         d = self.data
         d.ctrl[self._act] = (target - d.act[self._act_state]) * self._inv_dt
-        stable = self._simulate()
-        self._tick += 1
-        if not stable:
-            return self._last_obs.copy(), 0.0, False, True, self._info({}, unstable=True)
-        self._update_stability()
-        # The penalty is paid once; stepping on after termination keeps `terminated` True.
-        tipped = bool(d.xmat[self._torso, 8] < self.tip_over_cos) and not self._tipped
-        self._tipped = self._tipped or tipped
-        self._success = not self._tipped and self._all_feet_past_finish()
-        cog_x = float(d.subtree_com[self._torso, 0])
-        terms = self._reward_terms(cog_x, tipped)
-        self._prev_cog_x = cog_x
-        self._last_obs = self._observation()
-        reward = float(sum(terms.values()))
-        terminated = self._tipped or self._success
-        return self._last_obs, reward, terminated, False, self._info(terms, unstable=False)
 
     # --- measurements ------------------------------------------------------------------------
-    def _update_stability(self) -> None:
+    def _measure(self) -> None:
         d = self.data
         sd = d.sensordata
+        act = self._act
+        self._power = float(np.abs(d.actuator_force[act] * d.actuator_velocity[act]).sum())
         # Every foot site is parallel to its platform and the platforms stay parallel (the
         # mechanism only translates), so one rotation takes all six force readings to the world
         # frame. Ground reaction = -R s + m_foot g (see model.py).
@@ -587,8 +511,8 @@ class DitchCrossingEnv(HexapodEnv):
         loaded = sd[self._touch] > self.contact_force
         self._loaded = loaded
         soles = d.xpos[self._foot_body]
-        cog = d.subtree_com[self._torso]
-        self._fasm_deg, _ = fasm_from_feet(soles, forces, cog, loaded)
+        cog = self._cog = d.subtree_com[self._torso].copy()
+        self._fasm_deg, self._fasm_edge = fasm_from_feet(soles, forces, cog, loaded)
         self._static_margin = 0.0
         if loaded.sum() >= 3:
             pts = soles[loaded].tolist()
@@ -607,102 +531,75 @@ class DitchCrossingEnv(HexapodEnv):
                 return
             self._static_margin = signed_distance_2d(xs, ys, hull, px, py)
 
-    def _all_feet_past_finish(self) -> bool:
+    def _is_success(self) -> bool:
+        """Every foot past the far edge of the ditch (the finish line), all six loaded."""
         if not self._loaded.all():
             return False
         rear = self.data.xpos[self._foot_body, 0].min() - self.params.foot_radius
         return bool(rear > self.finish_x)
 
-    def _observation_pieces(self) -> dict[str, np.ndarray]:
-        s = self.sensors
-        d = self.data
+    def _is_tipping(self) -> bool:
+        """The paper's criterion: the CoG projection is not inside the loaded feet's polygon."""
+        return self._static_margin <= 0.0
+
+    def _observation_pieces(self) -> dict:
+        # Readers look the data up at call time: a task may rebuild the model (and its data).
         return {
-            "joint_pos": d.actuator_length[self._act],
-            "joint_vel": d.actuator_velocity[self._act],
-            "foot_force": self._forces.reshape(-1),
-            "foot_contact": self._loaded,
-            "fasm_margin_deg": self._fasm_deg,
-            "static_margin_m": self._static_margin,
-            "imu_gyro": s.gyro(),
-            "imu_accel": s.accelerometer(),
-            "imu_quat": s.orientation(),
-            "reference_action": self._reference_actions[
-                min(self._tick, len(self._reference_actions) - 1)
-            ],
-            "residual_state": self._residual_units(),
+            "joint_pos": (9, lambda: self.data.actuator_length[self._act]),
+            "joint_vel": (9, lambda: self.data.actuator_velocity[self._act]),
+            "foot_force": (18, lambda: self._forces.reshape(-1)),
+            "foot_contact": (6, lambda: self._loaded),
+            "fasm_margin_deg": (1, lambda: self._fasm_deg),
+            "static_margin_m": (1, lambda: self._static_margin),
+            "imu_gyro": (3, lambda: self.sensors.gyro()),
+            "imu_accel": (3, lambda: self.sensors.accelerometer()),
+            "imu_quat": (4, lambda: self.sensors.orientation()),
+            "reference_action": (9, self._reference_action),
+            "residual_state": (9, lambda: self._residual * self._inv_residual_gain),
         }
 
-    def _residual_units(self) -> np.ndarray:
-        return self._residual * self._inv_residual_gain
-
-    def _observation(self) -> np.ndarray:
-        """`_observation_pieces` written straight into the flat vector (the per-step path)."""
-        b, o, d = self._obs_buffer, self.observation_layout.slices, self.data
-        b[o["joint_pos"]] = d.actuator_length[self._act]
-        b[o["joint_vel"]] = d.actuator_velocity[self._act]
-        b[o["foot_force"]] = self._forces.reshape(-1)
-        b[o["foot_contact"]] = self._loaded
-        b[o["fasm_margin_deg"]] = self._fasm_deg
-        b[o["static_margin_m"]] = self._static_margin
-        b[self._imu_obs] = d.sensordata[self._imu_sensors]  # gyro, accel, quat
-        b[o["reference_action"]] = self._reference_actions[
-            min(self._tick, len(self._reference_actions) - 1)
-        ]
-        b[o["residual_state"]] = self._residual_units()
-        if self.sensor_noise:
-            self._add_sensor_noise(b)
-        return b.copy()
+    def _reference_action(self) -> np.ndarray:
+        """The reference gait's command now, normalised like a "joint" action."""
+        ref = self._reference_actions
+        return ref[min(self._step_count, len(ref) - 1)]
 
     def step_cost_bound(self) -> float:
-        """The largest cost one step can carry (bounded negative parts of progress, stability
+        """The largest cost one step can carry (bounded negative parts of forward, stability
         and effort); the ``alive`` term pays it on every step the robot is up."""
         w = self.weights
-        return w["progress"] * PROGRESS_CLIP_M_S + w["stability"] + w["effort"] * EFFORT_CAP
+        return w["forward"] * FORWARD_CLIP_M_S + w["stability"] + w["effort"] * EFFORT_CAP
 
     def step_reward_bound(self) -> float:
         """The largest reward one step can earn (alive + the bounded positive terms)."""
         w = self.weights
-        return self.step_cost_bound() + w["progress"] * PROGRESS_CLIP_M_S + w["stability"]
+        return self.step_cost_bound() + w["forward"] * FORWARD_CLIP_M_S + w["stability"]
 
-    def _reward_terms(self, cog_x: float, tipped: bool) -> dict[str, float]:
+    def _reward_terms(self, tipped: bool) -> dict[str, float]:
         w = self.weights
-        speed = (cog_x - self._prev_cog_x) / self.control_dt
+        speed = (float(self._cog[0]) - self._prev_cog_x) / self.control_dt
         r = self.inradius
         margin = min(max(self._static_margin, -r), r) / r
-        d = self.data
-        power = float(np.abs(d.actuator_force[self._act] * d.actuator_velocity[self._act]).sum())
         # Crossing ends the episode: the bonus pays what the remaining steps could at most have
         # earned, so that standing still on the near side never returns more than crossing.
-        remaining = max(self.horizon_steps - self._tick, 0)
+        remaining = max(self.horizon_steps - self._step_count, 0)
         return {
-            "progress": w["progress"] * min(max(speed, -PROGRESS_CLIP_M_S), PROGRESS_CLIP_M_S),
+            "forward": w["forward"] * min(max(speed, -FORWARD_CLIP_M_S), FORWARD_CLIP_M_S),
             "stability": w["stability"] * margin,
             "alive": 0.0 if self._tipped else self.step_cost_bound(),
             "success": remaining * self.step_reward_bound() if self._success else 0.0,
             "tip_over": -w["tip_over"] if tipped else 0.0,
-            "effort": -w["effort"] * min(power / self._reference_power, EFFORT_CAP),
+            "effort": -w["effort"] * min(self._power / self._reference_power, EFFORT_CAP),
         }
 
-    def _info(self, terms: dict[str, float], unstable: bool) -> dict:
-        step, phase = self.schedule.phase(self._tick)
-        cog = self.data.subtree_com[self._torso]
+    def _extra_info(self, unstable: bool) -> dict:
+        step, phase = self.schedule.phase(self._step_count)
         up_z = min(1.0, max(-1.0, float(self.data.xmat[self._torso, 8])))
         return {
-            **{f"reward_{name}": value for name, value in terms.items()},
-            "fasm_margin_deg": self._fasm_deg,
             "static_margin_m": self._static_margin,
-            "stance_legs": tuple(compress(LEG_NAMES, self._loaded.tolist())),
-            "is_tipping": self._static_margin <= 0.0,
-            "is_tipped_over": self._tipped,
-            "is_success": self._success and not unstable,
-            "sim_unstable": unstable,
-            "distance": float(cog[0]) - self._start_cog_x,
+            "actuator_power_w": self._power,
             "tilt_deg": math.degrees(math.acos(up_z)),
             **self._episode_info,
             "ditch": self._ditch_info,  # a new dict every step (callers may keep infos)
             "gait_step": step,
             "gait_phase": phase,
-            "time": self._tick * self.control_dt,
-            "cog": cog.copy(),
-            "task": dict(self.task),
         }

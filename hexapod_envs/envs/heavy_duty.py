@@ -13,6 +13,8 @@ distance the reference gait covers in the elapsed walking time.
 
 from __future__ import annotations
 
+import dataclasses
+
 import mujoco
 import numpy as np
 from gymnasium import spaces
@@ -21,8 +23,9 @@ from ..robots.heavy_duty import LEG_NAMES, HeavyDutyParams
 from ..robots.heavy_duty.gait import TripodGait, TripodGaitParams
 from ..robots.heavy_duty.model import add_heavy_duty
 from ..stability import fasm_from_feet
-from .base import HexapodEnv, JointActionMap, check_choice
+from .base import HexapodEnv, JointActionMap
 from .sensors import RobotSensors
+from .settings import EnvSettings, RewardScales, choice, number, option
 
 XI_F_DEG = 20.0
 """Tipping threshold ξ_f of Zhang et al. 2024 §3 [deg]."""
@@ -35,78 +38,67 @@ step's reward >= 0, so that tipping over early never pays more than staying up."
 ACTION_MODES = ("joint", "residual")
 
 
+@dataclasses.dataclass(frozen=True)
+class HeavyDutyRewardScales(RewardScales):
+    """Weights of the heavy-duty envs' reward terms (see the env docstrings)."""
+
+    forward_weight: float = number(1.0)
+    stability_weight: float = number(1.0)
+    tip_over_penalty: float = number(100.0)
+    effort_weight: float = number(0.05)
+
+
+@dataclasses.dataclass(frozen=True)
+class HeavyDutySettings(EnvSettings):
+    """Settings of the heavy-duty hexapod envs (the scenario envs extend them)."""
+
+    reward_class = HeavyDutyRewardScales
+    tipping_threshold_deg: float = number(XI_F_DEG, high=90.0)
+    """ξ_f [deg]: FASM below it means the robot is tipping (the paper's judgment threshold)."""
+    action_mode: str = choice("residual", ACTION_MODES)
+    residual_scale: float = number(0.25)
+    """Residual action 1 = this fraction of each joint's half range."""
+    residual_filter_tau: float = number(0.1)
+    """Time constant of the residual's first-order low-pass filter [s] (0: none)."""
+    min_progress: float = number(0.5)
+    """Share of the reference gait's distance a successful walking episode covers."""
+    gait: TripodGaitParams | None = option(None, kind=TripodGaitParams)
+    """The reference tripod gait (None: the paper's)."""
+
+
 class HeavyDutyEnv(HexapodEnv):
     """Base for the heavy-duty hexapod scenarios: robot, sensors, FASM, action modes, rewards."""
+
+    Settings = HeavyDutySettings
 
     walks: bool = True
     """Walking scenarios follow the reference tripod gait and observe its phase."""
 
-    tipping_threshold_deg: float = XI_F_DEG
-    """ξ_f [deg]: FASM below it means the robot is tipping (the paper's judgment threshold)."""
-    stability_criterion = f"FASM >= ξ_f = {XI_F_DEG:g} deg (the paper's tipping judgment)"
-
-    def __init__(
-        self,
-        *,
-        action_mode: str = "residual",
-        residual_scale: float = 0.25,
-        residual_filter_tau: float = 0.1,
-        min_progress: float = 0.5,
-        control_dt: float = 0.02,
-        physics_dt: float = 0.001,
-        gait: TripodGaitParams | None = None,
-        forward_weight: float = 1.0,
-        stability_weight: float = 1.0,
-        tip_over_penalty: float = 100.0,
-        effort_weight: float = 0.05,
-        contact_threshold: float = 0.02,
-        tip_over_angle_deg: float = 20.0,
-        reset_noise_scale: float = 0.01,
-        render_mode: str | None = None,
-        width: int = 640,
-        height: int = 480,
-        camera_name: str | None = None,
-        task_distribution: str = "paper",
-        sensor_noise: float = 0.0,
-    ):
-        super().__init__(
-            control_dt=control_dt,
-            physics_dt=physics_dt,
-            render_mode=render_mode,
-            width=width,
-            height=height,
-            camera_name=camera_name,
-            task_distribution=task_distribution,
-            sensor_noise=sensor_noise,
+    def _setup(self) -> None:
+        s = self.settings
+        self.stability_criterion = (
+            f"FASM >= ξ_f = {self.tipping_threshold_deg:g} deg (the paper's tipping judgment)"
         )
-        check_choice("action_mode", action_mode, ACTION_MODES)
-        self.action_mode = action_mode
-        self.residual_scale = residual_scale
+        self.action_mode = s.action_mode
+        self.residual_scale = s.residual_scale
         self.robot = HeavyDutyParams()
-        self.gait = TripodGait(self.robot, gait)
+        self.gait = TripodGait(self.robot, s.gait)
         self.weights = {
-            "forward": forward_weight,
-            "stability": stability_weight,
-            "tip_over": tip_over_penalty,
-            "effort": effort_weight,
+            "forward": s.reward.forward_weight,
+            "stability": s.reward.stability_weight,
+            "tip_over": s.reward.tip_over_penalty,
+            "effort": s.reward.effort_weight,
         }
-        self.contact_threshold = contact_threshold
-        self.tip_over_cos = float(np.cos(np.radians(tip_over_angle_deg)))
-        self.reset_noise_scale = reset_noise_scale
-        # Physics run in reset() so the episode starts with the robot resting on its feet [s].
-        self.settle_time = 0.5
         self.weight_n = self.robot.total_mass * 9.81
-        self._contact_force_sq = (contact_threshold * self.weight_n) ** 2
+        self._contact_force_sq = (s.contact_threshold * self.weight_n) ** 2
         self.action_map = JointActionMap(np.tile(self.robot.joint_ranges, (6, 1)))
         self.action_space = spaces.Box(-1.0, 1.0, shape=(18,), dtype=np.float32)
-        self._residual_gain = residual_scale * self.action_map.half
-        if residual_filter_tau < 0:
-            raise ValueError(f"residual_filter_tau must be >= 0 s, got {residual_filter_tau}")
+        self._residual_gain = s.residual_scale * self.action_map.half
         # First-order low-pass on the residual (a servo command filter): a step-to-step
         # jittering residual would otherwise hammer 5 t through 4e6 N/m servos.
-        self._filter_alpha = control_dt / (residual_filter_tau + control_dt)
-        self.min_progress = min_progress
-        steps_per_cycle = self.gait.gait.period / control_dt
+        self._filter_alpha = self.control_dt / (s.residual_filter_tau + self.control_dt)
+        self.min_progress = s.min_progress
+        steps_per_cycle = self.gait.gait.period / self.control_dt
         if abs(steps_per_cycle - round(steps_per_cycle)) > 1e-9:
             raise ValueError("gait period must be a whole number of control periods")
         self._steps_per_cycle = int(round(steps_per_cycle))
@@ -116,37 +108,21 @@ class HeavyDutyEnv(HexapodEnv):
                 for k in range(self._steps_per_cycle)
             ]
         )
-        self._stand_steps = int(round(self.gait.gait.stand_time / control_dt))
-        self._build()
-        self._set_observation_layout(
-            {
-                "joint_pos": 18,
-                "joint_vel": 18,
-                "foot_force": 18,
-                "foot_contact": 6,
-                "fasm_margin_deg": 1,
-                "imu_gyro": 3,
-                "imu_accel": 3,
-                "imu_quat": 4,
-                **({"gait_phase": 3} if self.walks else {}),
-                **self._extra_observation_sizes(),
-            }
-        )
+        self._stand_steps = int(round(self.gait.gait.stand_time / self.control_dt))
+        self._build_model()
 
     # --- model ---------------------------------------------------------------------------
-    def _add_terrain(self, spec: mujoco.MjSpec) -> None:  # pragma: no cover - abstract
+    def _add_terrain(self, spec) -> None:  # pragma: no cover - abstract
         raise NotImplementedError
 
     def _robot_start_height(self) -> float:
         return self.robot.stand_height + 0.005
 
-    def _build(self) -> None:
-        spec = mujoco.MjSpec()
-        spec.compiler.degree = False  # MjSpec defaults to degrees like MJCF; we use radians
-        spec.modelname = type(self).__name__
+    def _build_spec(self, spec) -> None:
         self._add_terrain(spec)
         self.handles = add_heavy_duty(spec, self.robot, pos=(0.0, 0.0, self._robot_start_height()))
-        self._compile(spec)
+
+    def _bind_model(self) -> None:
         actuators = tuple(j for leg in LEG_NAMES for j in self.handles.joints[leg])
         self.sensors = RobotSensors(self.model, self.data, LEG_NAMES, actuators)
         self._act_ids = np.array([self.model.actuator(a).id for a in actuators])
@@ -156,14 +132,7 @@ class HeavyDutyEnv(HexapodEnv):
         )
         self._gears = self.model.actuator_gear[self._act_ids, 0].copy()
 
-    def _extra_observation_sizes(self) -> dict[str, int]:
-        return {}
-
     # --- time and reference gait ------------------------------------------------------------
-    @property
-    def time(self) -> float:
-        return self._step_count * self.control_dt
-
     def _gait_step(self) -> int:
         """Index into the reference table (the gait clock is frozen while standing)."""
         return max(0, self._step_count - self._stand_steps) % self._steps_per_cycle
@@ -179,39 +148,30 @@ class HeavyDutyEnv(HexapodEnv):
         self._residual += self._filter_alpha * (self._residual_gain * action - self._residual)
         return self.reference_joints() + self._residual
 
-    # --- reset / step --------------------------------------------------------------------
+    # --- episode hooks ---------------------------------------------------------------------
     def _initial_joints(self) -> np.ndarray:
         return self._reference_table[0]
 
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed, options=options)
-        self._apply_task(self.task)
-        mujoco.mj_resetData(self.model, self.data)
-        self._step_count = 0
-        self._residual = np.zeros(self.action_space.shape)
-        self._on_reset()
+    def _set_initial_state(self) -> None:
         # The initial joint state is perturbed; the servo targets are not, and the settling
-        # below lets the perturbation decay into a seed-dependent resting state.
+        # lets the perturbation decay into a seed-dependent resting state.
         targets = self._initial_joints()
         noise = self.reset_noise_scale * self.action_map.half
         joints = targets + self.np_random.uniform(-noise, noise)
         joints = np.clip(joints, self.action_map.low, self.action_map.high)
         self.data.qpos[self._joint_qpos] = joints / self._gears
         self.data.ctrl[self._act_ids] = targets
-        mujoco.mj_forward(self.model, self.data)
-        # Let the robot settle onto its feet before the episode starts (not part of the episode).
-        for _ in range(int(round(self.settle_time / self.control_dt))):
-            self._simulate()
-        self._tipped = False
-        self._power = 0.0
-        self._start_cog = self.sensors.cog().copy()
-        self._prev_cog_x = float(self._start_cog[0])
-        self._update_stability()
-        self._last_obs = self._observation()
-        return self._last_obs, self._info({}, unstable=False)
 
-    def _on_reset(self) -> None:
-        """Hook for scenario state (terrain randomisation, platform pose)."""
+    def _start_episode(self) -> None:
+        self._residual = np.zeros(self.action_space.shape)
+
+    def _apply_action(self, action: np.ndarray) -> None:
+        ctrl = self._ctrl_from_action(action)
+        self._before_physics()
+        self.data.ctrl[self._act_ids] = ctrl
+
+    def _before_physics(self) -> None:
+        """Hook run before each control period's physics (e.g. driving a platform)."""
 
     def _reference_description(self) -> dict:
         """The reference: tripod gait parameters, its table of joint targets per control step
@@ -246,7 +206,7 @@ class HeavyDutyEnv(HexapodEnv):
         """Rebuild the model when the task changes it, then place the payload (a point mass
         added to the body at its CoG offset; the body's inertia is kept)."""
         if self._rebuild_needed(task):
-            self._build()
+            self._build_model()
         m = self.model
         torso = self.sensors.torso_id
         if not hasattr(self, "_torso_mass0"):
@@ -264,66 +224,41 @@ class HeavyDutyEnv(HexapodEnv):
         """Whether the task changes the terrain geometry (the model is then rebuilt)."""
         return False
 
-    def step(self, action):
-        action = self._validate_action(action, self.action_space)
-        ctrl = self._ctrl_from_action(action)
-        self._before_physics()
-        self.data.ctrl[self._act_ids] = ctrl
-        stable = self._simulate()
-        self._step_count += 1
-        if not stable:
-            # Keep training runs alive: end the episode with a flag, return the last good obs.
-            return self._last_obs.copy(), 0.0, False, True, self._info({}, unstable=True)
-        self._update_stability()
-        # The penalty is paid once, on the step the robot tips over; stepping on after the
-        # episode terminated keeps `terminated` True and never pays it again.
-        tipped = self._is_tipped_over() and not self._tipped
-        self._tipped = self._tipped or tipped
-        self._power = float(
-            np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
-        )
-        cog_x = float(self.sensors.cog()[0])
-        terms = self._reward_terms(tipped, cog_x)
-        self._prev_cog_x = cog_x
-        self._last_obs = self._observation()
-        reward = float(sum(terms.values()))
-        return self._last_obs, reward, self._tipped, False, self._info(terms, unstable=False)
-
-    def _before_physics(self) -> None:
-        """Hook run before each control period's physics (e.g. driving a platform)."""
-
-    # --- stability -----------------------------------------------------------------------
-    def _update_stability(self) -> None:
+    # --- measurements ----------------------------------------------------------------------
+    def _measure(self) -> None:
         forces = self.sensors.foot_forces()
         self._forces = forces
         self._loaded = (forces * forces).sum(axis=1) > self._contact_force_sq
+        self._cog = self.sensors.cog().copy()
         self._fasm_deg, self._fasm_edge = fasm_from_feet(
-            self.sensors.foot_positions(), forces, self.sensors.cog(), self._loaded
+            self.sensors.foot_positions(), forces, self._cog, self._loaded
+        )
+        self._power = float(
+            np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
         )
 
-    def _is_tipped_over(self) -> bool:
-        """True when the body up axis leans more than `tip_over_angle_deg` from vertical."""
-        return bool(self.data.xmat[self.sensors.torso_id, 8] < self.tip_over_cos)
-
     # --- observation, reward, info ----------------------------------------------------------
-    def _observation_pieces(self) -> dict[str, np.ndarray]:
+    def _observation_pieces(self) -> dict:
+        # Readers look the sensors up at call time: a task may rebuild the model (and sensors).
+        pieces = {
+            "joint_pos": (18, lambda: self.sensors.joint_positions()),
+            "joint_vel": (18, lambda: self.sensors.joint_velocities()),
+            "foot_force": (18, lambda: self._forces.reshape(-1)),
+            "foot_contact": (6, lambda: self._loaded),
+            "fasm_margin_deg": (1, lambda: self._fasm_deg),
+            "imu_gyro": (3, lambda: self.sensors.gyro()),
+            "imu_accel": (3, lambda: self.sensors.accelerometer()),
+            "imu_quat": (4, lambda: self.sensors.orientation()),
+        }
+        if self.walks:
+            pieces["gait_phase"] = (3, self._gait_phase)
+        return pieces
+
+    def _gait_phase(self) -> tuple[float, float, float]:
+        """sin, cos of the gait clock's phase, and 1 once walking."""
         phase = self._gait_step() / self._steps_per_cycle
         walking = float(self._step_count >= self._stand_steps)
-        return {
-            "joint_pos": self.sensors.joint_positions(),
-            "joint_vel": self.sensors.joint_velocities(),
-            "foot_force": self._forces.reshape(-1),
-            "foot_contact": self._loaded,
-            "fasm_margin_deg": self._fasm_deg,
-            "imu_gyro": self.sensors.gyro(),
-            "imu_accel": self.sensors.accelerometer(),
-            "imu_quat": self.sensors.orientation(),
-            "gait_phase": (np.sin(2 * np.pi * phase), np.cos(2 * np.pi * phase), walking),
-            **self._extra_observation_pieces(),
-        }
-
-    def _extra_observation_pieces(self) -> dict[str, np.ndarray]:
-        return {}
+        return np.sin(2 * np.pi * phase), np.cos(2 * np.pi * phase), walking
 
     def step_cost_bound(self) -> float:
         """The largest cost one step can carry (the sum of the bounded negative parts of the
@@ -334,8 +269,8 @@ class HeavyDutyEnv(HexapodEnv):
         stability = w["stability"] * self.tipping_threshold_deg / 45.0
         return forward + stability + w["effort"] * EFFORT_CAP
 
-    def _reward_terms(self, tipped: bool, cog_x: float) -> dict[str, float]:
-        """Named reward terms, each bounded; the progress term only in walking scenarios."""
+    def _reward_terms(self, tipped: bool) -> dict[str, float]:
+        """Named reward terms, each bounded; the forward term only in walking scenarios."""
         w = self.weights
         v_ref = self.gait.gait.body_speed
         margin = min(max(self._fasm_deg, -self.tipping_threshold_deg), 45.0)
@@ -343,7 +278,7 @@ class HeavyDutyEnv(HexapodEnv):
         if self.walks:
             # Progress up to the reference gait's speed: faster is not rewarded, so a policy
             # cannot trade stability for a scramble (PPO did, at 1 m/s with FASM ~ 0).
-            speed = (cog_x - self._prev_cog_x) / self.control_dt
+            speed = (float(self._cog[0]) - self._prev_cog_x) / self.control_dt
             terms["forward"] = w["forward"] * min(max(speed / v_ref, -1.0), 1.0)
         terms["stability"] = w["stability"] * margin / 45.0
         terms["alive"] = 0.0 if self._tipped else self.step_cost_bound()
@@ -352,36 +287,13 @@ class HeavyDutyEnv(HexapodEnv):
         terms["effort"] = -w["effort"] * min(ratio, EFFORT_CAP)
         return terms
 
-    def _info(self, terms: dict[str, float], unstable: bool) -> dict:
-        stance = tuple(leg for leg, on in zip(LEG_NAMES, self._loaded, strict=True) if on)
-        edge = None
-        if self._fasm_edge is not None:
-            edge = (LEG_NAMES[self._fasm_edge[0]], LEG_NAMES[self._fasm_edge[1]])
-        cog = self.sensors.cog()
-        info = {f"reward_{name}": value for name, value in terms.items()}
-        info.update(
-            fasm_margin_deg=self._fasm_deg,
-            fasm_edge=edge,
-            stance_legs=stance,
-            is_tipping=self._fasm_deg < self.tipping_threshold_deg,
-            is_tipped_over=self._tipped,
-            is_success=not self._tipped and not unstable and self._made_progress(cog),
-            actuator_power_w=self._power,
-            sim_unstable=unstable,
-            time=self.time,
-            cog=cog.copy(),
-            distance=float(cog[0] - self._start_cog[0]),
-            task=dict(self.task),
-        )
-        info.update(self._extra_info())
-        return info
+    def _extra_info(self, unstable: bool) -> dict:
+        return {"actuator_power_w": self._power}
 
-    def _extra_info(self) -> dict:
-        return {}
-
-    def _made_progress(self, cog: np.ndarray) -> bool:
+    def _is_success(self) -> bool:
         """Walking envs: at least `min_progress` of the reference gait's distance so far."""
         if not self.walks:
             return True
         walked = max(0.0, self.time - self.gait.gait.stand_time)
-        return cog[0] - self._start_cog[0] >= self.min_progress * self.gait.gait.body_speed * walked
+        progress = float(self._cog[0]) - self._start_cog_x
+        return progress >= self.min_progress * self.gait.gait.body_speed * walked

@@ -18,9 +18,10 @@ The block heights are drawn from the episode's ``np_random`` at every reset (one
 
 Task distributions (``task_distribution=``): "paper" (default) is the terrain above; "train" /
 "test" draw the slope, the block bed's highest block and block size, friction and servo
-stiffness at every reset from `TERRAIN_TRAIN` / `TERRAIN_TEST` (held out: slopes 8.5-11.5 deg,
-taller and smaller blocks, lower friction, stiffness farther from nominal). ``info["task"]``
-holds the values. ``sensor_noise`` adds Gaussian noise to the observed foot forces and IMU.
+stiffness at every reset from the ``train_ranges`` / ``test_ranges`` settings (defaults
+`TERRAIN_TRAIN` / `TERRAIN_TEST`) (held out: slopes 8.5-11.5 deg, taller and smaller blocks,
+lower friction, stiffness farther from nominal). ``info["task"]`` holds the values.
+``sensor_noise`` adds Gaussian noise to the observed foot forces and IMU.
 
 Servos and gait. The paper's joints are servos with a 1.89 N·m stall torque. Ours are
 proportional position servos with that torque limit, a stiffness ``servo_kp`` and viscous damping
@@ -44,7 +45,7 @@ non-adaptive "simple control".
 | joint_pos | 18 | encoder angles θ2 (TC), θ3 (CTr), θ4 (FTi) per leg (LF LM LR RF RM RR) [rad] |
 | joint_vel | 18 | [rad/s] |
 | foot_force | 18 | ground reaction on each foot, world frame [N] (3-D foot force sensors) |
-| foot_contact | 6 | 1 when the foot force exceeds ``contact_threshold`` [N] |
+| foot_contact | 6 | 1 when the foot force exceeds ``contact_threshold`` x weight (0.5 N) |
 | fasm_margin_deg | 1 | FASM from the measured foot forces [deg] (0 without a support polygon) |
 | imu_gyro | 3 | torso angular velocity, torso frame: roll rate, pitch rate, yaw rate [rad/s] |
 | imu_accel | 3 | accelerometer [m/s²] |
@@ -109,8 +110,12 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
-from ..checks import check_number
-from ..robots.athena.gait import AthenaPostureController, AthenaSensors
+from ..robots.athena.gait import (
+    GROUND_SEARCH,
+    START_FROM,
+    AthenaPostureController,
+    AthenaSensors,
+)
 from ..robots.athena.kinematics import standing_foot_positions
 from ..robots.athena.model import add_athena
 from ..robots.athena.params import ATHENA, LEG_NAMES
@@ -118,8 +123,9 @@ from ..stability import fasm_from_feet
 from ..stability.zmp import zmp_margin
 from ..terrain.flat import add_flat
 from ..terrain.irregular import PAPER_FRICTION, add_blocks, add_ramp
-from .base import HexapodEnv, JointActionMap, check_choice
+from .base import HexapodEnv, JointActionMap
 from .sensors import RobotSensors
+from .settings import EnvSettings, RewardScales, TaskRanges, choice, number, numbers, option
 
 TERRAINS = ("ramp", "blocks", "flat")
 ACTION_MODES = ("residual", "joint", "gains")
@@ -132,7 +138,7 @@ RAMP_TOP_LENGTH = 2.0
 
 
 @dataclasses.dataclass(frozen=True)
-class TerrainTaskRanges:
+class TerrainTaskRanges(TaskRanges):
     """Ranges of one task distribution (uniform draws; a tuple of ranges: one chosen at random).
 
     Held-out test ranges (`TERRAIN_TEST`): slopes interleaved with training (8.5-11.5 deg, which
@@ -164,7 +170,6 @@ TERRAIN_TEST = TerrainTaskRanges(
     friction=(0.5, 0.7),
     servo_kp_scale=((0.7, 0.85), (1.15, 1.3)),
 )
-TERRAIN_RANGES = {"train": TERRAIN_TRAIN, "test": TERRAIN_TEST}
 
 
 def _uniform_in(rng: np.random.Generator, ranges: tuple[tuple[float, float], ...]) -> float:
@@ -184,6 +189,76 @@ HEIGHT_CLIP_M = 0.1
 
 _CONTACT_CHECKS = 5
 """Torso-terrain contact is looked for this many times per control period (every 10 ms)."""
+
+CONTACT_FORCE_N = 0.5
+"""Ground reaction above which ATHENA's foot counts as loaded [N] (the default
+``contact_threshold`` is this share of the robot's 21 N weight, about 2.4 %)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class IrregularTerrainRewardScales(RewardScales):
+    """Weights of HexapodIrregularTerrain-v0's reward terms (see the module docstring)."""
+
+    forward_weight: float = number(10.0)
+    rate_weight: float = number(0.5)
+    height_weight: float = number(0.02)
+    collision_penalty: float = number(1.0)
+    tip_over_penalty: float = number(50.0)
+
+
+@dataclasses.dataclass(frozen=True)
+class IrregularTerrainSettings(EnvSettings):
+    """Settings of HexapodIrregularTerrain-v0 (ATHENA; see the module docstring)."""
+
+    reward_class = IrregularTerrainRewardScales
+    control_dt: float = number(0.05, strict=True)
+    physics_dt: float = number(0.002, strict=True)
+    contact_threshold: float = number(CONTACT_FORCE_N / (ATHENA.total_mass * 9.81), high=1.0)
+    """A foot is loaded above this fraction of the weight (default: 0.5 N)."""
+    tipping_threshold_deg: float = number(10.0, high=90.0)
+    tip_over_angle_deg: float = number(60.0, strict=True, high=90.0)
+    terrain: str = choice("ramp", TERRAINS)
+    action_mode: str = choice("residual", ACTION_MODES)
+    residual_scale: float = number(0.25)
+    reference_gains: tuple[float, float, float] = numbers((0.0, 0.0, 0.0), size=3, high=1.0)
+    """(k_z, k_α, k_β) of the reference gait's posture control (all 0: simple control)."""
+    stride: float = number(0.06, strict=True)
+    """Stride of the tripod gait [m]."""
+    swing_height: float | None = number(None, strict=True, optional=True)
+    """h of eqs. (20)-(21) [m] (None: per terrain, `DEFAULT_SWING_HEIGHT`)."""
+    phase_time: float = number(1.0, strict=True)
+    """t_g, duration of one gait phase [s]."""
+    gait_start_from: str = choice("measured_height", START_FROM)
+    gait_ground_search: str = choice("auto", GROUND_SEARCH)
+    servo_kp: float = number(8.0, strict=True)
+    """Servo stiffness [N·m/rad]."""
+    servo_damping: float = number(0.2, strict=True)
+    """Servo viscous damping [N·m·s/rad]."""
+    friction: float = number(PAPER_FRICTION)
+    ramp_slope_deg: float = number(10.0, high=45.0)
+    ramp_start_x: float = number(-0.4, low=None)
+    """x of the slope's foot [m]: <= -0.3 starts on the slope, >= 0.3 on the flat approach."""
+    ramp_length: float = number(4.5, strict=True)
+    block_height_range: tuple[float, float] = numbers((0.04, 0.13), size=2, ordered=True)
+    """Block heights are drawn uniformly from this range [m]."""
+    block_size: tuple[float, float] = numbers((0.1, 0.1), size=2)
+    """Block edge lengths (x, y) [m]."""
+    block_region: tuple[tuple[float, float], tuple[float, float]] = numbers(
+        ((-0.4, 3.0), (-0.5, 0.5)), size=2, low=None, ordered=True
+    )
+    """((x0, x1), (y0, y1)) covered by blocks [m]."""
+    block_layout_seed: int | None = number(None, integer=True, optional=True)
+    """Fixes one block bed for all episodes (None: a new bed from every episode's seed)."""
+    train_ranges: TerrainTaskRanges = option(TERRAIN_TRAIN, kind=TerrainTaskRanges)
+    test_ranges: TerrainTaskRanges = option(TERRAIN_TEST, kind=TerrainTaskRanges)
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.terrain == "ramp" and -0.3 < self.ramp_start_x < 0.3:
+            raise ValueError(
+                f"ramp_start_x={self.ramp_start_x} m puts the foot of the slope under the robot; "
+                "use <= -0.3 (start on the slope) or >= 0.3 (start on the flat approach)"
+            )
 
 
 class IrregularTerrainEnv(HexapodEnv):
@@ -227,166 +302,80 @@ class IrregularTerrainEnv(HexapodEnv):
     }
     """What the evaluation pipeline reduces over an episode (see agents/pipeline/episode.py)."""
 
-    def __init__(
-        self,
-        *,
-        terrain: str = "ramp",
-        action_mode: str = "residual",
-        residual_scale: float = 0.25,
-        reference_gains: tuple[float, float, float] = (0.0, 0.0, 0.0),
-        stride: float = 0.06,
-        swing_height: float | None = None,
-        phase_time: float = 1.0,
-        gait_start_from: str = "measured_height",
-        gait_ground_search: str = "auto",
-        control_dt: float = 0.05,
-        physics_dt: float = 0.002,
-        servo_kp: float = 8.0,
-        servo_damping: float = 0.2,
-        friction: float = PAPER_FRICTION,
-        ramp_slope_deg: float = 10.0,
-        ramp_start_x: float = -0.4,
-        ramp_length: float = 4.5,
-        block_height_range: tuple[float, float] = (0.04, 0.13),
-        block_size: tuple[float, float] = (0.1, 0.1),
-        block_region: tuple[tuple[float, float], tuple[float, float]] = (
-            (-0.4, 3.0),
-            (-0.5, 0.5),
-        ),
-        block_layout_seed: int | None = None,
-        contact_threshold: float = 0.5,
-        forward_weight: float = 10.0,
-        rate_weight: float = 0.5,
-        height_weight: float = 0.02,
-        collision_penalty: float = 1.0,
-        tip_over_penalty: float = 50.0,
-        tipping_threshold_deg: float = 10.0,
-        tip_over_angle_deg: float = 60.0,
-        reset_noise_scale: float = 0.01,
-        settle_time: float = 0.5,
-        render_mode: str | None = None,
-        width: int = 640,
-        height: int = 480,
-        camera_name: str | None = None,
-        task_distribution: str = "paper",
-        sensor_noise: float = 0.0,
-    ):
-        super().__init__(
-            control_dt=control_dt,
-            physics_dt=physics_dt,
-            render_mode=render_mode,
-            width=width,
-            height=height,
-            camera_name=camera_name,
-            task_distribution=task_distribution,
-            sensor_noise=sensor_noise,
-        )
-        check_choice("terrain", terrain, TERRAINS)
-        check_choice("action_mode", action_mode, ACTION_MODES)
+    Settings = IrregularTerrainSettings
+
+    def _setup(self) -> None:
+        s = self.settings
         if self.n_substeps % _CONTACT_CHECKS:
             raise ValueError(
                 f"control_dt / physics_dt = {self.n_substeps} substeps must be a multiple of "
                 f"{_CONTACT_CHECKS} (torso contact is checked {_CONTACT_CHECKS} times per step)"
             )
-        for label, value in (("servo_kp", servo_kp), ("servo_damping", servo_damping)):
-            check_number(label, value, strict=True)
-        if terrain == "ramp" and -0.3 < ramp_start_x < 0.3:
-            raise ValueError(
-                f"ramp_start_x={ramp_start_x} m puts the foot of the slope under the robot; use "
-                "<= -0.3 (start on the slope) or >= 0.3 (start on the flat approach)"
-            )
-        if block_layout_seed is not None and not isinstance(block_layout_seed, int):
-            raise ValueError(f"block_layout_seed must be an int or None, got {block_layout_seed!r}")
-        self.terrain = terrain
-        self.action_mode = action_mode
-        self.residual_scale = float(residual_scale)
-        self.robot = dataclasses.replace(ATHENA, servo_kp=servo_kp, servo_damping=servo_damping)
+        self.terrain = s.terrain
+        self.action_mode = s.action_mode
+        self.residual_scale = float(s.residual_scale)
+        self.robot = dataclasses.replace(ATHENA, servo_kp=s.servo_kp, servo_damping=s.servo_damping)
+        self.contact_force = s.contact_threshold * self.robot.total_mass * 9.81
+        """Ground reaction above which a foot counts as loaded [N]."""
         self.gait_config = {
-            "stride": float(stride),
+            "stride": float(s.stride),
             "swing_height": float(
-                DEFAULT_SWING_HEIGHT[terrain] if swing_height is None else swing_height
+                DEFAULT_SWING_HEIGHT[s.terrain] if s.swing_height is None else s.swing_height
             ),
-            "phase_time": float(phase_time),
-            "control_dt": float(control_dt),
-            "contact_threshold": float(contact_threshold),
-            "start_from": gait_start_from,
-            "ground_search": gait_ground_search,
+            "phase_time": float(s.phase_time),
+            "control_dt": float(s.control_dt),
+            "contact_threshold": float(self.contact_force),
+            "start_from": s.gait_start_from,
+            "ground_search": s.gait_ground_search,
         }
         """Keyword arguments of `AthenaPostureController` that match this env (policies use it)."""
-        self.reference_gains = tuple(float(g) for g in reference_gains)
+        self.reference_gains = tuple(float(g) for g in s.reference_gains)
         # Validates the gait numbers (and the gains) with clear errors before anything is built.
         self.controller = AthenaPostureController(
             self.robot, **self.gait_config, **_gain_kwargs(self.reference_gains)
         )
         self.ticks_per_cycle = self.controller.ticks_per_cycle
-        self.friction = float(friction)
+        self.friction = float(s.friction)
         self.ramp = {
-            "slope_deg": float(ramp_slope_deg),
-            "start_x": float(ramp_start_x),
-            "length": float(ramp_length),
+            "slope_deg": float(s.ramp_slope_deg),
+            "start_x": float(s.ramp_start_x),
+            "length": float(s.ramp_length),
         }
         self.blocks = {
-            "height_range": tuple(block_height_range),
-            "block_size": tuple(block_size),
-            "region": tuple(tuple(r) for r in block_region),
+            "height_range": tuple(s.block_height_range),
+            "block_size": tuple(s.block_size),
+            "region": tuple(tuple(r) for r in s.block_region),
         }
-        self.block_layout_seed = block_layout_seed
-        self.contact_threshold = float(contact_threshold)
+        self.block_layout_seed = s.block_layout_seed
+        self.task_ranges = {"train": s.train_ranges, "test": s.test_ranges}
+        r = s.reward
         self.weights = {
-            "forward": forward_weight,
-            "steadiness_rate": rate_weight,
-            "steadiness_height": height_weight,
-            "torso_collision": collision_penalty,
-            "tip_over": tip_over_penalty,
+            "forward": r.forward_weight,
+            "steadiness_rate": r.rate_weight,
+            "steadiness_height": r.height_weight,
+            "torso_collision": r.collision_penalty,
+            "tip_over": r.tip_over_penalty,
         }
-        self.tipping_threshold_deg = float(tipping_threshold_deg)
         self.stability_criterion = f"FASM >= {self.tipping_threshold_deg:g} deg"
-        self.tip_over_cos = float(np.cos(np.radians(tip_over_angle_deg)))
-        self.reset_noise_scale = float(reset_noise_scale)
-        self.settle_time = float(settle_time)
         self.reference_height = self.robot.standing_torso_height
-
         self.action_map = JointActionMap(np.tile(self.robot.joint_ranges, (6, 1)))
         self._residual_gain = self.residual_scale * self.action_map.half
-        if action_mode == "gains":
+        if s.action_mode == "gains":
             self.action_space = spaces.Box(0.0, 1.0, shape=(3,), dtype=np.float32)
         else:
             self.action_space = spaces.Box(-1.0, 1.0, shape=(18,), dtype=np.float32)
-        self._contact_force_sq = self.contact_threshold**2
-        self._paper = {
-            "slope_deg": self.ramp["slope_deg"],
-            "block_height_max": float(self.blocks["height_range"][1]),
-            "block_size": float(self.blocks["block_size"][0]),
-            "friction": self.friction,
-            "servo_kp": float(servo_kp),
-        }
+        self._contact_force_sq = self.contact_force**2
         self._built_task = self.paper_task()
-        self._build(np.random.default_rng(block_layout_seed or 0))
-        self._set_observation_layout(
-            {
-                "joint_pos": 18,
-                "joint_vel": 18,
-                "foot_force": 18,
-                "foot_contact": 6,
-                "fasm_margin_deg": 1,
-                "imu_gyro": 3,
-                "imu_accel": 3,
-                "imu_quat": 4,
-                "torso_height": 1,
-                "gait_phase": 3,
-                **({"posture_gains": 3} if action_mode == "gains" else {}),
-            }
-        )
+        self._terrain_rng = np.random.default_rng(s.block_layout_seed or 0)
+        self._build_model()
 
     # --- model ---------------------------------------------------------------------------
-    def _build(self, terrain_rng: np.random.Generator) -> None:
-        """Build and compile terrain + robot (blocks drawn from `terrain_rng`)."""
-        spec = mujoco.MjSpec()
-        spec.compiler.degree = False  # MjSpec defaults to degrees; our builders give radians
-        spec.modelname = "HexapodIrregularTerrain"
-        pos, quat = self._add_terrain(spec, terrain_rng)
+    def _build_spec(self, spec: mujoco.MjSpec) -> None:
+        """Terrain (blocks drawn from `_terrain_rng`) and the robot at its start pose."""
+        pos, quat = self._add_terrain(spec, self._terrain_rng)
         self.handles = add_athena(spec, pos=pos, quat=quat, params=self.robot)
-        self._compile(spec)
+
+    def _bind_model(self) -> None:
         m = self.model
         actuators = tuple(a for leg in self.handles.actuators for a in leg)
         self.sensors = RobotSensors(m, self.data, LEG_NAMES, actuators)
@@ -439,109 +428,85 @@ class IrregularTerrainEnv(HexapodEnv):
     # --- reset / step --------------------------------------------------------------------
     def _reference_description(self) -> dict:
         """The reference gait: `AthenaPostureController` settings, gains, ticks per cycle,
-        residual scale and the ramp geometry."""
+        residual scale, the terrain kind and the ramp geometry."""
         return {
             "gait_config": dict(self.gait_config),
             "reference_gains": self.reference_gains,
             "ticks_per_cycle": self.ticks_per_cycle,
             "residual_scale": self.residual_scale,
+            "terrain": self.terrain,
             "ramp": dict(self.ramp),
         }
 
     # --- task distribution -----------------------------------------------------------------
     def paper_task(self) -> dict:
+        s = self.settings
         return {
             "terrain": self.terrain,
-            "slope_deg": self._paper["slope_deg"],
-            "block_height_max": self._paper["block_height_max"],
-            "block_size": self._paper["block_size"],
-            "friction": self._paper["friction"],
-            "servo_kp": self._paper["servo_kp"],
+            "slope_deg": float(s.ramp_slope_deg),
+            "block_height_max": float(s.block_height_range[1]),
+            "block_size": float(s.block_size[0]),
+            "friction": float(s.friction),
+            "servo_kp": float(s.servo_kp),
         }
 
     def sample_task(self, rng: np.random.Generator, distribution: str) -> dict:
-        r = TERRAIN_RANGES[distribution]
+        r = self.task_ranges[distribution]
         return {
             "terrain": self.terrain,
             "slope_deg": _uniform_in(rng, r.slope_deg),
             "block_height_max": float(rng.uniform(*r.block_height_max)),
             "block_size": float(rng.uniform(*r.block_size)),
             "friction": float(rng.uniform(*r.friction)),
-            "servo_kp": self._paper["servo_kp"] * _uniform_in(rng, r.servo_kp_scale),
+            "servo_kp": float(self.settings.servo_kp) * _uniform_in(rng, r.servo_kp_scale),
         }
 
-    def _apply_task(self, task: dict) -> bool:
-        """Set the terrain and servo parameters of `task`; True if the model must be rebuilt."""
-        if task == self._built_task:
-            return False
-        self._built_task = dict(task)
-        self.ramp["slope_deg"] = task["slope_deg"]
-        low = self.blocks["height_range"][0]
-        self.blocks["height_range"] = (low, max(low, task["block_height_max"]))
-        self.blocks["block_size"] = (task["block_size"], task["block_size"])
-        self.friction = task["friction"]
-        self.robot = dataclasses.replace(self.robot, servo_kp=task["servo_kp"])
-        return True
-
-    def reset(self, *, seed: int | None = None, options: dict | None = None):
-        super().reset(seed=seed, options=options)
-        rebuild = self._apply_task(self.task)
+    def _apply_task(self, task: dict) -> None:
+        """Set the terrain and servo parameters of `task` and rebuild the model if they changed;
+        the block bed is drawn anew from the episode's `np_random` at every reset, unless
+        `block_layout_seed` fixes it."""
+        changed = task != self._built_task
+        if changed:
+            self._built_task = dict(task)
+            self.ramp["slope_deg"] = task["slope_deg"]
+            low = self.blocks["height_range"][0]
+            self.blocks["height_range"] = (low, max(low, task["block_height_max"]))
+            self.blocks["block_size"] = (task["block_size"], task["block_size"])
+            self.friction = task["friction"]
+            self.robot = dataclasses.replace(self.robot, servo_kp=task["servo_kp"])
         if self.terrain == "blocks" and self.block_layout_seed is None:
-            self._build(self.np_random)  # a new test bed per episode, from the episode's seed
-        elif rebuild:
-            self._build(np.random.default_rng(self.block_layout_seed or 0))
-        mujoco.mj_resetData(self.model, self.data)
+            self._terrain_rng = self.np_random  # a new test bed per episode, from its seed
+            self._build_model()
+        elif changed:
+            self._terrain_rng = np.random.default_rng(self.block_layout_seed or 0)
+            self._build_model()
+
+    def _set_initial_state(self) -> None:
         standing = np.tile(self.robot.standing_posture, 6)
         noise = self.reset_noise_scale * self.action_map.half
         joints = standing + self.np_random.uniform(-noise, noise)
         low, high = self.action_map.low, self.action_map.high
         self.data.qpos[self._joint_qpos] = np.clip(joints, low, high)
         self.data.ctrl[self._act_ids] = standing
-        mujoco.mj_forward(self.model, self.data)
-        for _ in range(round(self.settle_time / self.control_dt)):  # not part of the episode
-            self._physics()
+
+    def _start_episode(self) -> None:
         self.controller.reset()
         self.controller.set_gains(*self.reference_gains)
-        self._step_count = 0
-        self._tipped = False
         self._collisions = 0
-        self._touched = False
-        self._start_cog = self.sensors.cog().copy()
-        self._prev_cog_x = float(self._start_cog[0])
+        self._touched_in_physics = False
         self._cycle_id = 0
+        self._finished_cycle: dict | None = None
         self._window: list[tuple] = []
-        self._window_x0 = float(self._start_cog[0])
+        self._window_x0 = float(self.sensors.cog()[0])
         self._episode_metrics = {
             "cycle_height_rms": [],
             "cycle_pitch_rate_rms": [],
             "cycle_roll_rate_rms": [],
             "cycle_zmp_margin": [],
         }
-        self._read_sensors()
-        self._last_obs = self._observation()
-        return self._last_obs, self._info({}, unstable=False, cycle_stats=None)
 
-    def step(self, action):
-        action = self._validate_action(action, self.action_space)
-        ctrl = self._ctrl_from_action(action)
-        self.data.ctrl[self._act_ids] = ctrl
-        stable, touched = self._physics()
-        self._step_count += 1
-        if not stable:
-            return self._last_obs.copy(), 0.0, False, True, self._info({}, True, None)
-        self._touched = touched
-        self._collisions += touched
-        self._read_sensors()
-        # The penalty is paid once; stepping on after termination keeps `terminated` True.
-        tipped = bool(self.data.xmat[self.sensors.torso_id, 8] < self.tip_over_cos)
-        tipped = tipped and not self._tipped
-        self._tipped = self._tipped or tipped
-        terms = self._reward_terms(touched, tipped)
-        cycle_stats = self._update_cycle_window(touched)
-        self._prev_cog_x = float(self._cog[0])
-        self._last_obs = self._observation()
-        reward = float(sum(terms.values()))
-        return self._last_obs, reward, self._tipped, False, self._info(terms, False, cycle_stats)
+    def _apply_action(self, action: np.ndarray) -> None:
+        self.data.ctrl[self._act_ids] = self._ctrl_from_action(action)
 
     def _ctrl_from_action(self, action: np.ndarray) -> np.ndarray:
         if self.action_mode == "joint":
@@ -560,21 +525,20 @@ class IrregularTerrainEnv(HexapodEnv):
             torso_height=self._height,
         )
 
-    def _physics(self) -> tuple[bool, bool]:
-        """One control period of physics: (stable, torso touched the terrain)."""
+    def _run_physics(self) -> None:
+        """One control period of physics, looking for torso-terrain contact every 10 ms."""
         m, d = self.model, self.data
-        t_expected = d.time + self.control_dt
         chunk = self.n_substeps // _CONTACT_CHECKS
         touched = False
         for _ in range(_CONTACT_CHECKS):
             mujoco.mj_step(m, d, nstep=chunk)
             touched = touched or d.sensordata[self._torso_contact_adr] > 0.0
-        if abs(d.time - t_expected) > 1e-6:
-            return False, bool(touched)
-        return not d.warning.number[self._UNSTABLE_WARNINGS].any(), bool(touched)
+        self._touched_in_physics = bool(touched)
 
     # --- measurements --------------------------------------------------------------------
-    def _read_sensors(self) -> None:
+    def _measure(self) -> None:
+        self._touched = self._touched_in_physics
+        self._collisions += self._touched
         s = self.sensors
         self._joints = s.joint_positions()  # fancy indexing: already a copy
         self._forces = s.foot_forces()
@@ -625,8 +589,9 @@ class IrregularTerrainEnv(HexapodEnv):
         angle = 2 * math.pi * phase
         return math.sin(angle), math.cos(angle), float(start)
 
-    def _update_cycle_window(self, touched: bool) -> dict | None:
-        """Add this step to its cycle's window; on a new cycle return the finished one's stats."""
+    def _end_step(self) -> None:
+        """Add this step to its cycle's window; on a new cycle keep the finished one's stats
+        (``info["cycle_stats"]``)."""
         cid = self._gait_cycle_index()
         stats = None
         if cid != self._cycle_id and self._window:
@@ -645,12 +610,12 @@ class IrregularTerrainEnv(HexapodEnv):
                 float(self._gyro[1]),
                 float(self._gyro[0]),
                 self._zmp_margin,
-                touched,
+                self._touched,
                 float(self._cog[0]),
                 self.controller.gains if self.action_mode != "joint" else None,
             )
         )
-        return stats
+        self._finished_cycle = stats
 
     def _cycle_stats(self, index: int, window: list[tuple]) -> dict:
         h, pitch, roll, margin, touched, x, gains = zip(*window, strict=True)
@@ -671,21 +636,22 @@ class IrregularTerrainEnv(HexapodEnv):
         }
 
     # --- observation, reward, info --------------------------------------------------------
-    def _observation_pieces(self) -> dict[str, np.ndarray]:
+    def _observation_pieces(self) -> dict:
+        # Readers look the sensors up at call time: a task may rebuild the model (and sensors).
         pieces = {
-            "joint_pos": self._joints,
-            "joint_vel": self.sensors.joint_velocities(),
-            "foot_force": self._forces.reshape(-1),
-            "foot_contact": self._loaded,
-            "fasm_margin_deg": self._fasm_deg,
-            "imu_gyro": self._gyro,
-            "imu_accel": self.sensors.accelerometer(),
-            "imu_quat": self.sensors.orientation(),
-            "torso_height": self._height,
-            "gait_phase": self._gait_phase(),
+            "joint_pos": (18, lambda: self._joints),
+            "joint_vel": (18, lambda: self.sensors.joint_velocities()),
+            "foot_force": (18, lambda: self._forces.reshape(-1)),
+            "foot_contact": (6, lambda: self._loaded),
+            "fasm_margin_deg": (1, lambda: self._fasm_deg),
+            "imu_gyro": (3, lambda: self._gyro),
+            "imu_accel": (3, lambda: self.sensors.accelerometer()),
+            "imu_quat": (4, lambda: self.sensors.orientation()),
+            "torso_height": (1, lambda: self._height),
+            "gait_phase": (3, self._gait_phase),
         }
         if self.action_mode == "gains":
-            pieces["posture_gains"] = self.controller.gains
+            pieces["posture_gains"] = (3, lambda: self.controller.gains)
         return pieces
 
     def step_cost_bound(self) -> float:
@@ -700,7 +666,7 @@ class IrregularTerrainEnv(HexapodEnv):
             + w["torso_collision"]
         )
 
-    def _reward_terms(self, touched: bool, tipped: bool) -> dict[str, float]:
+    def _reward_terms(self, tipped: bool) -> dict[str, float]:
         w = self.weights
         speed = (self._cog[0] - self._prev_cog_x) / self.control_dt
         rates = float(self._gyro[0] ** 2 + self._gyro[1] ** 2)
@@ -709,55 +675,40 @@ class IrregularTerrainEnv(HexapodEnv):
             "forward": w["forward"] * min(max(speed, -SPEED_CLIP_M_S), SPEED_CLIP_M_S),
             "steadiness_rate": -w["steadiness_rate"] * min(rates, RATE_CAP),
             "steadiness_height": -w["steadiness_height"] * dz * dz,
-            "torso_collision": -w["torso_collision"] if touched else 0.0,
+            "torso_collision": -w["torso_collision"] if self._touched else 0.0,
             "alive": 0.0 if self._tipped else self.step_cost_bound(),
             "tip_over": -w["tip_over"] if tipped else 0.0,
         }
 
-    def _made_progress(self) -> bool:
-        """At least `MIN_PROGRESS` of the distance the gait's nominal speed (stride per phase)
-        covers in the elapsed time: standing still or walking backwards is not a success."""
+    def _is_success(self) -> bool:
+        """No torso contact so far, and at least `MIN_PROGRESS` of the distance the gait's
+        nominal speed (stride per phase) covers in the elapsed time: standing still or walking
+        backwards is not a success."""
+        if self._collisions:
+            return False
         speed = self.gait_config["stride"] / self.gait_config["phase_time"]
-        walked = float(self._cog[0] - self._start_cog[0])
+        walked = float(self._cog[0] - self._start_cog_x)
         return walked >= MIN_PROGRESS * speed * self._step_count * self.control_dt
 
-    def _info(self, terms: dict[str, float], unstable: bool, cycle_stats: dict | None) -> dict:
-        stance = tuple(leg for leg, on in zip(LEG_NAMES, self._loaded, strict=True) if on)
-        edge = None
-        if self._fasm_edge is not None:
-            edge = (LEG_NAMES[self._fasm_edge[0]], LEG_NAMES[self._fasm_edge[1]])
-        info = {f"reward_{name}": value for name, value in terms.items()}
-        info.update(
-            fasm_margin_deg=self._fasm_deg,
-            fasm_edge=edge,
-            stance_legs=stance,
-            is_tipping=self._fasm_deg < self.tipping_threshold_deg,
-            is_tipped_over=self._tipped,
-            is_success=not self._tipped
-            and not unstable
-            and self._collisions == 0
-            and self._made_progress(),
-            sim_unstable=unstable,
-            actuator_power_w=float(
+    def _extra_info(self, unstable: bool) -> dict:
+        stats = None if unstable else self._finished_cycle
+        info = {
+            "actuator_power_w": float(
                 np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
             ),
-            time=self._step_count * self.control_dt,
-            cog=self._cog,  # a fresh copy every step
-            distance=float(self._cog[0] - self._start_cog[0]),
-            zmp=self._zmp.copy(),
-            zmp_margin=self._zmp_margin,
-            torso_contact=self._touched,
-            torso_collisions=self._collisions,
-            torso_height=self._height,
-            torso_clearance=self.torso_clearance(),
-            pitch_rate=float(self._gyro[1]),
-            roll_rate=float(self._gyro[0]),
-            posture_gains=self.controller.gains if self.action_mode != "joint" else None,
-            gait_cycle=self._gait_cycle_index(),
-            cycle_stats=cycle_stats,
-            task=dict(self.task),
-        )
-        if cycle_stats is not None or self._step_count == 0:
+            "zmp": self._zmp.copy(),
+            "zmp_margin": self._zmp_margin,
+            "torso_contact": self._touched,
+            "torso_collisions": self._collisions,
+            "torso_height": self._height,
+            "torso_clearance": self.torso_clearance(),
+            "pitch_rate": float(self._gyro[1]),
+            "roll_rate": float(self._gyro[0]),
+            "posture_gains": self.controller.gains if self.action_mode != "joint" else None,
+            "gait_cycle": self._gait_cycle_index(),
+            "cycle_stats": stats,
+        }
+        if stats is not None or self._step_count == 0:
             # A fresh copy whenever the lists change (and at reset): infos must not share data.
             info["episode_metrics"] = {k: list(v) for k, v in self._episode_metrics.items()}
         return info

@@ -3,7 +3,7 @@
 Zhang et al. 2024 §5.2.
 
 The robot stands on one tripod with the other tripod lifted in swing posture. After
-`settle_time` the platform tilts at `tilt_rate_deg` [deg/s] up to `max_tilt_deg` and holds
+`tilt_start_time` (3 s) the platform tilts at `tilt_rate_deg` [deg/s] up to `max_tilt_deg` and holds
 there. Held on its tripod the robot tips over; a controller that lands a swing leg in time keeps
 it up. Scenarios are defined by what the robot feels:
 
@@ -20,10 +20,11 @@ The hold posture is a little taller and narrower than the walking stance (feet a
 1.95 m below the hips) so that the side case tips within the platform's reach (the 6-UPS
 platform tilts at most ~44-46 deg; the walking stance would need 48.5 deg).
 
-Task distributions (``task_distribution=``): "paper" (default) runs `scenario`; "train" /
-"test" draw the held tripod, the tilt axis (one of the six paper cases or an arbitrary axis),
-the tilt rate, the platform friction and a payload at every reset from `TILT_TRAIN` /
-`TILT_TEST` (held out: rates 4-8 and 12-20 deg/s). ``info["task"]`` holds the values.
+Task distributions (``task_distribution=``): "paper" (default) runs `scenario`; "train" / "test"
+draw the held tripod, the tilt axis (one of the six paper cases or an arbitrary axis), the tilt
+rate, the platform friction and a payload at every reset from the ``train_ranges`` /
+``test_ranges`` settings (defaults `TILT_TRAIN` / `TILT_TEST` (held out: rates 4-8 and 12-20
+deg/s). ``info["task"]`` holds the values.
 
 Observation: as HexapodCliffWalk-v0 without the gait phase (joint_pos, joint_vel, foot_force,
 foot_contact, fasm_margin_deg, imu_gyro, imu_accel, imu_quat). Action: 18 values in [-1, 1];
@@ -44,8 +45,8 @@ import numpy as np
 from ..robots.heavy_duty import LEG_NAMES, TRIPODS, joints_for_foot
 from ..terrain.stewart import add_stewart_platform
 from ..terrain.stewart_kinematics import DEFAULT_PLATFORM
-from .base import check_choice
-from .heavy_duty import HeavyDutyEnv
+from .heavy_duty import HeavyDutyEnv, HeavyDutySettings
+from .settings import TaskRanges, choice, number, option
 
 SCENARIOS = ("climb", "descend", "side", "random")
 STANCES = {"LF-LR-RM": TRIPODS[0], "LM-RF-RR": TRIPODS[1]}
@@ -66,7 +67,7 @@ CASES = tuple((scenario, stance) for scenario in ("climb", "descend", "side") fo
 
 
 @dataclasses.dataclass(frozen=True)
-class TiltTaskRanges:
+class TiltTaskRanges(TaskRanges):
     """Ranges of one task distribution. Each reset holds a random tripod and tilts either about
     one of the six paper cases' axes (probability `case_probability`) or about an arbitrary
     horizontal axis, at a rate drawn uniformly from one of `rates_deg_s` (chosen at random).
@@ -84,7 +85,6 @@ class TiltTaskRanges:
 
 TILT_TRAIN = TiltTaskRanges(rates_deg_s=((1.0, 4.0), (8.0, 12.0)), friction=(1.2, 1.8))
 TILT_TEST = TiltTaskRanges(rates_deg_s=((4.0, 8.0), (12.0, 20.0)), friction=(0.9, 1.2))
-TILT_RANGES = {"train": TILT_TRAIN, "test": TILT_TEST}
 
 
 def tilt_axis(scenario: str, stance: tuple[str, ...]) -> np.ndarray:
@@ -99,58 +99,59 @@ def tilt_axis(scenario: str, stance: tuple[str, ...]) -> np.ndarray:
     raise ValueError(f"scenario must be one of {SCENARIOS}, got {scenario!r}")
 
 
+@dataclasses.dataclass(frozen=True)
+class StewartTiltSettings(HeavyDutySettings):
+    """Settings of HexapodStewartTilt-v0: the "paper" scenario's tilt, and the ranges."""
+
+    scenario: str = choice("random", SCENARIOS)
+    stance: str = choice("LF-LR-RM", tuple(STANCES))
+    """The tripod the robot stands on (the other is lifted)."""
+    tilt_rate_deg: float = number(2.0, strict=True)
+    """Platform tilt rate [deg/s]."""
+    max_tilt_deg: float | None = number(None, strict=True, high=90.0, optional=True)
+    """Tilt at which the platform stops [deg] (None: the scenario's default)."""
+    tilt_start_time: float = number(3.0)
+    """Episode time at which the platform starts tilting [s]."""
+    platform_friction: float = number(1.5)
+    residual_scale: float = number(2.0)
+    """Residual action 1 = this fraction of each joint's half range (2: any target)."""
+    tip_over_angle_deg: float = number(10.0, strict=True, high=90.0)
+    """Tip-over: the body leans more than this relative to the platform [deg]."""
+    train_ranges: TiltTaskRanges = option(TILT_TRAIN, kind=TiltTaskRanges)
+    test_ranges: TiltTaskRanges = option(TILT_TEST, kind=TiltTaskRanges)
+
+
 class StewartTiltEnv(HeavyDutyEnv):
     """See the module docstring."""
 
+    Settings = StewartTiltSettings
     walks = False
 
-    def __init__(
-        self,
-        *,
-        scenario: str = "random",
-        stance: str = "LF-LR-RM",
-        tilt_rate_deg: float = 2.0,
-        max_tilt_deg: float | None = None,
-        settle_time: float = 3.0,
-        platform_friction: float = 1.5,
-        action_mode: str = "residual",
-        residual_scale: float = 2.0,
-        stability_weight: float = 1.0,
-        tip_over_penalty: float = 100.0,
-        tip_over_angle_deg: float = 10.0,
-        **kwargs,
-    ):
-        check_choice("scenario", scenario, SCENARIOS)
-        check_choice("stance", stance, STANCES)
-        if tilt_rate_deg <= 0:
-            raise ValueError(f"tilt_rate_deg must be > 0, got {tilt_rate_deg}")
-        self.scenario, self.stance_name = scenario, stance
-        self.tilt_rate = np.radians(tilt_rate_deg)
-        self.settle = settle_time
-        self.platform_friction = platform_friction
-        self._paper_friction = platform_friction
-        self._max_tilt_arg = max_tilt_deg
+    def _setup(self) -> None:
+        s = self.settings
+        self.scenario, self.stance_name = s.scenario, s.stance
+        self.tilt_rate = np.radians(s.tilt_rate_deg)
+        self.tilt_start_time = s.tilt_start_time
+        self.platform_friction = s.platform_friction
+        self._max_tilt_arg = s.max_tilt_deg
         self.platform = DEFAULT_PLATFORM
-        super().__init__(
-            action_mode=action_mode,
-            residual_scale=residual_scale,
-            stability_weight=stability_weight,
-            tip_over_penalty=tip_over_penalty,
-            tip_over_angle_deg=tip_over_angle_deg,
-            **kwargs,
-        )
-        self._platform_act = np.array(
-            [self.model.actuator(j).id for j in self.platform_handles.joints]
-        )
-        self._platform_qpos = np.array(
-            [self.model.jnt_qposadr[self.model.joint(j).id] for j in self.platform_handles.joints]
-        )
-        self._platform_body = self.model.body("platform").id
+        self.task_ranges = {"train": s.train_ranges, "test": s.test_ranges}
+        super()._setup()
+        self._hold = self._hold_posture(STANCES[self.stance_name])  # set per episode at reset
         # Validate the fixed scenarios' whole motion up front: a pose the actuators cannot reach
         # is refused here, not discovered mid-episode.
-        if scenario != "random":
-            self._configure(scenario, STANCES[stance], self.tilt_rate)
+        if self.scenario != "random":
+            self._configure(self.scenario, STANCES[self.stance_name], self.tilt_rate)
             self._check_reachable()
+
+    def _bind_model(self) -> None:
+        super()._bind_model()
+        m = self.model
+        self._platform_act = np.array([m.actuator(j).id for j in self.platform_handles.joints])
+        self._platform_qpos = np.array(
+            [m.jnt_qposadr[m.joint(j).id] for j in self.platform_handles.joints]
+        )
+        self._platform_body = m.body("platform").id
 
     # --- scenario ------------------------------------------------------------------------
     def _configure(self, scenario: str, stance: tuple[str, ...], rate: float, axis=None) -> None:
@@ -189,7 +190,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         """Platform tilt [rad] at time t: level while settling, then the scenario rate reached
         and left with a constant (de)celeration over RAMP_TIME so the plate never jerks."""
         ramp = RAMP_TIME
-        tau = t - self.settle
+        tau = t - self.tilt_start_time
         if tau <= 0.0:
             return 0.0
         total = self.max_tilt / self.rate + ramp  # time to reach max_tilt with both ramps
@@ -214,6 +215,11 @@ class StewartTiltEnv(HeavyDutyEnv):
     def reference_joints(self) -> np.ndarray:
         return self._hold
 
+    def _reference_description(self) -> dict:
+        """As the heavy-duty envs', plus ``hold_posture``: the episode's (18,) joint targets of
+        the hold posture, the zero residual action (the held tripod depends on the task)."""
+        return {**super()._reference_description(), "hold_posture": self._hold.copy()}
+
     def _initial_joints(self) -> np.ndarray:
         return self._hold
 
@@ -228,12 +234,12 @@ class StewartTiltEnv(HeavyDutyEnv):
             "stance": self.stance_name,
             **axis,
             "tilt_rate_deg": float(np.degrees(self.tilt_rate)),
-            "platform_friction": float(self._paper_friction),
+            "platform_friction": float(self.settings.platform_friction),
             **self.NO_PAYLOAD,
         }
 
     def sample_task(self, rng: np.random.Generator, distribution: str) -> dict:
-        r = TILT_RANGES[distribution]
+        r = self.task_ranges[distribution]
         if rng.uniform() < r.case_probability:
             scenario, stance = CASES[int(rng.integers(len(CASES)))]
             axis = tilt_axis(scenario, STANCES[stance])
@@ -264,7 +270,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         self._configure(scenario, STANCES[task["stance"]], np.radians(task["tilt_rate_deg"]), axis)
         self.max_tilt = min(self.max_tilt, 0.95 * self.platform.max_tilt(axis))
 
-    def _on_reset(self) -> None:
+    def _set_initial_state(self) -> None:
         if self.task_distribution != "paper":
             self._configure_sampled(self.task)
         elif self.scenario == "random":
@@ -288,6 +294,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         self._first_tipping_time = None
         self._adjustment_leg = None
         self._recovery_time = None
+        super()._set_initial_state()
 
     def _before_physics(self) -> None:
         """Command the tilt rate that carries the platform to tilt_at(t + dt) within the period."""
@@ -305,8 +312,8 @@ class StewartTiltEnv(HeavyDutyEnv):
         body_up = self.data.xmat[self.sensors.torso_id].reshape(3, 3)[:, 2]
         return bool(body_up @ self._platform_up() < self.tip_over_cos)
 
-    def _update_stability(self) -> None:
-        super()._update_stability()
+    def _measure(self) -> None:
+        super()._measure()
         if self._step_count == 0:
             return
         if self._first_tipping_time is None and self._fasm_deg < self.tipping_threshold_deg:
@@ -318,11 +325,12 @@ class StewartTiltEnv(HeavyDutyEnv):
                     self._recovery_time = self.time - self._first_tipping_time
                     break
 
-    def _extra_info(self) -> dict:
+    def _extra_info(self, unstable: bool) -> dict:
         rpy = np.array(
             [self.data.qpos[self._platform_qpos[1]], self.data.qpos[self._platform_qpos[0]], 0.0]
         )
         return {
+            **super()._extra_info(unstable),
             "scenario": self.scenario,
             "stance": self.stance,
             "platform_tilt_deg": float(np.degrees(np.arccos(min(1.0, self._platform_up()[2])))),

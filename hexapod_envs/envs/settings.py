@@ -1,0 +1,291 @@
+"""Typed env settings: one frozen dataclass per env, built from ``gym.make(id, **kwargs)``.
+
+Every env declares its settings as a frozen dataclass derived from `EnvSettings` (timing, settle
+time, contact threshold, tipping threshold ξ, tip-over angle, reset noise, task distribution,
+sensor noise, rendering), with a nested frozen `RewardScales` dataclass (`reward`). Each field is
+made by one of `number`, `numbers`, `choice` or `option`, which attach the check run at
+construction: a bad value raises a ValueError that names the setting and its valid range, so
+nothing bad reaches the physics (a NaN gain, an infinite drop, a negative friction).
+
+Keyword arguments build the dataclass (`EnvSettings.from_kwargs`): a reward scale may be given
+flat (``gym.make(id, forward_weight=2.0)``) or nested (``reward={"forward_weight": 2.0}``);
+unknown keys are a TypeError that lists the valid ones. ``env.unwrapped.settings`` holds the
+result, and ``gym.make(id, **vars(env.unwrapped.settings))`` rebuilds the same env.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import numbers as _numbers
+from collections.abc import Callable, Mapping
+from typing import Any, ClassVar
+
+TASK_DISTRIBUTIONS = ("paper", "train", "test")
+"""``task_distribution`` values: the paper's scenario (plus small reset noise), or task and
+physical parameters sampled at every reset from the env's training or held-out test ranges."""
+
+RENDER_MODES = ("human", "rgb_array", "depth_array")
+
+RENAMED = {
+    "progress_weight": "forward_weight",
+}
+"""Settings that were renamed (old -> new), so that an old name gets a pointed message."""
+
+
+def check_choice(name: str, value: Any, choices) -> None:
+    """Raise a ValueError naming `name`, the bad value and the valid choices."""
+    if value not in choices:
+        raise ValueError(f"{name} must be one of {sorted(choices)}, got {value!r}")
+
+
+def _check_real(name: str, value: Any, shown: Any) -> float:
+    if isinstance(value, bool) or not isinstance(value, _numbers.Real):
+        raise ValueError(f"{name} must be a real number, got {shown!r} ({type(value).__name__})")
+    x = float(value)
+    if not math.isfinite(x):
+        raise ValueError(f"{name} must be finite, got {shown!r}")
+    return x
+
+
+def _range_text(low, high, strict) -> str:
+    parts = []
+    if low is not None:
+        parts.append(f"{'>' if strict else '>='} {low:g}")
+    if high is not None:
+        parts.append(f"<= {high:g}")
+    return " and ".join(parts)
+
+
+def number(
+    default: Any,
+    *,
+    low: float | None = 0.0,
+    high: float | None = None,
+    strict: bool = False,
+    integer: bool = False,
+    optional: bool = False,
+) -> Any:
+    """A numeric setting: a real number (not a string, bool or complex), finite, >= `low`
+    (> with `strict`; ``low=None``: any sign) and <= `high`; `integer`: an int; `optional`:
+    None is allowed."""
+
+    def check(name: str, value: Any) -> None:
+        if value is None and optional:
+            return
+        if integer and (isinstance(value, bool) or not isinstance(value, _numbers.Integral)):
+            raise ValueError(f"{name} must be an integer, got {value!r} ({type(value).__name__})")
+        x = _check_real(name, value, value)
+        too_low = low is not None and (x <= low if strict else x < low)
+        if too_low or (high is not None and x > high):
+            raise ValueError(f"{name} must be {_range_text(low, high, strict)}, got {value!r}")
+
+    return dataclasses.field(default=default, metadata=_numeric(check, low))
+
+
+def _numeric(check: Callable, low: float | None) -> dict:
+    return {"check": check, "numeric": True, "signed": low is None}
+
+
+def numbers(
+    default: Any,
+    *,
+    size: int | None = None,
+    low: float | None = 0.0,
+    high: float | None = None,
+    ordered: bool = False,
+    optional: bool = False,
+) -> Any:
+    """A tuple of numbers (or of (low, high) pairs): each real, finite and in [`low`, `high`]
+    (``low=None``: any sign); `size` entries; `ordered`: each pair has low <= high."""
+
+    def check(name: str, value: Any) -> None:
+        if value is None and optional:
+            return
+        if not isinstance(value, (tuple, list)):
+            raise ValueError(f"{name} must be a tuple of numbers, got {value!r}")
+        if size is not None and len(value) != size:
+            raise ValueError(f"{name} must have {size} entries, got {value!r}")
+        items = [v for item in value for v in (item if isinstance(item, (tuple, list)) else [item])]
+        for x in items:
+            x = _check_real(name, x, value)
+            if (low is not None and x < low) or (high is not None and x > high):
+                raise ValueError(
+                    f"{name} entries must be {_range_text(low, high, False)}, got {value!r}"
+                )
+        pairs = [value] if not isinstance(value[0], (tuple, list)) else value
+        if ordered and any(len(p) != 2 or p[0] > p[1] for p in pairs):
+            raise ValueError(f"{name} must be (low, high) with low <= high, got {value!r}")
+
+    return dataclasses.field(default=default, metadata=_numeric(check, low))
+
+
+def choice(default: Any, choices: tuple, *, optional: bool = False) -> Any:
+    """A setting that takes one of `choices` (None too if `optional`)."""
+
+    def check(name: str, value: Any) -> None:
+        if not (value is None and optional):
+            check_choice(name, value, choices)
+
+    return dataclasses.field(default=default, metadata={"check": check})
+
+
+def option(default: Any = None, *, kind: type | tuple[type, ...] | None = None) -> Any:
+    """A setting of another type (a parameter dataclass, a name): None or an instance of
+    `kind`, checked by type; its own dataclass checks its fields."""
+
+    def check(name: str, value: Any) -> None:
+        if value is not None and kind is not None and not isinstance(value, kind):
+            names = kind.__name__ if isinstance(kind, type) else [k.__name__ for k in kind]
+            raise ValueError(f"{name} must be None or a {names}, got {value!r}")
+
+    if isinstance(default, (list, dict, set)):
+        raise TypeError("mutable defaults are not allowed for settings")
+    return dataclasses.field(default=default, metadata={"check": check})
+
+
+class _Checked:
+    """Runs every field's check (see `number`, `numbers`, `choice`, `option`) on construction."""
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            check: Callable | None = f.metadata.get("check")
+            if check is not None:
+                check(f.name, getattr(self, f.name))
+
+
+class TaskRanges:
+    """Base of the envs' task-range dataclasses: every (low, high) pair (or tuple of pairs) must
+    be finite with low <= high, every number finite; checked on construction."""
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):
+            value = getattr(self, f.name)
+            if isinstance(value, _numbers.Real) and not isinstance(value, bool):
+                _check_real(f.name, value, value)
+                continue
+            if not isinstance(value, tuple) or not value or isinstance(value[0], str):
+                continue
+            pairs = value if isinstance(value[0], tuple) else (value,)
+            for pair in pairs:
+                ok = len(pair) == 2 and all(
+                    isinstance(x, _numbers.Real) and math.isfinite(x) for x in pair
+                )
+                if not (ok and pair[0] <= pair[1]):
+                    raise ValueError(
+                        f"{type(self).__name__}.{f.name} must be finite (low, high) pairs with "
+                        f"low <= high, got {value!r}"
+                    )
+
+
+@dataclasses.dataclass(frozen=True)
+class RewardScales(_Checked):
+    """The weights of an env's named reward terms (every env extends it)."""
+
+    tip_over_penalty: float = number(100.0)
+    """Paid once, on the step the robot tips over."""
+
+
+@dataclasses.dataclass(frozen=True)
+class EnvSettings(_Checked):
+    """Settings every hexapod env has. Subclasses change the defaults to their robot's."""
+
+    reward_class: ClassVar[type[RewardScales]] = RewardScales
+    """The env's reward-scales dataclass (the type of `reward`)."""
+
+    control_dt: float = number(0.02, strict=True)
+    """Control period [s] (one `step`)."""
+    physics_dt: float = number(0.001, strict=True)
+    """MuJoCo timestep [s]; control_dt must be a whole multiple of it."""
+    integrator: str = choice("implicitfast", ("implicitfast", "implicit", "euler", "rk4"))
+    """MuJoCo integrator."""
+    solver_iterations: int | None = number(None, strict=True, integer=True, optional=True)
+    """Constraint solver iterations (None: MuJoCo's default, 100)."""
+    solver_ls_iterations: int | None = number(None, strict=True, integer=True, optional=True)
+    """Line-search iterations of the solver (None: MuJoCo's default, 50)."""
+    solver_tolerance: float | None = number(None, optional=True)
+    """Constraint solver tolerance (None: MuJoCo's default, 1e-8)."""
+    settle_time: float = number(0.5)
+    """Physics run in `reset` before the episode starts, the robot resting on its feet [s]."""
+    contact_threshold: float = number(0.02, high=1.0)
+    """A foot is loaded when its ground reaction exceeds this fraction of the robot's weight."""
+    tipping_threshold_deg: float = number(20.0, high=90.0)
+    """The robot's tipping threshold ξ on the FASM [deg] (`info["is_tipping"]` below it)."""
+    tip_over_angle_deg: float = number(20.0, strict=True, high=90.0)
+    """Tip-over (episode ends): the body's up axis leans more than this from vertical [deg]."""
+    reset_noise_scale: float = number(0.01)
+    """Size of the seed-dependent perturbation of the start state (env-specific units)."""
+    task_distribution: str = choice("paper", TASK_DISTRIBUTIONS)
+    """"paper" (the paper's scenario), "train" or "test" (tasks sampled at every reset)."""
+    sensor_noise: float = number(0.0)
+    """Relative std of Gaussian noise on the observed foot forces and IMU (0: exact)."""
+    render_mode: str | None = choice(None, RENDER_MODES, optional=True)
+    width: int = number(640, strict=True, integer=True)
+    """Rendered image width [px]."""
+    height: int = number(480, strict=True, integer=True)
+    """Rendered image height [px]."""
+    camera_name: str | None = option(None, kind=str)
+    """Named camera to render from (None: a free camera tracking the body)."""
+    reward: RewardScales = None  # type: ignore[assignment]  # the env's reward_class() if None
+    """The reward terms' weights (`reward_class`)."""
+
+    def __post_init__(self) -> None:
+        if self.reward is None:
+            object.__setattr__(self, "reward", self.reward_class())
+        elif not isinstance(self.reward, self.reward_class):
+            raise ValueError(
+                f"reward must be a {self.reward_class.__name__} or a dict of its fields, got "
+                f"{self.reward!r}"
+            )
+        super().__post_init__()
+
+    @classmethod
+    def from_kwargs(cls, owner: str, kwargs: Mapping[str, Any]) -> EnvSettings:
+        """Build the settings from keyword arguments; reward scales may be given flat or as
+        ``reward=`` (a dict or a `reward_class`). TypeError naming unknown keys (`owner` is
+        the env's name for the message)."""
+        kwargs = dict(kwargs)
+        own = {f.name for f in dataclasses.fields(cls)}
+        scales = {f.name for f in dataclasses.fields(cls.reward_class)}
+        unknown = sorted(set(kwargs) - own - scales)
+        if unknown:
+            hints = [f"{k} is now {RENAMED[k]}" for k in unknown if k in RENAMED]
+            hint = f" ({'; '.join(hints)})" if hints else ""
+            raise TypeError(
+                f"{owner} got unknown keyword argument(s) {unknown}{hint}; valid: "
+                f"{sorted((own - {'reward'}) | scales)}, or reward={{...}} with the "
+                "reward scales"
+            )
+        flat = {k: kwargs.pop(k) for k in list(kwargs) if k in scales and k not in own}
+        reward = kwargs.pop("reward", None)
+        if isinstance(reward, Mapping):
+            bad = sorted(set(reward) - scales)
+            if bad:
+                raise TypeError(f"{owner}: unknown reward scale(s) {bad}; valid: {sorted(scales)}")
+            reward = cls.reward_class(**{**reward, **flat})
+        elif reward is None:
+            reward = cls.reward_class(**flat)
+        elif flat and isinstance(reward, cls.reward_class):
+            reward = dataclasses.replace(reward, **flat)
+        return cls(**kwargs, reward=reward)
+
+    @classmethod
+    def numeric_names(cls) -> list[str]:
+        """Names of the numeric settings, the reward scales included (flat names)."""
+        names = [f.name for f in dataclasses.fields(cls) if f.metadata.get("numeric")]
+        return names + [
+            f.name for f in dataclasses.fields(cls.reward_class) if f.metadata.get("numeric")
+        ]
+
+    @classmethod
+    def signed_names(cls) -> list[str]:
+        """Numeric settings for which a negative value is meaningful (positions, offsets)."""
+        return [n for n in cls.numeric_names() if cls._field(n).metadata.get("signed")]
+
+    @classmethod
+    def _field(cls, name: str) -> dataclasses.Field:
+        for klass in (cls, cls.reward_class):
+            for f in dataclasses.fields(klass):
+                if f.name == name:
+                    return f
+        raise KeyError(name)
