@@ -5,7 +5,7 @@ TensorBoard tags written besides SB3's own (``rollout/``, ``train/``, ``eval/``,
 | tag | meaning (mean over the episodes finished since the last log) |
 |---|---|
 | ``hexapod/fasm_min_deg``, ``hexapod/fasm_mean_deg`` | per-episode min / mean FASM [deg] |
-| ``hexapod/time_below_xi_s`` | per-episode time with FASM < ξ_f = 20° [s] |
+| ``hexapod/time_below_xi_s`` | per-episode time with FASM below the robot's ξ [s] |
 | ``hexapod/success_rate``, ``hexapod/tip_over_rate`` | fraction of episodes |
 | ``hexapod/distance_m``, ``hexapod/energy_j`` | when the env reports them |
 | ``hexapod/<metric>`` | numeric env-specific episode metrics (see `episode`) |
@@ -22,7 +22,7 @@ from typing import Any
 from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
 
 from .artifacts import BEST, checkpoint_dir, save_model_dir
-from .episode import EpisodeAccumulator, EpisodeRecord, MetricSpec
+from .episode import EpisodeAccumulator, EpisodeRecord
 
 
 def record_episode(logger: Any, prefix: str, record: EpisodeRecord) -> None:
@@ -50,15 +50,13 @@ def record_episode(logger: Any, prefix: str, record: EpisodeRecord) -> None:
 class EpisodeStatsCallback(BaseCallback):
     """Accumulates every training env's info dicts and logs each finished episode."""
 
-    def __init__(self, dt: float | None, specs: list[MetricSpec]):
+    def __init__(self, new_accumulator: Callable[[], EpisodeAccumulator]):
         super().__init__()
-        self.dt, self.specs = dt, specs
+        self.new_accumulator = new_accumulator
         self.accumulators: list[EpisodeAccumulator] = []
 
     def _on_training_start(self) -> None:
-        self.accumulators = [
-            EpisodeAccumulator(self.dt, self.specs) for _ in range(self.training_env.num_envs)
-        ]
+        self.accumulators = [self.new_accumulator() for _ in range(self.training_env.num_envs)]
 
     def _on_step(self) -> bool:
         infos, dones = self.locals["infos"], self.locals["dones"]
@@ -119,11 +117,11 @@ class SaveBest(BaseCallback):
 class StatsEvalCallback(EvalCallback):
     """EvalCallback that also logs FASM/success statistics of its evaluation episodes."""
 
-    def __init__(self, *args: Any, dt: float | None, specs: list[MetricSpec], **kwargs: Any):
+    def __init__(
+        self, *args: Any, new_accumulator: Callable[[], EpisodeAccumulator], **kwargs: Any
+    ):
         super().__init__(*args, **kwargs)
-        self._make_accumulators: Callable[[], EpisodeAccumulator] = lambda: EpisodeAccumulator(
-            dt, specs
-        )
+        self._make_accumulators = new_accumulator
         self._accumulators: dict[int, EpisodeAccumulator] = {}
 
     def _on_training_start(self) -> None:

@@ -12,7 +12,9 @@ import signal
 import sys
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -32,7 +34,7 @@ from .artifacts import (
 )
 from .configtools import dump_yaml, load_yaml, parse_override
 from .envs import EnvSpec, env_time_step, make_vec_env
-from .episode import metric_specs
+from .episode import XI_F_DEG, EpisodeAccumulator, metric_specs
 from .errors import UserError
 from .model_files import (
     NormalizationStats,
@@ -74,13 +76,17 @@ def env_spec(config: TrainConfig) -> EnvSpec:
     )
 
 
-def _probe(spec: EnvSpec) -> tuple[float | None, list]:
-    """Make one env in this process: clear errors early; read its time step and metric specs."""
+def _probe(spec: EnvSpec) -> Callable[[], EpisodeAccumulator]:
+    """Make one env in this process: clear errors early; read its time step, metric specs and
+    the robot's tipping threshold ξ (the time below it is logged); return a factory of episode
+    accumulators for the training and evaluation callbacks."""
     env = spec.make()
     try:
-        return env_time_step(env), metric_specs(env)
+        dt, specs = env_time_step(env), metric_specs(env)
+        xi = getattr(env.unwrapped, "tipping_threshold_deg", XI_F_DEG)
     finally:
         env.close()
+    return partial(EpisodeAccumulator, dt, specs, xi_f_deg=xi)
 
 
 def _vec_envs(config: TrainConfig, seed: int, stats: NormalizationStats | None = None):
@@ -141,7 +147,7 @@ def start_training(
     from stable_baselines3 import PPO
 
     spec = env_spec(config)
-    dt, specs = _probe(spec)
+    new_accumulator = _probe(spec)
     name = name or run_name(config.env.id, config.train.seed)
     run_dir = prepare_new_dir(Path(output_dir) / name, force, "run directory")
     try:
@@ -167,7 +173,7 @@ def start_training(
     except BaseException:
         shutil.rmtree(run_dir, ignore_errors=True)
         raise
-    return _learn(model, config, run_dir, command, eval_env, dt, specs, False, after_eval)
+    return _learn(model, config, run_dir, command, eval_env, new_accumulator, False, after_eval)
 
 
 def resume_training(
@@ -199,7 +205,7 @@ def resume_training(
     if not candidates:
         raise UserError(f"{run_dir} holds no checkpoint to resume from")
     spec = env_spec(config)
-    dt, specs = _probe(spec)
+    new_accumulator = _probe(spec)
     model = eval_env = None
     problems = []
     for checkpoint in candidates:
@@ -225,7 +231,7 @@ def resume_training(
     with open(run_dir / COMMAND_FILE, "a") as fh:
         fh.write(command + "\n")
     print(f"resuming {run_dir} from {checkpoint.name} at {model.num_timesteps} steps")
-    return _learn(model, config, run_dir, command, eval_env, dt, specs, True, after_eval)
+    return _learn(model, config, run_dir, command, eval_env, new_accumulator, True, after_eval)
 
 
 def _load_checkpoint(
@@ -268,8 +274,7 @@ def _learn(
     run_dir: Path,
     command: str,
     eval_env: Any,
-    dt: float | None,
-    specs: list,
+    new_accumulator: Callable[[], EpisodeAccumulator],
     resumed: bool,
     after_eval: Any = None,
 ) -> TrainResult:
@@ -288,7 +293,7 @@ def _learn(
     )
 
     saver = ModelSaver(run_dir, config, command)
-    callbacks = [EpisodeStatsCallback(dt, specs)]
+    callbacks = [EpisodeStatsCallback(new_accumulator)]
     if config.checkpoint.freq > 0:
         callbacks.append(CheckpointEvery(config.checkpoint.freq, saver))
     if eval_env is not None:
@@ -302,8 +307,7 @@ def _learn(
             callback_after_eval=after_eval,
             warn=False,
             verbose=config.logging.verbose,
-            dt=dt,
-            specs=specs,
+            new_accumulator=new_accumulator,
         )
         if resumed:
             _restore_eval_history(eval_cb, run_dir)
