@@ -337,8 +337,7 @@ class TippingRecoveryController:
         self._filter(reading)
         rot = quat_to_matrix(reading.quat)
         joints = np.asarray(reading.joints, dtype=float).reshape(6, 3)
-        feet = self.body.feet(joints)
-        cog = self.body.cog(joints)
+        feet, cog = self.body.feet_and_cog(joints)
         forces = forces_to_body(reading.foot_forces, rot)
         loaded = (forces * forces).sum(axis=1) > self._contact_sq
         margin, edge = self._margin(feet, forces, cog, loaded)
@@ -347,7 +346,9 @@ class TippingRecoveryController:
         self._previous_margin = d["fasm_deg"]
         d["fasm_deg"] = margin
         d["fasm_edge"] = None if edge is None else (LEG_NAMES[edge[0]], LEG_NAMES[edge[1]])
-        d["stance_legs"] = tuple(leg for leg, on in zip(LEG_NAMES, loaded, strict=True) if on)
+        d["stance_legs"] = tuple(
+            leg for leg, on in zip(LEG_NAMES, loaded.tolist(), strict=True) if on
+        )
 
         if self.phase == "monitor":
             if margin < cfg.threshold_deg and time >= cfg.arm_after and loaded.sum() >= 3:
@@ -656,8 +657,8 @@ class TippingRecoveryPolicy:
         if self.action_mode == "residual":
             reference = self.env.unwrapped.reference_joints()
             raw = (joints - reference) / self._gain
-            self._saturated = self._saturated or bool(np.any(np.abs(raw) > 1.0 + 1e-9))
-            action = np.clip(raw, -1.0, 1.0)
+            self._saturated = self._saturated or bool(np.abs(raw).max() > 1.0 + 1e-9)
+            action = np.minimum(np.maximum(raw, -1.0), 1.0)  # np.clip, without its wrapper
         else:
             action = self.action_map.to_action(joints)
         return action.astype(self._dtype)

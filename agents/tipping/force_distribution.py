@@ -156,7 +156,12 @@ def _skew(v: np.ndarray) -> np.ndarray:
 
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product along the last axis (np.cross is slow for tiny arrays)."""
+    """Cross product along the last axis (np.cross is slow for tiny arrays; two 3-vectors are
+    crossed on floats, with the same operations)."""
+    if a.shape == b.shape == (3,):
+        a0, a1, a2 = a.tolist()
+        b0, b1, b2 = b.tolist()
+        return np.array((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0))
     return np.stack(
         [
             a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
@@ -651,7 +656,7 @@ class ForceDistributor:
                 )
             return self._failure(qp, solver, "solver_error", "solver failed on a feasible problem")
         slack_all = (qp.h - qp.G @ x_scaled) * qp.scale
-        violation = max(0.0, -float(slack_all.min()))
+        violation = max(0.0, -float(np.minimum.reduce(slack_all)))  # .min() minus its wrapper
         x = x_scaled * qp.scale
         wrench = qp.A @ x
         status, message = "optimal", ""
