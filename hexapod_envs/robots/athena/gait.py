@@ -197,9 +197,9 @@ class PostureEstimate:
 class _Plan:
     """One phase's foot paths: Bezier control points of the swing legs, lines of the stance legs."""
 
-    swing: list[int]  # leg indices
+    swing: slice | list[int]  # rows of the swing legs (see _rows)
     swing_points: np.ndarray  # (3, 4, 3) control points per swing leg
-    stance: list[int]
+    stance: slice | list[int]  # rows of the stance legs
     stance_start: np.ndarray  # (3, 3) p_{i,0}
     stance_delta: np.ndarray  # (3, 3) p_{i,f} - p_{i,0}
 
@@ -441,11 +441,11 @@ class AthenaPostureController:
         rotation = posture_rotation(ka * d_pitch, kb * d_roll)
         stance_end = [stance_end_point(start[i], stride, kz * d_z, rotation) for i in stance]
         self._plan = _Plan(
-            swing=list(swing),
+            swing=_rows(swing),
             swing_points=np.array(
                 [swing_control_points(start[i], stride, self.swing_height, kz * d_z) for i in swing]
             ),
-            stance=list(stance),
+            stance=_rows(stance),
             stance_start=start[list(stance)],
             stance_delta=np.array(stance_end) - start[list(stance)],
         )
@@ -500,6 +500,15 @@ class AthenaPostureController:
         return np.array(rows)
 
 
+def _rows(legs: tuple[int, ...]) -> slice | list[int]:
+    """Index of the rows ``legs``: a slice when they are evenly spaced (the tripods are rows
+    0, 2, 4 and 1, 3, 5), which numpy assigns through about three times faster than a list."""
+    step = legs[1] - legs[0] if len(legs) > 1 else 1
+    if step > 0 and list(legs) == list(range(legs[0], legs[-1] + 1, step)):
+        return slice(legs[0], legs[-1] + 1, step)
+    return list(legs)
+
+
 def _checked_gains(kz: float, k_alpha: float, k_beta: float) -> tuple[float, float, float]:
     gains = (float(kz), float(k_alpha), float(k_beta))
     for label, value in zip(("kz", "k_alpha", "k_beta"), gains, strict=True):
@@ -514,7 +523,7 @@ def _checked_sensors(sensors: AthenaSensors) -> tuple[np.ndarray, np.ndarray, fl
         raise ValueError(f"joint_angles must have shape (6, 3) (rows {LEG_NAMES}), got {q.shape}")
     f = np.asarray(sensors.foot_forces, dtype=float)
     if f.shape == (6, 3):
-        f = np.linalg.norm(f, axis=1)
+        f = np.sqrt(np.add.reduce(f * f, axis=1))  # np.linalg.norm(f, axis=1), minus its wrapper
     elif f.shape != (6,):
         raise ValueError(f"foot_forces must have shape (6,) or (6, 3), got {f.shape}")
     return q, f, float(sensors.torso_height)
