@@ -291,6 +291,7 @@ class AthenaPostureController:
         self.ground_search = ground_search
         self.rng = rng
         self._iks = [leg_ik(leg, params) for leg in LEG_NAMES]
+        self._solvers = [ik.solve for ik in self._iks]  # bound once (six calls every tick)
         self._gains = _checked_gains(kz, k_alpha, k_beta)
         self.reset()
 
@@ -379,8 +380,9 @@ class AthenaPostureController:
     def step(self, sensors: AthenaSensors) -> np.ndarray:
         """One control tick: (6, 3) joint-angle targets from the current sensor readings."""
         q, forces, height = _checked_sensors(sensors)
-        contact = forces > self.contact_threshold
-        if self._tick == 0:
+        if self._tick == 0:  # forces only matter at a phase start
+            forces = _normal_forces(forces)
+            contact = forces > self.contact_threshold
             stance = _TRIPOD_INDICES[(self._phase_index + 2) % 2]
             missing = [i for i in stance if not contact[i]]
             if missing and self._searches_ground() and self._extension < self.max_extension:
@@ -490,14 +492,14 @@ class AthenaPostureController:
 
     def _joint_targets(self) -> np.ndarray:
         """IK of the commanded feet; unreachable points get the nearest reachable pose."""
-        rows, clamped = [], []
-        for ik, (x, y, z) in zip(self._iks, self._command.tolist(), strict=True):
-            t2, t3, t4, problem = ik.solve(x, y, z)
-            rows.append((t2, t3, t4))
-            if problem is not None:
-                clamped.append(ik.leg)
-        self.clamped_legs = tuple(clamped)
-        return np.array(rows)
+        solutions = [
+            solve(x, y, z)
+            for solve, (x, y, z) in zip(self._solvers, self._command.tolist(), strict=True)
+        ]
+        self.clamped_legs = tuple(
+            leg for leg, sol in zip(LEG_NAMES, solutions, strict=True) if sol[3] is not None
+        )
+        return np.array([sol[:3] for sol in solutions])
 
 
 def _rows(legs: tuple[int, ...]) -> slice | list[int]:
@@ -518,12 +520,17 @@ def _checked_gains(kz: float, k_alpha: float, k_beta: float) -> tuple[float, flo
 
 
 def _checked_sensors(sensors: AthenaSensors) -> tuple[np.ndarray, np.ndarray, float]:
+    """(joint angles (6, 3), foot forces (6,) or (6, 3) as given, torso height), validated."""
     q = np.asarray(sensors.joint_angles, dtype=float)
     if q.shape != (6, 3):
         raise ValueError(f"joint_angles must have shape (6, 3) (rows {LEG_NAMES}), got {q.shape}")
     f = np.asarray(sensors.foot_forces, dtype=float)
-    if f.shape == (6, 3):
-        f = np.sqrt(np.add.reduce(f * f, axis=1))  # np.linalg.norm(f, axis=1), minus its wrapper
-    elif f.shape != (6,):
+    if f.shape != (6, 3) and f.shape != (6,):
         raise ValueError(f"foot_forces must have shape (6,) or (6, 3), got {f.shape}")
     return q, f, float(sensors.torso_height)
+
+
+def _normal_forces(f: np.ndarray) -> np.ndarray:
+    """(6,) force magnitudes from validated (6,) or (6, 3) foot forces: the vectors' norms
+    (np.linalg.norm(f, axis=1), computed without its wrapper)."""
+    return np.sqrt(np.add.reduce(f * f, axis=1)) if f.ndim == 2 else f
