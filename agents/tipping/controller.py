@@ -339,7 +339,7 @@ class TippingRecoveryController:
         joints = np.asarray(reading.joints, dtype=float).reshape(6, 3)
         feet, cog = self.body.feet_and_cog(joints)
         forces = forces_to_body(reading.foot_forces, rot)
-        loaded = (forces * forces).sum(axis=1) > self._contact_sq
+        loaded = np.add.reduce(forces * forces, axis=1) > self._contact_sq  # .sum(axis=1)
         margin, edge = self._margin(feet, forces, cog, loaded)
         self.history.add(time, margin)
         d = self.diagnostics
@@ -554,7 +554,7 @@ class TippingRecoveryController:
         held = self._support_idx
         in_contact = loaded[held]
         support = held[in_contact]
-        complete = bool(in_contact.all())
+        complete = bool(np.logical_and.reduce(in_contact))  # .all(), minus its wrapper
         self._steps_supported += 1
         d["qp_legs"] = tuple(LEG_NAMES[i] for i in support.tolist())
         measured = d["measured_forces"] = forces[support]
@@ -622,7 +622,7 @@ class TippingRecoveryPolicy:
 
     def __init__(self, env: gym.Env, config: RecoveryConfig | None = None, **overrides):
         self.env = env
-        base = env.unwrapped
+        self._base = base = env.unwrapped  # (each .unwrapped walks the wrapper chain)
         for name in ("observation_structure", "action_map", "action_mode", "robot"):
             if not hasattr(base, name):
                 raise ValueError(f"{type(base).__name__} is not a heavy-duty hexapod env")
@@ -650,12 +650,12 @@ class TippingRecoveryPolicy:
 
     def nominal(self, observation: np.ndarray) -> np.ndarray:
         """Joint targets without recovery: the env's reference posture."""
-        return self.env.unwrapped.reference_joints().reshape(6, 3)
+        return self._base.reference_joints().reshape(6, 3)
 
     def to_action(self, targets: np.ndarray) -> np.ndarray:
         joints = np.asarray(targets).reshape(-1)
         if self.action_mode == "residual":
-            reference = self.env.unwrapped.reference_joints()
+            reference = self._base.reference_joints()
             raw = (joints - reference) / self._gain
             self._saturated = self._saturated or bool(np.abs(raw).max() > 1.0 + 1e-9)
             action = np.minimum(np.maximum(raw, -1.0), 1.0)  # np.clip, without its wrapper

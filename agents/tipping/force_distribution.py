@@ -431,7 +431,8 @@ def _tipping_matrices(rows, c, edges, moment_rows: np.ndarray) -> np.ndarray:
         )  # fmt: skip
     out = np.array(couple).reshape(m, 3, 3) @ moment_rows  # (m, 3, 3k)
     # + [I - a aᵀ ... I - a aᵀ], added per foot block in place (np.tile cost a copy).
-    out.reshape(m, 3, k, 3)[...] += np.array(ima).reshape(m, 3, 1, 3)
+    blocks = out.reshape(m, 3, k, 3)
+    np.add(blocks, np.array(ima).reshape(m, 3, 1, 3), out=blocks)
     return out
 
 
