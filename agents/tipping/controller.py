@@ -657,7 +657,7 @@ class TippingRecoveryPolicy:
         if self.action_mode == "residual":
             reference = self._base.reference_joints()
             raw = (joints - reference) / self._gain
-            self._saturated = self._saturated or bool(np.abs(raw).max() > 1.0 + 1e-9)
+            self._saturated = self._saturated or bool(np.maximum.reduce(np.abs(raw)) > 1.0 + 1e-9)
             action = np.minimum(np.maximum(raw, -1.0), 1.0)  # np.clip, without its wrapper
         else:
             action = self.action_map.to_action(joints)
