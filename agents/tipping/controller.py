@@ -622,7 +622,7 @@ class TippingRecoveryPolicy:
 
     def __init__(self, env: gym.Env, config: RecoveryConfig | None = None, **overrides):
         self.env = env
-        self._base = base = env.unwrapped  # (each .unwrapped walks the wrapper chain)
+        base = env.unwrapped
         for name in ("observation_structure", "action_map", "action_mode", "robot"):
             if not hasattr(base, name):
                 raise ValueError(f"{type(base).__name__} is not a heavy-duty hexapod env")
@@ -650,15 +650,15 @@ class TippingRecoveryPolicy:
 
     def nominal(self, observation: np.ndarray) -> np.ndarray:
         """Joint targets without recovery: the env's reference posture."""
-        return self._base.reference_joints().reshape(6, 3)
+        return self.env.unwrapped.reference_joints().reshape(6, 3)
 
     def to_action(self, targets: np.ndarray) -> np.ndarray:
         joints = np.asarray(targets).reshape(-1)
         if self.action_mode == "residual":
-            reference = self._base.reference_joints()
+            reference = self.env.unwrapped.reference_joints()
             raw = (joints - reference) / self._gain
-            self._saturated = self._saturated or bool(np.maximum.reduce(np.abs(raw)) > 1.0 + 1e-9)
-            action = np.minimum(np.maximum(raw, -1.0), 1.0)  # np.clip, without its wrapper
+            self._saturated = self._saturated or bool(np.any(np.abs(raw) > 1.0 + 1e-9))
+            action = np.clip(raw, -1.0, 1.0)
         else:
             action = self.action_map.to_action(joints)
         return action.astype(self._dtype)
