@@ -2,15 +2,17 @@
 controller's step time.
 
 Targets (issue 4): env/raw ratio >= 0.9 (Gymnasium's Ant-v5 is measured alongside for context);
-controller step time reported in µs. The env/raw figure is measured per terrain in each action
+controller step time in µs, with issue 14's target (median <= 15 µs) printed beside it
+(``--posture-only`` runs just that part). The env/raw figure is measured per terrain in each action
 mode (zero actions: in "residual" and "gains" mode the env runs the Coelho et al. 2024 gait with its
 internal controller, in "joint" mode it holds zero targets), and the per-step costs of the
 pieces that the env adds to the physics are timed on their own, so that a shortfall can be
-attributed. Run: python benchmarks/bench_irregular_terrain.py
+attributed. Run: python benchmarks/bench_irregular_terrain.py [--posture-only]
 """
 
 from __future__ import annotations
 
+import argparse
 import sys
 import time
 from pathlib import Path
@@ -58,6 +60,18 @@ def controller_step_us(terrain: str = "ramp", steps: int = 2400) -> tuple[float,
     return float(np.median(times)), float(np.mean(times)), float(np.mean(starts))
 
 
+def print_posture_step() -> None:
+    """The posture controller step (median beside issue 14's target) and one leg's IK."""
+    median, mean, start = controller_step_us()
+    verdict = "met" if median <= POSTURE_TARGET_US else "missed"
+    print(
+        f"posture controller step: median {median:5.1f} us (target <= {POSTURE_TARGET_US:.0f}: "
+        f"{verdict}), mean {mean:5.1f} us (phase start {start:5.1f} us)"
+    )
+    ik = leg_ik("LF")
+    print(f"  leg IK (LegIK.solve):  {per_call_us(ik.solve, 0.2, 0.15, -0.08):5.1f} us per leg")
+
+
 def env_piece_costs(terrain: str = "ramp") -> dict[str, float]:
     """µs per call of what the env computes every step besides the physics."""
     env = gym.make(ENV_ID, terrain=terrain, action_mode="joint")
@@ -80,7 +94,18 @@ def env_piece_costs(terrain: str = "ramp") -> dict[str, float]:
     return costs
 
 
+POSTURE_TARGET_US = 15.0  # issue 14: median controller step
+
+
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument(
+        "--posture-only", action="store_true", help="only the posture controller step (10 s)"
+    )
+    args = parser.parse_args()
+    if args.posture_only:
+        print_posture_step()
+        return
     print(f"{'terrain':8s} {'mode':9s} {'raw mj_step/s':>14s} {'env steps/s':>12s} {'env/raw':>8s}")
     for terrain in ("ramp", "blocks", "flat"):
         for mode in ("residual", "gains", "joint"):
@@ -93,13 +118,7 @@ def main() -> None:
         print(f"Ant-v5 not measured: {exc}")
     physics_us = 25 / env_vs_raw(ENV_ID, steps=1200, terrain="ramp", action_mode="joint")[0] * 1e6
     print(f"\nphysics per 50 ms control step (25 x 2 ms mj_step, ramp): {physics_us:6.0f} us")
-    median, mean, start = controller_step_us()
-    print(
-        f"posture controller step: median {median:5.1f} us, mean {mean:5.1f} us "
-        f"(phase start {start:5.1f} us)"
-    )
-    ik = leg_ik("LF")
-    print(f"  leg IK (LegIK.solve):  {per_call_us(ik.solve, 0.2, 0.15, -0.08):5.1f} us per leg")
+    print_posture_step()
     for name, us in env_piece_costs().items():
         print(f"env per step, {name:34s} {us:6.1f} us")
 

@@ -1,9 +1,11 @@
 """Foot-force distribution QP with the FASM stability cone (Zhang et al. 2024 §4.3, eqs. 16-24)."""
 
 import math
+import re
 
 import numpy as np
 import pytest
+import qpsolvers
 
 from agents.tipping.force_distribution import (
     GRAVITY,
@@ -244,3 +246,67 @@ def test_config_validation_names_choices():
         ForceDistributionConfig(cone_ratio=1.0)
     with pytest.raises(ValueError, match="at least 3"):
         ForceDistributor(2)
+
+
+def _random_case(rng):
+    """A random stance (3-6 feet, perturbed standing footholds), CoG, wrench and options."""
+    k = int(rng.integers(3, 7))
+    legs = list(rng.permutation(list(FEET))[:k])
+    feet = feet_of(*legs) + rng.normal(scale=0.15, size=(k, 3))
+    cog = rng.normal(scale=0.3, size=3)
+    pitch, roll = rng.normal(scale=12.0, size=2)
+    b = desired_wrench(
+        MASS,
+        INERTIA,
+        gravity_pitched(pitch) + [0.0, GRAVITY * math.sin(math.radians(roll)), 0.0],
+        accel_body=rng.normal(scale=0.5, size=3),
+        omega=rng.normal(scale=0.2, size=3),
+        omega_dot=rng.normal(scale=0.5, size=3),
+    )
+    normal = None if rng.random() < 0.3 else rng.normal(scale=0.15, size=3) + [0.0, 0.0, 1.0]
+    config = ForceDistributionConfig(
+        cone_ratio=float(rng.choice([0.5, 0.65, 0.8, 0.95])),
+        stability_cone=bool(rng.random() < 0.85),
+        solver=str(rng.choice(SOLVERS)),
+    )
+    return k, feet, cog, b, normal, config
+
+
+def test_build_is_bit_identical_to_the_original_assembly():
+    """The speed-up of the assembly (issue 14) changes no bit of U, f, G, h, A, the cone or the
+    forces: 200 random stances against the verbatim original in reference_force_distribution."""
+    from reference_force_distribution import reference_build
+
+    rng = np.random.default_rng(14)
+    distributors = {}
+    compared = errors = 0
+    for _ in range(200):
+        k, feet, cog, b, normal, config = _random_case(rng)
+        # Reuse distributors across cases, as the controller does (the G buffers persist).
+        distributor = distributors.setdefault((k, config), ForceDistributor(k, config))
+        try:
+            old = reference_build(distributor, feet, cog, b, normal)
+        except ValueError as error:
+            with pytest.raises(ValueError, match=re.escape(str(error)[:20])):
+                distributor.build(feet, cog, b, normal)
+            errors += 1
+            continue
+        new = distributor.build(feet, cog, b, normal)
+        for name in ("U", "f", "G", "h", "A", "b", "edges", "normal"):
+            old_v, new_v = getattr(old, name), getattr(new, name)
+            assert old_v.shape == new_v.shape and old_v.tobytes() == new_v.tobytes(), name
+        assert (old.scale, old.blocks) == (new.scale, new.blocks)
+        if config.stability_cone:
+            for name in ("apex", "centroid", "base_points", "tan_alpha", "faces"):
+                assert getattr(old.cone, name).tobytes() == getattr(new.cone, name).tobytes()
+            assert (old.cone.d_min, old.cone.radius) == (new.cone.d_min, new.cone.radius)
+        else:
+            assert new.cone is None
+        # The forces as before: qpsolvers on the old problem (solve_qp calls daqp directly).
+        x_old = qpsolvers.solve_qp(old.U, old.f, old.G, old.h, solver=config.solver)
+        new_x = distributor.solve_qp(new)
+        assert (x_old is not None) == (new_x.status != "infeasible")
+        if new_x.ok:
+            assert (x_old * old.scale).reshape(k, 3).tobytes() == new_x.forces.tobytes()
+        compared += 1
+    assert compared >= 150 and errors < 50

@@ -256,3 +256,52 @@ def test_no_ground_is_a_held_posture_with_a_reason():
     d = controller.diagnostics
     assert controller.phase == "holding" and "no ground under RR" in d["failure"]
     np.testing.assert_allclose(joints[LEG_NAMES.index("RR")], _hold_joints()[5])  # pulled back
+
+
+def _array_feet_cog_and_target_change(body, joints, delta_force, legs):
+    """The body model's feet, CoG and target change as numpy array expressions (their form
+    before the float rewrite of issue 14), as the reference for the equivalence test."""
+    p = body.params
+    x, d, theta = p.k_x * joints[:, 0], p.k_z * joints[:, 1] + p.l2, joints[:, 2].copy()
+    c, s = np.cos(theta), np.sin(theta)
+    feet = body.hips.copy()
+    feet[:, 0] += x
+    feet[:, 1] += body.l1 * c + d * s
+    feet[:, 2] += body.l1 * s - d * c
+    m_moving = body._m_carriage + body._m_shank + body._m_foot
+    y = (0.5 * body._m_hip + m_moving) * body.l1
+    z = (
+        body._m_carriage * body._carriage_z
+        + body._m_shank * (body._shank_up - d)
+        + body._m_foot * (body._foot_up - d)
+    )
+    hips = body._hip_sums
+    moment = (
+        p.leg_mass * hips[0] + m_moving * float(x.sum()),
+        p.leg_mass * hips[1] + float((y * c - z * s).sum()),
+        p.leg_mass * hips[2] + float((y * s + z * c).sum()),
+    )
+    jac = np.zeros((6, 3, 3))
+    jac[:, 0, 0] = 1.0
+    jac[:, 1, 1], jac[:, 2, 1] = s, -c
+    jac[:, 1, 2] = -body.l1 * s + d * c
+    jac[:, 2, 2] = body.l1 * c + d * s
+    change = -np.einsum("lji,lj->li", jac[legs], delta_force) / body.stiffness
+    return feet, np.array(moment) / body.total_mass, change / body._joint_scale
+
+
+def test_body_model_float_code_is_bit_identical_to_array_expressions():
+    body = HeavyDutyBodyModel(PARAMS)
+    rng = np.random.default_rng(14)
+    for _ in range(500):
+        joints = np.column_stack(
+            [rng.uniform(-0.3, 0.3, 6), rng.uniform(-0.2, 0.5, 6), rng.uniform(-0.6, 0.6, 6)]
+        )
+        legs = np.sort(rng.permutation(6)[: rng.integers(3, 7)])
+        delta_force = rng.normal(scale=1000.0, size=(len(legs), 3))
+        feet, cog, change = _array_feet_cog_and_target_change(body, joints, delta_force, legs)
+        new_feet, new_cog = body.feet_and_cog(joints)
+        assert new_feet.tobytes() == feet.tobytes() == body.feet(joints).tobytes()
+        assert new_cog.tobytes() == cog.tobytes() == body.cog(joints).tobytes()
+        new_change = body.target_change_for_force(joints, delta_force, legs=legs)
+        assert new_change.tobytes() == change.tobytes()

@@ -43,7 +43,7 @@ SHANK_TOP: float = 0.7
 
 def quat_to_matrix(quat: np.ndarray) -> np.ndarray:
     """Rotation matrix (body -> world) of a unit quaternion (w, x, y, z)."""
-    w, x, y, z = (float(v) for v in quat)
+    w, x, y, z = np.asarray(quat, dtype=float).tolist()
     n = w * w + x * x + y * y + z * z
     if not n > 0.0:
         raise ValueError(f"quaternion {quat} has zero norm")
@@ -94,6 +94,11 @@ class HeavyDutyBodyModel:
         )
         self.stiffness = np.array(p.foot_stiffness, dtype=float)
         self._joint_scale = np.array([p.k_x, p.k_z, 1.0])  # generalised = scale * J (+ L2 for d)
+        # The same constants as floats for the per-period float code.
+        self._hip_rows = [tuple(row) for row in self.hips.tolist()]
+        self._l1_list = self.l1.tolist()
+        self._stiffness_list = self.stiffness.tolist()
+        self._joint_scale_list = self._joint_scale.tolist()
 
     # --- legs -------------------------------------------------------------------------------
     def leg_state(self, joints: np.ndarray) -> LegState:
@@ -104,13 +109,54 @@ class HeavyDutyBodyModel:
 
     def feet(self, joints: np.ndarray) -> np.ndarray:
         """(6, 3) sole points in the body frame [m] (eq. 1 plus the hip offsets)."""
-        q = self.leg_state(joints)
-        c, s = np.cos(q.theta), np.sin(q.theta)
-        out = self.hips.copy()
-        out[:, 0] += q.x
-        out[:, 1] += self.l1 * c + q.d * s
-        out[:, 2] += self.l1 * s - q.d * c
-        return out
+        return self.feet_and_cog(joints)[0]
+
+    def feet_and_cog(self, joints: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(:meth:`feet`, :meth:`cog`) from one pass over the legs (the controller needs both
+        every period).
+
+        Plain floats after one np.cos / np.sin of the six swing angles: on six legs numpy's
+        per-call overhead cost more than the arithmetic (about 20 µs per period). The operations
+        and summation order are those of the former array expressions, so the numbers are
+        bit-identical to them (tests/test_tipping_recovery.py).
+        """
+        j = np.asarray(joints, dtype=float).reshape(6, 3)
+        theta = j[:, 2]
+        cos, sin = np.cos(theta).tolist(), np.sin(theta).tolist()
+        p = self.params
+        k_x, k_z, l2 = p.k_x, p.k_z, p.l2
+        m_moving = self._m_carriage + self._m_shank + self._m_foot
+        y_mass = 0.5 * self._m_hip + m_moving
+        z_fixed = self._m_carriage * self._carriage_z
+        m_shank, shank_up, m_foot, foot_up = (
+            self._m_shank,
+            self._shank_up,
+            self._m_foot,
+            self._foot_up,
+        )
+        feet = []
+        sum_x = sum_y = sum_z = 0.0
+        for (jx, jz, _), (hx, hy, hz), l1, c, s in zip(
+            j.tolist(), self._hip_rows, self._l1_list, cos, sin, strict=True
+        ):
+            x = k_x * jx
+            d = k_z * jz + l2
+            feet.append((hx + x, hy + (l1 * c + d * s), hz + (l1 * s - d * c)))
+            # Mass moment of the leg's links in its (unrotated) leg plane, rotated by the swing
+            # angle (the rotation is linear, so it commutes with the weighted sum).
+            y = y_mass * l1
+            z = z_fixed + m_shank * (shank_up - d) + m_foot * (foot_up - d)
+            sum_x += x
+            sum_y += y * c - z * s
+            sum_z += y * s + z * c
+        m_leg, total = p.leg_mass, self.total_mass
+        hips = self._hip_sums
+        cog = (
+            (m_leg * hips[0] + m_moving * sum_x) / total,
+            (m_leg * hips[1] + sum_y) / total,
+            (m_leg * hips[2] + sum_z) / total,
+        )
+        return np.array(feet), np.array(cog)
 
     def foot_velocities(self, joints: np.ndarray, joint_velocities: np.ndarray) -> np.ndarray:
         """(6, 3) sole velocities relative to the body [m/s] from encoder rates."""
@@ -145,36 +191,36 @@ class HeavyDutyBodyModel:
         Returns:
             (n, 3) target changes in joint units (m, m, rad).
         """
-        q = self.leg_state(joints)
-        jac = self.jacobians(q)
-        if legs is not None:
-            jac = jac[np.asarray(legs)]
-        df = np.asarray(delta_force, dtype=float).reshape(len(jac), 3)
-        generalised = -np.einsum("lji,lj->li", jac, df) / self.stiffness
-        return generalised / self._joint_scale
+        legs = list(range(6)) if legs is None else np.asarray(legs).tolist()
+        j = np.asarray(joints, dtype=float).reshape(6, 3)[legs]
+        df = np.asarray(delta_force, dtype=float).reshape(len(legs), 3).tolist()
+        cos, sin = np.cos(j[:, 2]).tolist(), np.sin(j[:, 2]).tolist()
+        k_z, l2 = self.params.k_z, self.params.l2
+        k_x_stiff, k_d_stiff, k_t_stiff = self._stiffness_list
+        scale_x, scale_d, scale_t = self._joint_scale_list
+        out = []
+        # Jᵀ ΔF per leg on floats (J as in :meth:`jacobians`, columns x, d, θ; its zero entries
+        # multiplied in as the einsum did, so the numbers are bit-identical), then -K⁻¹ and the
+        # joint scale.
+        for leg, (fx, fy, fz), jz, c, s in zip(legs, df, j[:, 1].tolist(), cos, sin, strict=True):
+            l1 = self._l1_list[leg]
+            d = k_z * jz + l2
+            g_x = 1.0 * fx + 0.0 * fy + 0.0 * fz
+            g_d = 0.0 * fx + s * fy + -c * fz
+            g_t = 0.0 * fx + (-l1 * s + d * c) * fy + (l1 * c + d * s) * fz
+            out.append(
+                (
+                    (-g_x / k_x_stiff) / scale_x,
+                    (-g_d / k_d_stiff) / scale_d,
+                    (-g_t / k_t_stiff) / scale_t,
+                )
+            )
+        return np.array(out)
 
     # --- whole body ------------------------------------------------------------------------
     def cog(self, joints: np.ndarray) -> np.ndarray:
         """Whole-robot centre of gravity in the body frame [m] from the encoders."""
-        q = self.leg_state(joints)
-        # Mass moment of each leg's links in its (unrotated) leg plane, then one rotation by the
-        # swing angle per leg (the rotation is linear, so it commutes with the weighted sum).
-        m_moving = self._m_carriage + self._m_shank + self._m_foot
-        y = (0.5 * self._m_hip + m_moving) * self.l1
-        z = (
-            self._m_carriage * self._carriage_z
-            + self._m_shank * (self._shank_up - q.d)
-            + self._m_foot * (self._foot_up - q.d)
-        )
-        c, s = np.cos(q.theta), np.sin(q.theta)
-        m_leg = self.params.leg_mass
-        hips = self._hip_sums
-        moment = (
-            m_leg * hips[0] + m_moving * float(q.x.sum()),
-            m_leg * hips[1] + float((y * c - z * s).sum()),
-            m_leg * hips[2] + float((y * s + z * c).sum()),
-        )
-        return np.array(moment) / self.total_mass
+        return self.feet_and_cog(joints)[1]
 
     def inertia(self, joints: np.ndarray, cog: np.ndarray | None = None) -> np.ndarray:
         """(3, 3) inertia about the CoG, body frame [kg m²]: body box + feet-end leg masses.

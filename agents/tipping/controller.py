@@ -338,17 +338,18 @@ class TippingRecoveryController:
         self._filter(reading)
         rot = quat_to_matrix(reading.quat)
         joints = np.asarray(reading.joints, dtype=float).reshape(6, 3)
-        feet = self.body.feet(joints)
-        cog = self.body.cog(joints)
+        feet, cog = self.body.feet_and_cog(joints)
         forces = forces_to_body(reading.foot_forces, rot)
-        loaded = (forces * forces).sum(axis=1) > self._contact_sq
+        loaded = np.add.reduce(forces * forces, axis=1) > self._contact_sq  # .sum(axis=1)
         margin, edge = self._margin(feet, forces, cog, loaded)
         self.history.add(time, margin)
         d = self.diagnostics
         self._previous_margin = d["fasm_deg"]
         d["fasm_deg"] = margin
         d["fasm_edge"] = None if edge is None else (LEG_NAMES[edge[0]], LEG_NAMES[edge[1]])
-        d["stance_legs"] = tuple(leg for leg, on in zip(LEG_NAMES, loaded, strict=True) if on)
+        d["stance_legs"] = tuple(
+            leg for leg, on in zip(LEG_NAMES, loaded.tolist(), strict=True) if on
+        )
 
         if self.phase == "monitor":
             if margin < cfg.threshold_deg and time >= cfg.arm_after and loaded.sum() >= 3:
@@ -554,7 +555,7 @@ class TippingRecoveryController:
         held = self._support_idx
         in_contact = loaded[held]
         support = held[in_contact]
-        complete = bool(in_contact.all())
+        complete = bool(np.logical_and.reduce(in_contact))  # .all(), minus its wrapper
         self._steps_supported += 1
         d["qp_legs"] = tuple(LEG_NAMES[i] for i in support.tolist())
         measured = d["measured_forces"] = forces[support]

@@ -77,10 +77,12 @@ def fit_plane(points) -> Plane:
     k = pts.shape[0]
     if k < 3:
         raise ValueError(f"fitting a plane needs at least 3 points, got {k}")
-    if not np.isfinite(pts).all():
+    rows = pts.tolist()
+    # A finite sum proves every entry finite; only a non-finite one needs the element check.
+    if not math.isfinite(sum(map(sum, rows))) and not np.isfinite(pts).all():
         raise ValueError("points contains NaN or infinite values")
     # Plain floats: numpy reductions cost more than the arithmetic for a few feet.
-    (x0, y0, z0), (sxx, sxy, sxz, syy, syz, _) = centred_moments(pts.tolist())
+    (x0, y0, z0), (sxx, sxy, sxz, syy, syz, _) = centred_moments(rows)
     det = sxx * syy - sxy * sxy
     if not det > REL_TOL * (sxx + syy) ** 2:
         raise ValueError(

@@ -197,9 +197,9 @@ class PostureEstimate:
 class _Plan:
     """One phase's foot paths: Bezier control points of the swing legs, lines of the stance legs."""
 
-    swing: list[int]  # leg indices
+    swing: slice | list[int]  # rows of the swing legs (see _rows)
     swing_points: np.ndarray  # (3, 4, 3) control points per swing leg
-    stance: list[int]
+    stance: slice | list[int]  # rows of the stance legs
     stance_start: np.ndarray  # (3, 3) p_{i,0}
     stance_delta: np.ndarray  # (3, 3) p_{i,f} - p_{i,0}
 
@@ -291,6 +291,7 @@ class AthenaPostureController:
         self.ground_search = ground_search
         self.rng = rng
         self._iks = [leg_ik(leg, params) for leg in LEG_NAMES]
+        self._solvers = [ik.solve for ik in self._iks]  # bound once (six calls every tick)
         self._gains = _checked_gains(kz, k_alpha, k_beta)
         self.reset()
 
@@ -379,8 +380,9 @@ class AthenaPostureController:
     def step(self, sensors: AthenaSensors) -> np.ndarray:
         """One control tick: (6, 3) joint-angle targets from the current sensor readings."""
         q, forces, height = _checked_sensors(sensors)
-        contact = forces > self.contact_threshold
-        if self._tick == 0:
+        if self._tick == 0:  # forces only matter at a phase start
+            forces = _normal_forces(forces)
+            contact = forces > self.contact_threshold
             stance = _TRIPOD_INDICES[(self._phase_index + 2) % 2]
             missing = [i for i in stance if not contact[i]]
             if missing and self._searches_ground() and self._extension < self.max_extension:
@@ -441,11 +443,11 @@ class AthenaPostureController:
         rotation = posture_rotation(ka * d_pitch, kb * d_roll)
         stance_end = [stance_end_point(start[i], stride, kz * d_z, rotation) for i in stance]
         self._plan = _Plan(
-            swing=list(swing),
+            swing=_rows(swing),
             swing_points=np.array(
                 [swing_control_points(start[i], stride, self.swing_height, kz * d_z) for i in swing]
             ),
-            stance=list(stance),
+            stance=_rows(stance),
             stance_start=start[list(stance)],
             stance_delta=np.array(stance_end) - start[list(stance)],
         )
@@ -490,14 +492,23 @@ class AthenaPostureController:
 
     def _joint_targets(self) -> np.ndarray:
         """IK of the commanded feet; unreachable points get the nearest reachable pose."""
-        rows, clamped = [], []
-        for ik, (x, y, z) in zip(self._iks, self._command.tolist(), strict=True):
-            t2, t3, t4, problem = ik.solve(x, y, z)
-            rows.append((t2, t3, t4))
-            if problem is not None:
-                clamped.append(ik.leg)
-        self.clamped_legs = tuple(clamped)
-        return np.array(rows)
+        solutions = [
+            solve(x, y, z)
+            for solve, (x, y, z) in zip(self._solvers, self._command.tolist(), strict=True)
+        ]
+        self.clamped_legs = tuple(
+            leg for leg, sol in zip(LEG_NAMES, solutions, strict=True) if sol[3] is not None
+        )
+        return np.array([sol[:3] for sol in solutions])
+
+
+def _rows(legs: tuple[int, ...]) -> slice | list[int]:
+    """Index of the rows ``legs``: a slice when they are evenly spaced (the tripods are rows
+    0, 2, 4 and 1, 3, 5), which numpy assigns through about three times faster than a list."""
+    step = legs[1] - legs[0] if len(legs) > 1 else 1
+    if step > 0 and list(legs) == list(range(legs[0], legs[-1] + 1, step)):
+        return slice(legs[0], legs[-1] + 1, step)
+    return list(legs)
 
 
 def _checked_gains(kz: float, k_alpha: float, k_beta: float) -> tuple[float, float, float]:
@@ -509,12 +520,17 @@ def _checked_gains(kz: float, k_alpha: float, k_beta: float) -> tuple[float, flo
 
 
 def _checked_sensors(sensors: AthenaSensors) -> tuple[np.ndarray, np.ndarray, float]:
+    """(joint angles (6, 3), foot forces (6,) or (6, 3) as given, torso height), validated."""
     q = np.asarray(sensors.joint_angles, dtype=float)
     if q.shape != (6, 3):
         raise ValueError(f"joint_angles must have shape (6, 3) (rows {LEG_NAMES}), got {q.shape}")
     f = np.asarray(sensors.foot_forces, dtype=float)
-    if f.shape == (6, 3):
-        f = np.linalg.norm(f, axis=1)
-    elif f.shape != (6,):
+    if f.shape != (6, 3) and f.shape != (6,):
         raise ValueError(f"foot_forces must have shape (6,) or (6, 3), got {f.shape}")
     return q, f, float(sensors.torso_height)
+
+
+def _normal_forces(f: np.ndarray) -> np.ndarray:
+    """(6,) force magnitudes from validated (6,) or (6, 3) foot forces: the vectors' norms
+    (np.linalg.norm(f, axis=1), computed without its wrapper)."""
+    return np.sqrt(np.add.reduce(f * f, axis=1)) if f.ndim == 2 else f

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import functools
 import math
+from math import acos, atan2, cos, hypot, sin
 
 import numpy as np
 
@@ -121,6 +122,13 @@ class LegIK:
         self.theta1 = params.mounting_angle(leg)
         self.l2, self.l3, self.l4 = params.l2, params.l3, params.l4
         self.ranges = tuple(tuple(r) for r in params.joint_ranges.tolist())
+        l2, l3, l4 = self.l2, self.l3, self.l4
+        # Everything `solve` reads, unpacked in one go (it runs for six legs every tick); the
+        # derived constants are the very expressions `solve` used to evaluate per call.
+        self._constants = (
+            *self.hip, self.theta1, l2, l3, l4, *(v for r in self.ranges for v in r),
+            l3 * l3, l4 * l4, 2 * l3 * l4, abs(l3 - l4) + 1e-12, l3 + l4 - 1e-12,
+        )  # fmt: skip
 
     def solve(self, x: float, y: float, z: float) -> tuple[float, float, float, str | None]:
         """(theta_2, theta_3, theta_4, problem) for the foot centre at body-frame (x, y, z), m.
@@ -129,24 +137,26 @@ class LegIK:
         and the angles are the nearest pose the servos can take (distance clamped to the
         reachable annulus, angles to the joint ranges).
         """
-        hx, hy, hz = self.hip
+        (
+            hx, hy, hz, theta1, l2, l3, l4, lo2, hi2, lo3, hi3, lo4, hi4,
+            l3_sq, l4_sq, two_l3_l4, s_low, s_high,
+        ) = self._constants  # fmt: skip
         dx, dy, dz = x - hx, y - hy, z - hz
-        l2, l3, l4 = self.l2, self.l3, self.l4
-        (lo2, hi2), (lo3, hi3), (lo4, hi4) = self.ranges
 
         # Eq. (14): TC angle = azimuth of the foot about the hip, relative to the mounting angle.
-        t2 = _wrap(math.atan2(dy, dx) - self.theta1)
-        horizontal = math.hypot(dx, dy)
+        a2 = atan2(dy, dx) - theta1
+        t2 = atan2(sin(a2), cos(a2))  # _wrap, inlined (six legs every tick)
+        horizontal = hypot(dx, dy)
         if not lo2 <= t2 <= hi2 and lo2 <= _wrap(t2 + math.pi) <= hi2:
             # Foot horizontally behind the hip (femur down, tibia folded back under the body):
             # the coxa points away from the foot and the foot's reach along it is negative.
             t2, horizontal = _wrap(t2 + math.pi), -horizontal
         # Planar problem in the leg's vertical plane, origin at the CTr joint (frame U, eq. 16).
         rho, zz = horizontal - l2, dz
-        s = math.hypot(rho, zz)
-        s_min, s_max = abs(l3 - l4), l3 + l4
+        s = hypot(rho, zz)
         problem = None
-        if not s_min + 1e-12 <= s <= s_max - 1e-12:
+        if not s_low <= s <= s_high:
+            s_min, s_max = abs(l3 - l4), l3 + l4
             problem = (
                 f"is out of reach of leg {self.leg}: distance {s:.4f} m from the CTr joint, "
                 f"reachable [{s_min:.4f}, {s_max:.4f}] m"
@@ -158,10 +168,18 @@ class LegIK:
                 rho, zz = s_new, 0.0
             s = s_new
         # Eqs. (17)-(18), knee-up branch (theta_4 < 0).
-        c4 = (s * s - l3 * l3 - l4 * l4) / (2 * l3 * l4)
-        t4 = -math.acos(min(1.0, max(-1.0, c4)))
-        t3 = _wrap(math.atan2(zz, rho) - math.atan2(l4 * math.sin(t4), l3 + l4 * math.cos(t4)))
+        c4 = (s * s - l3_sq - l4_sq) / two_l3_l4
+        t4 = -acos(c4 if -1.0 <= c4 <= 1.0 else min(1.0, max(-1.0, c4)))
+        a3 = atan2(zz, rho) - atan2(l4 * sin(t4), l3 + l4 * cos(t4))
+        t3 = atan2(sin(a3), cos(a3))  # _wrap, inlined
 
+        if (
+            problem is None
+            and lo2 - 1e-9 <= t2 <= hi2 + 1e-9
+            and lo3 - 1e-9 <= t3 <= hi3 + 1e-9
+            and lo4 - 1e-9 <= t4 <= hi4 + 1e-9
+        ):
+            return t2, t3, t4, None  # the usual case, without building the lists below
         q = (t2, t3, t4)
         bounds = ((lo2, hi2), (lo3, hi3), (lo4, hi4))
         bad = [k for k in range(3) if not bounds[k][0] - 1e-9 <= q[k] <= bounds[k][1] + 1e-9]
