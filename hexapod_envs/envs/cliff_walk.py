@@ -155,7 +155,7 @@ class CliffWalkEnv(HeavyDutyEnv):
             **self._sample_payload(rng, distribution),
         }
 
-    def _rebuild_needed(self, task: dict) -> bool:
+    def _set_terrain(self, task: dict) -> bool:
         cliff = {
             "start_x": task["cliff_x"],
             "side": task["cliff_side"],

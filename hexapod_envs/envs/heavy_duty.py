@@ -205,7 +205,7 @@ class HeavyDutyEnv(HexapodEnv):
     def _apply_task(self, task: dict) -> None:
         """Rebuild the model when the task changes it, then place the payload (a point mass
         added to the body at its CoG offset; the body's inertia is kept)."""
-        if self._rebuild_needed(task):
+        if self._set_terrain(task):
             self._build_model()
         m = self.model
         torso = self.sensors.torso_id
@@ -220,8 +220,9 @@ class HeavyDutyEnv(HexapodEnv):
         m.body_ipos[torso, :2] = (self._torso_mass0 * self._torso_ipos0[:2] + mass * offset) / total
         mujoco.mj_setConst(m, self.data)
 
-    def _rebuild_needed(self, task: dict) -> bool:
-        """Whether the task changes the terrain geometry (the model is then rebuilt)."""
+    def _set_terrain(self, task: dict) -> bool:
+        """Take the task's terrain (geometry, friction); True if it changed (the model is then
+        rebuilt)."""
         return False
 
     # --- measurements ----------------------------------------------------------------------

@@ -74,8 +74,7 @@ class TiltTaskRanges(TaskRanges):
 
     Held-out test ranges (`TILT_TEST`): tilt rates interleaved with and beyond training (4-8 and
     12-20 deg/s against 1-4 and 8-12), where the time budget of Zhang et al. 2024 eq. 15 binds;
-    lower
-    platform friction; a heavier payload (see `HeavyDutyEnv.PAYLOAD_RANGES`).
+    lower platform friction; a heavier payload (see `HeavyDutyEnv.PAYLOAD_RANGES`).
     """
 
     rates_deg_s: tuple[tuple[float, float], ...]
@@ -258,7 +257,7 @@ class StewartTiltEnv(HeavyDutyEnv):
             **self._sample_payload(rng, distribution),
         }
 
-    def _rebuild_needed(self, task: dict) -> bool:
+    def _set_terrain(self, task: dict) -> bool:
         if task["platform_friction"] == self.platform_friction:
             return False
         self.platform_friction = task["platform_friction"]
@@ -270,7 +269,11 @@ class StewartTiltEnv(HeavyDutyEnv):
         self._configure(scenario, STANCES[task["stance"]], np.radians(task["tilt_rate_deg"]), axis)
         self.max_tilt = min(self.max_tilt, 0.95 * self.platform.max_tilt(axis))
 
-    def _set_initial_state(self) -> None:
+    def _apply_task(self, task: dict) -> None:
+        """The platform friction and payload (see `HeavyDutyEnv`), then the episode's tilt:
+        the sampled one, or with the "random" paper scenario an axis, rate and stance drawn
+        here from `np_random` (added to ``info["task"]``)."""
+        super()._apply_task(task)
         if self.task_distribution != "paper":
             self._configure_sampled(self.task)
         elif self.scenario == "random":
@@ -288,6 +291,8 @@ class StewartTiltEnv(HeavyDutyEnv):
                 tilt_axis_y=float(axis[1]),
                 tilt_rate_deg=float(np.degrees(rate)),
             )
+
+    def _set_initial_state(self) -> None:
         self.data.qpos[self._platform_qpos] = 0.0
         self.data.ctrl[self._platform_act] = 0.0
         self.data.act[self.model.actuator_actadr[self._platform_act]] = 0.0
