@@ -171,3 +171,18 @@ def test_task_description_is_declared_and_frozen(env_id):
         desc.control_dt = 1.0
     with pytest.raises(TypeError):
         desc.course["x"] = 1.0
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_numeric_info_values_are_finite_or_nan_by_contract(env_id):
+    from hexapod_envs.info_keys import UNDEFINED_AS_NAN
+
+    env = gym.make(env_id, task_distribution="train")
+    _, info = env.reset(seed=5)
+    infos = [info] + [env.step(env.action_space.sample())[4] for _ in range(30)]
+    for info in infos:
+        for key, value in info.items():
+            if key in UNDEFINED_AS_NAN or isinstance(value, (str, tuple, dict, type(None))):
+                continue
+            assert np.all(np.isfinite(np.asarray(value, dtype=float))), (key, value)
+    env.close()
