@@ -230,6 +230,13 @@ class EvalConfig:
     freq: int = 20_000
     n_episodes: int = 5
     deterministic: bool = True
+    same_tasks: bool = False
+    """Reseed the evaluation env before every evaluation, so that every checkpoint (and step 0)
+    is scored on the same `n_episodes` tasks; false: each evaluation draws new tasks (the task
+    mix then adds to the differences between checkpoints)."""
+    select: Literal["reward", "success"] = "reward"
+    """What ``best/`` keeps: the highest mean evaluation return (SB3's rule), or the highest
+    success rate with the mean return breaking ties."""
 
     def __post_init__(self):
         _require("eval.freq", self.freq, ">= 0 (0 disables evaluation)", self.freq >= 0)
