@@ -351,3 +351,26 @@ def test_each_policy_is_evaluated_in_the_action_mode_it_was_built_for(run):
     assert policy_env_kwargs("zero", "HexapodCliffWalk-v0") == {}
     trained = policy_env_kwargs(f"ppo:{run[0]}", "HexapodCliffWalk-v0")
     assert trained == {"action_mode": "residual", "residual_scale": 0.25}
+
+
+def test_reward_exclude_takes_the_named_terms_out_of_the_reward():
+    """env.reward_exclude: the learner's reward is the env's minus those info terms; a term the
+    env does not report is an error at the first step."""
+    from agents.pipeline.envs import EnvSpec
+    from agents.pipeline.errors import UserError
+
+    plain = EnvSpec("HexapodCliffWalk-v0", gym_packages=["hexapod_envs"]).make()
+    spec = EnvSpec("HexapodCliffWalk-v0", gym_packages=["hexapod_envs"], reward_exclude=["alive"])
+    without = spec.make()
+    for env in (plain, without):
+        env.reset(seed=0)
+    for _ in range(3):
+        _, r0, *_, info = plain.step(np.zeros(18))
+        _, r1, *_ = without.step(np.zeros(18))
+        assert info["reward_alive"] > 0
+        assert r1 == pytest.approx(r0 - info["reward_alive"])
+    bad = EnvSpec("HexapodCliffWalk-v0", gym_packages=["hexapod_envs"], reward_exclude=["alivee"])
+    env = bad.make()
+    env.reset(seed=0)
+    with pytest.raises(UserError, match="reward_alivee"):
+        env.step(np.zeros(18))

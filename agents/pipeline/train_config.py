@@ -66,6 +66,9 @@ class EnvConfig:
     max_episode_steps: int | None = None  # None: the registered time limit
     gym_packages: list[str] = field(default_factory=lambda: list(DEFAULT_GYM_PACKAGES))
     # modules imported (by name) before gym.make so that their env ids are registered
+    reward_exclude: list[str] = field(default_factory=list)
+    """Reward terms (``info["reward_<term>"]``) taken out of the reward the learner sees
+    (`agents.pipeline.envs.ExcludeRewardTerms`); the evaluation reports the env's own return."""
 
 
 @dataclass

@@ -70,7 +70,12 @@ class TrainResult:
 def env_spec(config: TrainConfig) -> EnvSpec:
     env = config.env
     return EnvSpec(
-        env.id, dict(env.kwargs), env.max_episode_steps, list(env.gym_packages), config.hybrid
+        env.id,
+        dict(env.kwargs),
+        env.max_episode_steps,
+        list(env.gym_packages),
+        config.hybrid,
+        list(env.reward_exclude),
     )
 
 
