@@ -321,6 +321,28 @@ def test_zero_initialised_action_net_starts_at_the_reference_and_is_evaluated_at
         assert list(log["timesteps"]) == [0, 256]
 
 
+def test_same_tasks_evaluations_score_every_checkpoint_on_the_same_tasks(tmp_path):
+    """eval.same_tasks reseeds the evaluation env: with a frozen policy every evaluation repeats
+    the first exactly (without it, each evaluation draws new tasks); eval.select=success keeps
+    best/ by success rate, then return, and writes both to its meta.json."""
+    extra = [*TINY, "train.total_timesteps=512", "policy.zero_init_action_net=true"]
+    extra += ["eval.freq=256", "eval.n_episodes=2", "ppo.learning_rate=1e-12"]
+    extra += ["env.kwargs={task_distribution: train}"]
+    logs = {}
+    for same in (True, False):
+        name = f"same_{same}"
+        both = [f"eval.same_tasks={str(same).lower()}", "eval.select=success"]
+        assert train(tmp_path, name, overrides=[*extra, *both]) == 0
+        with np.load(tmp_path / name / "evaluations.npz") as log:
+            logs[same] = log["results"]
+    assert logs[True].shape == (3, 2)
+    np.testing.assert_array_equal(logs[True][1:], np.repeat(logs[True][:1], 2, axis=0))
+    assert not np.array_equal(logs[False][0], logs[False][1])
+    best = meta(tmp_path / "same_True" / "best")
+    assert best["num_timesteps"] == 0 and "eval_success_rate" in best
+    assert best["eval_mean_reward"] == pytest.approx(float(logs[True][0].mean()))
+
+
 def test_each_policy_is_evaluated_in_the_action_mode_it_was_built_for(run):
     from agents.pipeline.evaluation import policy_env_kwargs
 
@@ -329,3 +351,26 @@ def test_each_policy_is_evaluated_in_the_action_mode_it_was_built_for(run):
     assert policy_env_kwargs("zero", "HexapodCliffWalk-v0") == {}
     trained = policy_env_kwargs(f"ppo:{run[0]}", "HexapodCliffWalk-v0")
     assert trained == {"action_mode": "residual", "residual_scale": 0.25}
+
+
+def test_reward_exclude_takes_the_named_terms_out_of_the_reward():
+    """env.reward_exclude: the learner's reward is the env's minus those info terms; a term the
+    env does not report is an error at the first step."""
+    from agents.pipeline.envs import EnvSpec
+    from agents.pipeline.errors import UserError
+
+    plain = EnvSpec("HexapodCliffWalk-v0", gym_packages=["hexapod_envs"]).make()
+    spec = EnvSpec("HexapodCliffWalk-v0", gym_packages=["hexapod_envs"], reward_exclude=["alive"])
+    without = spec.make()
+    for env in (plain, without):
+        env.reset(seed=0)
+    for _ in range(3):
+        _, r0, *_, info = plain.step(np.zeros(18))
+        _, r1, *_ = without.step(np.zeros(18))
+        assert info["reward_alive"] > 0
+        assert r1 == pytest.approx(r0 - info["reward_alive"])
+    bad = EnvSpec("HexapodCliffWalk-v0", gym_packages=["hexapod_envs"], reward_exclude=["alivee"])
+    env = bad.make()
+    env.reset(seed=0)
+    with pytest.raises(UserError, match="reward_alivee"):
+        env.step(np.zeros(18))

@@ -118,9 +118,20 @@ class StatsEvalCallback(EvalCallback):
     """EvalCallback that also logs FASM/success statistics of its evaluation episodes."""
 
     def __init__(
-        self, *args: Any, new_accumulator: Callable[[], EpisodeAccumulator], **kwargs: Any
+        self,
+        *args: Any,
+        new_accumulator: Callable[[], EpisodeAccumulator],
+        task_seed: int | None = None,
+        select_saver: ModelSaver | None = None,
+        **kwargs: Any,
     ):
+        """`new_accumulator`: makes the accumulator of one evaluation episode. `task_seed`:
+        reseed the evaluation env with it before every evaluation (the same tasks each time).
+        `select_saver`: keep ``best/`` by success rate, then mean return (instead of SB3's mean
+        return; pass no ``callback_on_new_best`` then)."""
         super().__init__(*args, **kwargs)
+        self.task_seed, self.select_saver = task_seed, select_saver
+        self.best_score: tuple[float, float] | None = None
         self._make_accumulators = new_accumulator
         self._accumulators: dict[int, EpisodeAccumulator] = {}
 
@@ -134,7 +145,30 @@ class StatsEvalCallback(EvalCallback):
 
     def _on_step(self) -> bool:
         self._accumulators = {}
-        return super()._on_step()
+        evaluating = self.eval_freq > 0 and self.n_calls % self.eval_freq == 0
+        if evaluating and self.task_seed is not None:
+            self.eval_env.seed(self.task_seed)
+        done_before = len(self.evaluations_timesteps)
+        continue_training = super()._on_step()
+        if self.select_saver is not None and len(self.evaluations_timesteps) > done_before:
+            score = self.score(len(self.evaluations_timesteps) - 1)
+            if self.best_score is None or score > self.best_score:
+                self.best_score = score
+                saver = self.select_saver
+                saver.save(
+                    self.model,
+                    "best",
+                    saver.run_dir / BEST,
+                    eval_mean_reward=score[1],
+                    eval_success_rate=score[0],
+                )
+        return continue_training
+
+    def score(self, i: int) -> tuple[float, float]:
+        """(success rate, mean return) of evaluation `i`; success 0 when the env reports none."""
+        successes = self.evaluations_successes[i] if i < len(self.evaluations_successes) else []
+        rate = float(sum(successes)) / len(successes) if len(successes) else 0.0
+        return rate, float(sum(self.evaluations_results[i]) / len(self.evaluations_results[i]))
 
     def _log_success_callback(self, locals_: dict[str, Any], globals_: dict[str, Any]) -> None:
         super()._log_success_callback(locals_, globals_)

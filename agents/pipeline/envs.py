@@ -69,6 +69,9 @@ class EnvSpec:
     hybrid: Any = None
     """`agents.hybrid.HybridSettings` (or the training config's ``hybrid`` section): wrap the env
     so that actions are combined with its analytical controller; None: the env as it is."""
+    reward_exclude: list[str] = field(default_factory=list)
+    """Reward terms (``info["reward_<term>"]``) taken out of the reward the learner sees (see
+    `ExcludeRewardTerms`); empty: the env's reward."""
 
     def make(self, **extra: Any) -> gym.Env:
         """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
@@ -82,15 +85,40 @@ class EnvSpec:
         except (TypeError, ValueError) as exc:
             message = str(exc).split(" was raised from the environment creator")[0]
             raise UserError(f"cannot create {self.id} with {self.kwargs}: {message}") from None
-        if self.hybrid is None:
-            return env
-        from ..hybrid import wrap
+        if self.hybrid is not None:
+            from ..hybrid import wrap
 
-        try:
-            return wrap(env, self.hybrid)
-        except ValueError as exc:
-            env.close()
-            raise UserError(f"cannot build the hybrid policy env on {self.id}: {exc}") from None
+            try:
+                env = wrap(env, self.hybrid)
+            except ValueError as exc:
+                env.close()
+                raise UserError(
+                    f"cannot build the hybrid policy env on {self.id}: {exc}"
+                ) from None
+        if self.reward_exclude:
+            env = ExcludeRewardTerms(env, self.reward_exclude)
+        return env
+
+
+class ExcludeRewardTerms(gym.Wrapper):
+    """The env's reward minus the named terms of its ``info["reward_<term>"]`` breakdown.
+
+    For terms that drown what a run should learn, e.g. the irregular terrain's ``alive`` term in
+    the "gains" mode: it pays the bound of every cost (rate_weight x 4 rad²/s² for the rate term
+    alone) on every upright step, ~2000 times the rate term's differences between gain settings.
+    A term missing from an info dict is an error (a misspelt name must not train silently)."""
+
+    def __init__(self, env: gym.Env, terms: Sequence[str]):
+        super().__init__(env)
+        self.keys = [f"reward_{t}" for t in terms]
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        missing = [k for k in self.keys if k not in info]
+        if missing and not info.get("sim_unstable", False):
+            raise UserError(f"reward_exclude: no {', '.join(missing)} in the env's info")
+        reward = float(reward) - sum(float(info.get(k, 0.0)) for k in self.keys)
+        return obs, reward, terminated, truncated, info
 
 
 class EnvFactory:

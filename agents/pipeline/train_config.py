@@ -66,6 +66,9 @@ class EnvConfig:
     max_episode_steps: int | None = None  # None: the registered time limit
     gym_packages: list[str] = field(default_factory=lambda: list(DEFAULT_GYM_PACKAGES))
     # modules imported (by name) before gym.make so that their env ids are registered
+    reward_exclude: list[str] = field(default_factory=list)
+    """Reward terms (``info["reward_<term>"]``) taken out of the reward the learner sees
+    (`agents.pipeline.envs.ExcludeRewardTerms`); the evaluation reports the env's own return."""
 
 
 @dataclass
@@ -230,6 +233,13 @@ class EvalConfig:
     freq: int = 20_000
     n_episodes: int = 5
     deterministic: bool = True
+    same_tasks: bool = False
+    """Reseed the evaluation env before every evaluation, so that every checkpoint (and step 0)
+    is scored on the same `n_episodes` tasks; false: each evaluation draws new tasks (the task
+    mix then adds to the differences between checkpoints)."""
+    select: Literal["reward", "success"] = "reward"
+    """What ``best/`` keeps: the highest mean evaluation return (SB3's rule), or the highest
+    success rate with the mean return breaking ties."""
 
     def __post_init__(self):
         _require("eval.freq", self.freq, ">= 0 (0 disables evaluation)", self.freq >= 0)

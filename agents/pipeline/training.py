@@ -72,7 +72,12 @@ class TrainResult:
 def env_spec(config: TrainConfig) -> EnvSpec:
     env = config.env
     return EnvSpec(
-        env.id, dict(env.kwargs), env.max_episode_steps, list(env.gym_packages), config.hybrid
+        env.id,
+        dict(env.kwargs),
+        env.max_episode_steps,
+        list(env.gym_packages),
+        config.hybrid,
+        list(env.reward_exclude),
     )
 
 
@@ -297,17 +302,20 @@ def _learn(
     if config.checkpoint.freq > 0:
         callbacks.append(CheckpointEvery(config.checkpoint.freq, saver))
     if eval_env is not None:
+        by_success = config.eval.select == "success"
         eval_cb = StatsEvalCallback(
             eval_env,
             n_eval_episodes=config.eval.n_episodes,
             eval_freq=max(config.eval.freq // config.vec_env.n_envs, 1),
             log_path=str(run_dir),
             deterministic=config.eval.deterministic,
-            callback_on_new_best=SaveBest(saver),
+            callback_on_new_best=None if by_success else SaveBest(saver),
             callback_after_eval=after_eval,
             warn=False,
             verbose=config.logging.verbose,
             new_accumulator=new_accumulator,
+            task_seed=config.train.seed + EVAL_SEED_OFFSET if config.eval.same_tasks else None,
+            select_saver=saver if by_success else None,
         )
         if resumed:
             _restore_eval_history(eval_cb, run_dir)
@@ -472,6 +480,10 @@ def _restore_eval_history(eval_cb: Any, run_dir: Path) -> None:
             eval_cb.evaluations_length = [list(r) for r in data["ep_lengths"]]
             if "successes" in data:
                 eval_cb.evaluations_successes = [list(r) for r in data["successes"]]
+        if eval_cb.select_saver is not None and eval_cb.evaluations_results:
+            eval_cb.best_score = max(
+                eval_cb.score(i) for i in range(len(eval_cb.evaluations_results))
+            )
     except (OSError, ValueError, KeyError, EOFError) as exc:
         print(
             f"warning: the evaluation log {log} is unreadable ({exc}); it starts anew",
