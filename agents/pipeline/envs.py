@@ -92,9 +92,7 @@ class EnvSpec:
                 env = wrap(env, self.hybrid)
             except ValueError as exc:
                 env.close()
-                raise UserError(
-                    f"cannot build the hybrid policy env on {self.id}: {exc}"
-                ) from None
+                raise UserError(f"cannot build the hybrid policy env on {self.id}: {exc}") from None
         if self.reward_exclude:
             env = ExcludeRewardTerms(env, self.reward_exclude)
         return env
