@@ -87,8 +87,8 @@ def env_piece_costs(terrain: str = "ramp") -> dict[str, float]:
         "  of which FASM": per_call_us(fasm_from_feet, feet, forces, cog, loaded, repeat=4000),
         "  of which ZMP margin": per_call_us(zmp_margin, torso_feet, normal, repeat=4000),
         "observation": per_call_us(base._observation, repeat=4000),
-        "info dict": per_call_us(base._info, {}, False, None, repeat=4000),
-        "action check": per_call_us(base._validate_action, action, base.action_space, repeat=4000),
+        "info dict": per_call_us(base._info, {}, False, repeat=4000),
+        "action check": per_call_us(base._validate_action, action, repeat=4000),
     }
     env.close()
     return costs
