@@ -57,7 +57,9 @@ def run(
     env_kwargs: dict | None = None,
     **policy_kwargs,
 ) -> dict:
-    """One episode; per-step time series and the controller's final diagnostics.
+    """One episode; per-step time series, the controller's final diagnostics, and the stability
+    cone's λ of every supported-phase QP step (``cone_ratios``; NaN: solved without the cone,
+    None: no QP that step).
 
     `env_kwargs` go to the env (e.g. tilt_rate_deg, max_tilt_deg), `policy_kwargs` to
     TippingRecoveryPolicy."""
@@ -67,7 +69,7 @@ def run(
     obs, info = env.reset(seed=seed)
     if policy is not None:
         policy.reset()
-    rows, planned = [], []
+    rows, planned, cone = [], [], []
     while True:
         action = policy(obs) if policy is not None else np.zeros(18)
         obs, _, terminated, truncated, info = env.step(action)
@@ -75,6 +77,8 @@ def run(
         fz = forces_to_body(obs[s["foot_force"]], rot)[:, 2]
         edge = "-".join(info["fasm_edge"]) if info["fasm_edge"] else "none"
         rows.append((info["time"], info["fasm_margin_deg"], info["platform_tilt_deg"], edge, fz))
+        if policy is not None and policy.diagnostics["phase"] == "supported":
+            cone.append(policy.diagnostics["qp_cone_ratio"])
         if policy is not None and policy.diagnostics["planned_forces"] is not None:
             d = policy.diagnostics
             plan = dict(zip(d["qp_legs"], d["planned_forces"][:, 2], strict=True))
@@ -93,6 +97,7 @@ def run(
         "tipped": bool(info["is_tipped_over"]),
         "end_time": float(info["time"]),
         "diagnostics": dict(policy.diagnostics) if policy is not None else None,
+        "cone_ratios": cone,
         "env_adjustment_leg": info.get("adjustment_leg"),
     }
 
