@@ -165,23 +165,37 @@ def upu_kinematics_rows() -> list[dict]:
     ]
 
 
-def athena_rows(seeds=range(4), steps: int = 1200, env_kwargs: dict | None = None) -> list[dict]:
+def athena_rows(
+    seeds=range(4),
+    steps: int = 1200,
+    env_kwargs: dict | None = None,
+    blocks_kwargs: dict | None = None,
+) -> list[dict]:
     """Rows 8-11 (Coelho et al. 2024 §5.2): posture vs simple control on the ramp and the block bed,
-    measured with agents.athena_study.compare (the posture study's protocol, default env)."""
+    measured with agents.athena_study.compare (the posture study's protocol, default env).
+
+    `env_kwargs` apply to both terrains, `blocks_kwargs` to the block bed only; each row's id gets
+    the suffix "@" + the kwargs of its terrain.
+    """
     from agents.athena_study import compare
 
     d = {"seeds": list(seeds), "steps": steps}
+    kwargs = {
+        "ramp": dict(env_kwargs or {}),
+        "blocks": {**(env_kwargs or {}), **(blocks_kwargs or {})},
+    }
     for terrain in ("ramp", "blocks"):
-        result = compare(terrain, d["seeds"], steps=steps, **(env_kwargs or {}))
+        result = compare(terrain, d["seeds"], steps=steps, **kwargs[terrain])
         d[terrain] = {"summary": result["summary"], "change_pct": result["change_pct"]}
     ramp, blocks = d["ramp"], d["blocks"]
     rc, bc = ramp["change_pct"], blocks["change_pct"]
     n = len(d["seeds"])
-    setting = (
-        f"HexapodIrregularTerrain-v0 {env_kwargs or 'default env (servo_kp 8 N m/rad)'}, "
-        f"seeds 0-{n - 1} x "
-        f"{d['steps']} steps, medians of per-cycle RMS, posture vs simple (paper gains)"
+    protocol = (
+        f"seeds 0-{n - 1} x {d['steps']} steps, medians of per-cycle RMS, posture vs simple "
+        "(paper gains)"
     )
+    default = "default env (servo_kp 8 N m/rad, 0.1 m blocks)"
+    settings = {t: f"HexapodIrregularTerrain-v0 {kwargs[t] or default}, {protocol}" for t in kwargs}
     bs, bp = blocks["summary"]["simple"], blocks["summary"]["posture"]
 
     def r(x):
@@ -198,7 +212,7 @@ def athena_rows(seeds=range(4), steps: int = 1200, env_kwargs: dict | None = Non
             "%",
             ">= +40",
             rc["height"] >= 40.0,
-            setting,
+            settings["ramp"],
         ),
         _row(
             "9",
@@ -209,7 +223,7 @@ def athena_rows(seeds=range(4), steps: int = 1200, env_kwargs: dict | None = Non
             "%",
             "< 0",
             rc["roll_rate"] < 0.0,
-            setting,
+            settings["ramp"],
         ),
         _row(
             "10",
@@ -220,7 +234,7 @@ def athena_rows(seeds=range(4), steps: int = 1200, env_kwargs: dict | None = Non
             "%",
             "<= 0",
             rc["pitch_rate"] <= 0.0,
-            setting,
+            settings["ramp"],
         ),
         _row(
             "11",
@@ -231,7 +245,8 @@ def athena_rows(seeds=range(4), steps: int = 1200, env_kwargs: dict | None = Non
             "steps",
             "posture 0 in >= 3 of 4 seeds, simple > 0 in all",
             posture_free >= 3 and bs["episodes_with_collision"] == n,
-            setting + f"; posture touched in {bp['episodes_with_collision']} of {n} episodes",
+            settings["blocks"]
+            + f"; posture touched in {bp['episodes_with_collision']} of {n} episodes",
         ),
         _row(
             "11b",
@@ -242,7 +257,7 @@ def athena_rows(seeds=range(4), steps: int = 1200, env_kwargs: dict | None = Non
             "%",
             "same sign as paper",
             bc["pitch_rate"] > 0,
-            setting,
+            settings["blocks"],
         ),
         _row(
             "11c",
@@ -253,7 +268,7 @@ def athena_rows(seeds=range(4), steps: int = 1200, env_kwargs: dict | None = Non
             "%",
             "same sign as paper",
             bc["roll_rate"] > 0,
-            setting,
+            settings["blocks"],
         ),
         _row(
             "11d",
@@ -264,12 +279,13 @@ def athena_rows(seeds=range(4), steps: int = 1200, env_kwargs: dict | None = Non
             "m",
             "+-0.005",
             abs(ramp["summary"]["simple"]["height_median"] - 0.068) <= 0.005,
-            setting,
+            settings["ramp"],
         ),
     ]
-    tag = "" if not env_kwargs else "@" + ",".join(f"{k}={v}" for k, v in env_kwargs.items())
     for row in rows:
-        row["id"] += tag
+        terrain_kwargs = kwargs["blocks" if row["id"] in ("11", "11b", "11c") else "ramp"]
+        if terrain_kwargs:
+            row["id"] += "@" + ",".join(f"{k}={v}" for k, v in terrain_kwargs.items())
     return rows
 
 
@@ -481,13 +497,31 @@ end; 30 deg at 10 deg/s: 21.9 deg (climb/descend) and the side case falls to 0."
 ATHENA_SERVO_CALIBRATED = {"servo_kp": 6.8}
 """Servo stiffness [N m/rad] at which the simple controller's median ramp torso height is the
 paper's 0.068 m (measured 0.0681 m over seeds 0-3; kp 8: 0.089 m, kp 6: 0.049 m). Not the env
-default: with it the ramp roll-rate RMS rises (+1.9 %, row 9 fails) and posture control still
-touches the blocks in 4/4 episodes, although rows 8, 11b, 11c and 11d then hold."""
+default: with it the ramp roll-rate RMS rises (+1.9 %, row 9 fails), and the shipped ATHENA
+agents were trained at kp 8."""
+
+ATHENA_BLOCKS_CALIBRATED = {"block_size": (0.25, 0.25)}
+"""Block edge length [m] of the calibrated block bed (heights stay the paper's 0.04-0.13 m; the
+paper gives no block size). Measured with ATHENA_SERVO_CALIBRATED, posture vs simple control,
+episodes in which posture control touches the blocks (simple control touches in all but one):
+
+| block size | seeds 0-3 | seeds 0-7 | pitch / roll-rate change, seeds 0-7 |
+|---|---|---|---|
+| 0.10 m (env default) | 4 of 4 | - | - |
+| 0.20 m | - | 6 of 8 | +277 % / +59 % |
+| 0.25 m | 1 of 4 | 3 of 8 | +68 % / +55 % (paper +54 % / +82 %) |
+| 0.30 m | 1 of 4 | 3 of 8 | +35 % / +24 % |
+| 0.35 m | - | 3 of 8 | -16 % / -51 % |
+
+Larger blocks leave fewer edges for the torso to meet, but posture control keeps touching in
+about 3 of 8 episodes; 0.25 m is the smallest size at that level and the one whose rate changes
+are nearest the paper's. With the default servo (kp 8) 0.25 m blocks give 4 of 8 and rate
+changes of -42 % / -50 %."""
 
 
 def athena_calibrated_rows() -> list[dict]:
-    """Rows 8-11 with the calibrated servo model (ATHENA_SERVO_CALIBRATED)."""
-    return athena_rows(env_kwargs=ATHENA_SERVO_CALIBRATED)
+    """Rows 8-11 with the calibrated servo model and, for the blocks, the calibrated bed."""
+    return athena_rows(env_kwargs=ATHENA_SERVO_CALIBRATED, blocks_kwargs=ATHENA_BLOCKS_CALIBRATED)
 
 
 PAPER_CONE_RATIO = 0.5
@@ -547,18 +581,34 @@ def stewart_paper_cone_rows(seed: int = 0) -> list[dict]:
     return rows
 
 
-def stewart_paper_reach_rows(seed: int = 0) -> list[dict]:
-    """Row 6b: the side cases with the paper's reach model (eqs. 10-12) instead of ours."""
+STEWART_PAPER_REACH = {"hold_depth": 1.79}
+"""Calibration setting for row 6b: the hold posture's feet 1.79 m below the coxa origins instead
+of 1.95 m (env kwarg hold_depth; the paper gives neither the hold posture nor all of the leg
+geometry). The paper's reach model (eqs. 10-12) then picks its foothold at the paper's height,
+(0, +-1837, -1786) mm against (0, +-1894, -1783) mm; at 1.95 m it lies 163 mm lower and 11 mm
+inside the tipping edge, and both side cases tip. Measured for the side case, LF-LR-RM: hold
+depth 1.95 m tips, 1.85 / 1.79 / 1.70 m recover (margin 0.5 s after landing 15.5 / 15.2 / 14.7
+deg, paper 21.5)."""
+
+
+def stewart_paper_reach_rows(seed: int = 0, env_kwargs: dict | None = None) -> list[dict]:
+    """Row 6b: the side cases with the paper's reach model (eqs. 10-12) instead of ours; with
+    `env_kwargs` (e.g. STEWART_PAPER_REACH) the row ids get the suffix "@" + the kwargs."""
     mod = _script("plot_stewart_recovery")
+    tag = "" if not env_kwargs else "@" + ",".join(f"{k}={v}" for k, v in env_kwargs.items())
     rows = []
     for stance in ("LF-LR-RM", "LM-RF-RR"):
-        ctrl = mod.run("side", stance, controlled=True, seed=seed, reach_model="paper")
+        ctrl = mod.run(
+            "side", stance, controlled=True, seed=seed, env_kwargs=env_kwargs, reach_model="paper"
+        )
         d = ctrl["diagnostics"]
         foot = d["foothold"]
         p_foot = mod.PAPER[("side", stance)][2]
+        landed = d["landing_time"]
+        after = "never landed" if landed is None else f"{mod.fasm_at(ctrl, landed + 0.5):.1f} deg"
         rows.append(
             _row(
-                f"6b.side {stance}",
+                f"6b.side {stance}{tag}",
                 "000",
                 f"side {stance} recovers with the paper's reach model (foothold)",
                 ["recovers", list(p_foot)],
@@ -569,16 +619,51 @@ def stewart_paper_reach_rows(seed: int = 0) -> list[dict]:
                 "mm",
                 "no tip-over",
                 not ctrl["tipped"],
-                f"HexapodStewartTilt-v0 scenario=side stance={stance}, reach_model='paper', "
-                f"seed {seed}",
+                f"HexapodStewartTilt-v0 scenario=side stance={stance} {env_kwargs or ''}, "
+                f"reach_model='paper', seed {seed}; FASM 0.5 s after landing {after}",
             )
         )
     return rows
 
 
+def stewart_paper_reach_calibrated_rows() -> list[dict]:
+    """Row 6b with the calibrated hold posture (STEWART_PAPER_REACH)."""
+    return stewart_paper_reach_rows(env_kwargs=STEWART_PAPER_REACH)
+
+
 def stewart_stop_rows() -> list[dict]:
     """Rows 7 / 7b with the platform stopping at STEWART_STOP (calibration setting)."""
     return stewart_rows(env_kwargs=STEWART_STOP)
+
+
+STEWART_EQ15 = {
+    "climb": {"tilt_rate_deg": 7.0, "max_tilt_deg": 15.0},
+    "descend": {"tilt_rate_deg": 7.0, "max_tilt_deg": 15.0},
+    "side": {"tilt_rate_deg": 6.0, "max_tilt_deg": 30.0},
+}
+"""Calibration setting per Stewart scenario that exercises eq. 15: tilt rate [deg/s] and the tilt
+at which the platform stops [deg]. The paper gives neither (its judgment times, 4.9-8.8 s after
+the tilt starts, fit a few deg/s). Eq. 15 forecasts the time for the margin to fall from xi_f to
+0 at its current rate, which in our model is 0.85-1.0 times the tilt rate, so the paper's t_s of
+0.74-2.31 s (with kappa 0.7) need 6-20 deg/s. Measured with the default controller (seed 0):
+
+- climb / descend: 6 deg/s t_s 2.73 s, 6.5: 2.59 s, 7: 2.24 s (margin 37.3 deg 0.5 s after
+  landing with a stop at 15 deg, 35.5 at 17, 34.0 at 18); at 8 and 10 deg/s the fitted margin
+  acceleration is positive, the quadratic forecast never reaches 0 and t_s is the 3 s clamp;
+- side (judged at 27 deg of tilt, so the stop must lie beyond): 6 deg/s t_s 2.32 s, margin 21.1
+  deg after landing and to the end (stop 30), 6.5 deg/s 2.14 s but 12.4 deg, 7 deg/s 1.98 s and
+  the margin falls to 7 deg; a faster swing lands the foot less well.
+"""
+
+
+def stewart_eq15_rows() -> list[dict]:
+    """Rows 7 / 7b / 7c with STEWART_EQ15 (a tilt rate and stop per scenario)."""
+    cases = _script("plot_stewart_recovery").CASES
+    rows = []
+    for scenario, env_kwargs in STEWART_EQ15.items():
+        mine = [case for case in cases if case[0] == scenario]
+        rows += stewart_rows(cases=mine, env_kwargs=env_kwargs)
+    return rows
 
 
 CHEAP = {"000": (table_ii_rows,), "003": (upu_kinematics_rows,)}
@@ -590,7 +675,9 @@ FULL = {
         stewart_rows,
         stewart_paper_cone_rows,
         stewart_paper_reach_rows,
+        stewart_paper_reach_calibrated_rows,
         stewart_stop_rows,
+        stewart_eq15_rows,
     ),
     "002": (athena_rows, athena_calibrated_rows),
     "003": (upu_kinematics_rows, ditch_rows),
@@ -611,11 +698,16 @@ def collect(only: str | None = None, quick: bool = False) -> list[dict]:
 
 
 NOTES = (
-    "7b (t_s, all cases, default 2 deg/s): t_s is the 3.0 s upper clamp. The margin falls at "
-    "only 1.7-2.0 deg/s, so eq. 15 forecasts 10-12 s. Tried: 5 deg/s gives 3.0 / 3.0 / 2.79 s, "
-    "10 deg/s 3.0 / 3.0 / 1.38 s, 20 deg/s the 0.5 s lower clamp, and the margin after landing "
-    "drops to 0-9 deg at >= 10 deg/s (no stop) or 0 deg sideways at 20 deg/s. No tilt rate gives "
-    "the paper's t_s with recovery intact.",
+    "7b (t_s, all cases, default 2 deg/s): t_s is the 3.0 s upper clamp. The margin falls at only"
+    " 1.7-2.0 deg/s, so eq. 15 forecasts 10-12 s. The paper gives neither its tilt rate nor its "
+    "final tilt; with a rate and a stop per scenario that exercise eq. 15 (STEWART_EQ15: climb "
+    "and descend 7 deg/s up to 15 deg, side 6 deg/s up to 30 deg) t_s is 2.24 s (climb, descend) "
+    "and 2.32 s (side), inside the tolerance of 0.5-2.5 s (paper 0.74-2.31 s), and rows 7 hold "
+    "too (37.3 / 37.3 / 21.1 deg after landing, never below xi_f afterwards). The paper's "
+    "shortest times (0.74-1.48 s) are not reached with recovery intact: at 8-10 deg/s the fitted "
+    "margin acceleration turns positive and eq. 15 has no root (3 s clamp); sideways at 7 deg/s "
+    "(t_s 1.98 s) the margin falls to 7 deg after landing; at 20 deg/s t_s is the 0.5 s lower "
+    "clamp.",
     "7 (post-landing margin, default): 36.2 / 36.2 / 22.0 deg 0.5 s after landing, then the "
     "platform keeps tilting to 38-44 deg and the margin falls to 13.5 / 13.5 / 3.6 deg. With the "
     "platform stopping at 25 deg (STEWART_STOP, env kwarg max_tilt_deg=25; the paper does not "
@@ -629,18 +721,27 @@ NOTES = (
     "stay at lambda 0.5 throughout. The cone's base is centred on the support polygon's "
     "centroid, which lies far from below the CoG once a rear or side leg has landed.",
     "8 (ramp height +14 % vs +60.77 %) and 11d (simple-control sag 0.089 m vs 0.068 m): the "
-    "default servo model (kp 8 N m/rad) sags less than the paper's robot; the servo model was not "
-    "recalibrated in this round (see reports/athena_gain_sweep.md for the stiffness sensitivity).",
-    "ATHENA servo calibration: servo_kp 6.8 N m/rad reproduces the 0.068 m sag (0.0681 m); "
-    "then ramp height +48 %, pitch rate -50 % and the blocks rate changes take the paper's sign, "
-    "but the ramp roll rate rises (+1.9 %, paper -36 %) and posture control still touches the "
-    "blocks in 4/4 episodes, so the env default stays at kp 8 (rows with @servo_kp=6.8).",
-    "11, 11b, 11c (blocks): posture control still touches the blocks (192 steps, 4/4 episodes) "
-    "and lowers the pitch/roll-rate RMS where the paper's rose; the block bed layout was not "
-    "recalibrated in this round.",
-    "6b (paper's reach model, side cases): the robot tips; the foothold (0, +-1889, -1946) mm is "
-    "the paper's kind but 163 mm lower (our hold posture stands taller), so the default is the "
-    "kinematic reach model. The leg geometry was not recalibrated in this round.",
+    "default servo model (kp 8 N m/rad) sags less than the paper's robot, which leaves posture "
+    "control less height to win back (stiffness sensitivity: reports/athena_gain_sweep.md).",
+    "ATHENA calibration: servo_kp 6.8 N m/rad reproduces the 0.068 m sag (0.0681 m); then the "
+    "ramp height gain is +48 % and the pitch rate -50 %, but the ramp roll rate rises (+1.9 %, "
+    "paper -36 %). On a block bed of 0.25 m blocks (ATHENA_BLOCKS_CALIBRATED; the paper gives the"
+    " heights, 0.04-0.13 m, not the size) the blocks rows then hold: posture control touches in 1"
+    " of 4 episodes (6 steps; simple control 3128 steps, 4 of 4) and the pitch/roll-rate RMS rise"
+    " by +45 % / +34 % (paper +54 % / +82 %). Over seeds 0-7 posture control still touches in 3 "
+    "of 8 episodes, so 'collision-free' holds for most beds, not for all. The env defaults stay "
+    "at kp 8 and 0.1 m blocks because the shipped ATHENA agents were trained on them (rows with "
+    "@servo_kp=6.8).",
+    "11, 11b, 11c (blocks, default env): posture control still touches the 0.1 m blocks (192 "
+    "steps, 4/4 episodes) and lowers the pitch/roll-rate RMS where the paper's rose: the simple "
+    "controller's torso knocks on the many block edges, which posture control mostly avoids.",
+    "6b (paper's reach model, side cases, default hold posture): the robot tips; the foothold "
+    "(0, +-1889, -1946) mm is the paper's kind but 163 mm lower (our hold posture stands "
+    "taller). With the hold posture calibrated to the paper's foothold height "
+    "(STEWART_PAPER_REACH, hold_depth 1.79 m) it picks (0, +-1837, -1786) mm and both side "
+    "cases recover, with a "
+    "margin of 15.2 deg 0.5 s after landing (paper 21.5). The env default stays 1.95 m with "
+    "the kinematic reach model, on which the shipped agents were trained.",
     "4 (cliff): our gait starts walking at 3 s and meets the cliff earlier than the paper's, so "
     "the absolute times differ; the order (judgment before the tip-over) holds.",
 )

@@ -44,3 +44,21 @@ def test_rows_have_the_required_fields_and_markdown_lists_them():
 def test_bad_paper_id_is_rejected_with_choices():
     with pytest.raises(ValueError, match="000"):
         collect(only="001")
+
+
+def test_stewart_eq15_side_rows_match_committed_report():
+    """The calibration setting that exercises eq. 15 (one side case, about 2 s): t_s lies inside
+    0.5-2.5 s and off the clamps, the margin holds after landing, as in the committed report."""
+    from agents.reproduction import STEWART_EQ15, stewart_rows
+
+    committed = {r["id"]: r for r in json.loads(COMMITTED.read_text())}
+    rows = stewart_rows(cases=[("side", "LF-LR-RM")], env_kwargs=STEWART_EQ15["side"])
+    assert [r["id"][:2] for r in rows] == ["7b", "7c", "7."]
+    for row in rows:
+        old = committed[row["id"]]
+        values = row["value"] if isinstance(row["value"], list) else [row["value"]]
+        olds = old["value"] if isinstance(old["value"], list) else [old["value"]]
+        assert all(_isclose(a, b) for a, b in zip(values, olds, strict=True)), row["id"]
+        assert row["holds"] == old["holds"], row["id"]
+    t_s = rows[0]["value"]
+    assert 0.5 < t_s < 2.5 and rows[0]["holds"] and rows[2]["holds"]

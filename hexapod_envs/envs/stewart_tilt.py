@@ -42,7 +42,7 @@ import dataclasses
 import mujoco
 import numpy as np
 
-from ..robots.heavy_duty import LEG_NAMES, TRIPODS, joints_for_foot
+from ..robots.heavy_duty import LEG_NAMES, TRIPODS, joints_for_foot, within_limits
 from ..terrain.stewart import add_stewart_platform
 from ..terrain.stewart_kinematics import DEFAULT_PLATFORM
 from .heavy_duty import HeavyDutyEnv, HeavyDutySettings
@@ -112,6 +112,10 @@ class StewartTiltSettings(HeavyDutySettings):
     tilt_start_time: float = number(3.0)
     """Episode time at which the platform starts tilting [s]."""
     platform_friction: float = number(1.5)
+    hold_depth: float = number(HOLD_DEPTH, strict=True)
+    """Feet below the coxa origins in the hold posture [m] (the paper does not give it; 1.79
+    puts the foothold of the paper's reach model at the paper's height, see
+    STEWART_PAPER_REACH in agents/reproduction.py)."""
     residual_scale: float = number(2.0)
     """Residual action 1 = this fraction of each joint's half range (2: any target)."""
     tip_over_angle_deg: float = number(10.0, strict=True, high=90.0)
@@ -132,6 +136,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         self.tilt_rate = np.radians(s.tilt_rate_deg)
         self.tilt_start_time = s.tilt_start_time
         self.platform_friction = s.platform_friction
+        self.hold_depth = s.hold_depth
         self._max_tilt_arg = s.max_tilt_deg
         self.platform = DEFAULT_PLATFORM
         self.task_ranges = {"train": s.train_ranges, "test": s.test_ranges}
@@ -174,11 +179,22 @@ class StewartTiltEnv(HeavyDutyEnv):
         joints = []
         for leg in LEG_NAMES:
             side = 1.0 if leg[0] == "L" else -1.0
-            foot = self.robot.hip_offsets[leg] + np.array([0.0, 0.0, -HOLD_DEPTH])
+            foot = self.robot.hip_offsets[leg] + np.array([0.0, 0.0, -self.hold_depth])
             foot[1] = side * HOLD_FOOT_Y
             if leg not in stance:
                 foot[2] += SWING_LIFT
-            joints.append(joints_for_foot(leg, foot, self.robot))
+            try:
+                leg_joints = joints_for_foot(leg, foot, self.robot)
+            except ValueError as err:
+                leg_joints, why = None, str(err)
+            else:
+                why = "the joints would leave their ranges"
+            if leg_joints is None or not within_limits(leg_joints, self.robot):
+                raise ValueError(
+                    f"hold_depth={self.hold_depth} m: leg {leg} cannot reach its hold foothold "
+                    f"({why})"
+                )
+            joints.append(leg_joints)
         return np.concatenate(joints)
 
     def _rpy(self, tilt: float) -> np.ndarray:
@@ -209,7 +225,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         )
 
     def _robot_start_height(self) -> float:
-        return self.platform.neutral_height + HOLD_DEPTH + 0.005
+        return self.platform.neutral_height + self.hold_depth + 0.005
 
     def reference_joints(self) -> np.ndarray:
         return self._hold
