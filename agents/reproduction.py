@@ -194,7 +194,7 @@ def athena_rows(
         f"seeds 0-{n - 1} x {d['steps']} steps, medians of per-cycle RMS, posture vs simple "
         "(paper gains)"
     )
-    default = "default env (servo_kp 8 N m/rad, 0.1 m blocks)"
+    default = "default env (servo_kp 6.8 N m/rad, 0.25 m blocks)"
     settings = {t: f"HexapodIrregularTerrain-v0 {kwargs[t] or default}, {protocol}" for t in kwargs}
     bs, bp = blocks["summary"]["simple"], blocks["summary"]["posture"]
 
@@ -494,20 +494,23 @@ xi_f. Measured 25 deg: margins 0.5 s after landing 36.2 / 36.2 / 26.0 deg and >=
 end; 30 deg at 10 deg/s: 21.9 deg (climb/descend) and the side case falls to 0."""
 
 
-ATHENA_SERVO_CALIBRATED = {"servo_kp": 6.8}
-"""Servo stiffness [N m/rad] at which the simple controller's median ramp torso height is the
-paper's 0.068 m (measured 0.0681 m over seeds 0-3; kp 8: 0.089 m, kp 6: 0.049 m). Not the env
-default: with it the ramp roll-rate RMS rises (+1.9 %, row 9 fails), and the shipped ATHENA
-agents were trained at kp 8."""
+ATHENA_PREVIOUS_DEFAULT = {"servo_kp": 8.0}
+ATHENA_PREVIOUS_BLOCKS = {"block_size": (0.1, 0.1)}
+"""The ATHENA env defaults before the calibration of 2026-11-24 (rows with these suffixes).
 
-ATHENA_BLOCKS_CALIBRATED = {"block_size": (0.25, 0.25)}
-"""Block edge length [m] of the calibrated block bed (heights stay the paper's 0.04-0.13 m; the
-paper gives no block size). Measured with ATHENA_SERVO_CALIBRATED, posture vs simple control,
-episodes in which posture control touches the blocks (simple control touches in all but one):
+Servo stiffness. The env default, 6.8 N m/rad, is the stiffness at which the simple controller's
+median ramp torso height is the paper's 0.068 m (measured 0.0681 m over seeds 0-3; kp 8: 0.089 m,
+kp 6: 0.049 m). With it the ramp height gain is +48 % (kp 8: +14 %) but the ramp roll-rate RMS
+rises (+1.9 %; kp 8: -16.9 %; paper -36 %): the sagging simple control drags its torso on the slope
+(361 of 1200 steps, seed 0), which damps its roll.
+
+Block bed. The env default block edge, 0.25 m (the paper gives the heights, 0.04-0.13 m, not the
+size), measured with kp 6.8, posture vs simple control, episodes in which posture control touches
+the blocks (simple control touches in all but one):
 
 | block size | seeds 0-3 | seeds 0-7 | pitch / roll-rate change, seeds 0-7 |
 |---|---|---|---|
-| 0.10 m (env default) | 4 of 4 | - | - |
+| 0.10 m (previous default) | 4 of 4 | - | - |
 | 0.20 m | - | 6 of 8 | +277 % / +59 % |
 | 0.25 m | 1 of 4 | 3 of 8 | +68 % / +55 % (paper +54 % / +82 %) |
 | 0.30 m | 1 of 4 | 3 of 8 | +35 % / +24 % |
@@ -515,13 +518,13 @@ episodes in which posture control touches the blocks (simple control touches in 
 
 Larger blocks leave fewer edges for the torso to meet, but posture control keeps touching in
 about 3 of 8 episodes; 0.25 m is the smallest size at that level and the one whose rate changes
-are nearest the paper's. With the default servo (kp 8) 0.25 m blocks give 4 of 8 and rate
-changes of -42 % / -50 %."""
+are nearest the paper's. With kp 8, 0.25 m blocks give 4 of 8 and rate changes of -42 % / -50 %.
+"""
 
 
-def athena_calibrated_rows() -> list[dict]:
-    """Rows 8-11 with the calibrated servo model and, for the blocks, the calibrated bed."""
-    return athena_rows(env_kwargs=ATHENA_SERVO_CALIBRATED, blocks_kwargs=ATHENA_BLOCKS_CALIBRATED)
+def athena_previous_default_rows() -> list[dict]:
+    """Rows 8-11 with the ATHENA env defaults before the calibration (kp 8, 0.1 m blocks)."""
+    return athena_rows(env_kwargs=ATHENA_PREVIOUS_DEFAULT, blocks_kwargs=ATHENA_PREVIOUS_BLOCKS)
 
 
 PAPER_CONE_RATIO = 0.5
@@ -679,7 +682,7 @@ FULL = {
         stewart_stop_rows,
         stewart_eq15_rows,
     ),
-    "002": (athena_rows, athena_calibrated_rows),
+    "002": (athena_rows, athena_previous_default_rows),
     "003": (upu_kinematics_rows, ditch_rows),
 }
 
@@ -720,21 +723,18 @@ NOTES = (
     "what holds the robot up in our model. With the platform stopping at 25 deg the side cases "
     "stay at lambda 0.5 throughout. The cone's base is centred on the support polygon's "
     "centroid, which lies far from below the CoG once a rear or side leg has landed.",
-    "8 (ramp height +14 % vs +60.77 %) and 11d (simple-control sag 0.089 m vs 0.068 m): the "
-    "default servo model (kp 8 N m/rad) sags less than the paper's robot, which leaves posture "
-    "control less height to win back (stiffness sensitivity: reports/athena_gain_sweep.md).",
-    "ATHENA calibration: servo_kp 6.8 N m/rad reproduces the 0.068 m sag (0.0681 m); then the "
-    "ramp height gain is +48 % and the pitch rate -50 %, but the ramp roll rate rises (+1.9 %, "
-    "paper -36 %). On a block bed of 0.25 m blocks (ATHENA_BLOCKS_CALIBRATED; the paper gives the"
-    " heights, 0.04-0.13 m, not the size) the blocks rows then hold: posture control touches in 1"
-    " of 4 episodes (6 steps; simple control 3128 steps, 4 of 4) and the pitch/roll-rate RMS rise"
-    " by +45 % / +34 % (paper +54 % / +82 %). Over seeds 0-7 posture control still touches in 3 "
-    "of 8 episodes, so 'collision-free' holds for most beds, not for all. The env defaults stay "
-    "at kp 8 and 0.1 m blocks because the shipped ATHENA agents were trained on them (rows with "
-    "@servo_kp=6.8).",
-    "11, 11b, 11c (blocks, default env): posture control still touches the 0.1 m blocks (192 "
-    "steps, 4/4 episodes) and lowers the pitch/roll-rate RMS where the paper's rose: the simple "
-    "controller's torso knocks on the many block edges, which posture control mostly avoids.",
+    "9 (ramp roll rate, +1.9 % vs -36 %): with the servo model calibrated to the paper's simple-"
+    "control sag (env default servo_kp 6.8 N m/rad; 0.0681 m vs 0.068 m, row 11d) the simple "
+    "control drags its torso on the slope, which damps its roll, and posture control's roll-rate "
+    "RMS ends 2 % above it. With the previous default (kp 8, rows @servo_kp=8.0) rows 9 and 10 "
+    "hold (-16.9 %, -33.8 %) but the height gain is only +14 % (row 8) and the sag 0.089 m: no "
+    "single stiffness reproduces all four ramp rows.",
+    "11 (blocks): on the calibrated bed (0.25 m blocks, env default; the paper gives no size) "
+    "posture control touches in 1 of seeds 0-3 (6 steps), 3 of seeds 0-7, so the row holds for "
+    "most beds, not for all; the pitch/roll-rate RMS rise as in the paper (+45 % / +34 %; paper "
+    "+54 % / +82 %). On the previous 0.1 m blocks with kp 8 posture control touched in 4 of 4 "
+    "episodes (192 steps) and lowered both rates: the simple controller's torso knocked on the "
+    "many block edges, which posture control mostly avoids.",
     "6b (paper's reach model, side cases, default hold posture): the robot tips; the foothold "
     "(0, +-1889, -1946) mm is the paper's kind but 163 mm lower (our hold posture stands "
     "taller). With the hold posture calibrated to the paper's foothold height "

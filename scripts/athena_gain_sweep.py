@@ -23,6 +23,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from agents.athena_study import PAPER_GAINS, SIMPLE, run_episode, summarize  # noqa: E402
+from hexapod_envs.envs.irregular_terrain import IrregularTerrainSettings  # noqa: E402
+
+DEFAULTS = IrregularTerrainSettings()
 
 VALUES = (0.0, 0.2, 0.4, 0.6, 0.8, 1.0)
 GAIN_NAMES = ("k_z", "k_α", "k_β")
@@ -120,14 +123,16 @@ def main(argv: list[str] | None = None) -> None:
         * bool(args.servo_kp)
         + "`. One gain at a time over {0, 0.2, …, 1}, the other two at 0 (the paper's "
         f"protocol); {args.cycles} gait cycles (2 t_g = 2 s each) per setting and seed, seeds "
-        f"{list(seeds)}, default env (servo_kp 8 N·m/rad, phase start `measured_height`). "
+        f"{list(seeds)}, default env (servo_kp {DEFAULTS.servo_kp:g} N·m/rad, "
+        f"{DEFAULTS.block_size[0]:g} m blocks, phase start `{DEFAULTS.gait_start_from}`). "
         "Medians over gait cycles of the per-cycle RMS torso height (infrared reading) and "
         "pitch/roll rates (IMU); the ZMP margin (eqs. 32-33) median over time steps; "
         "torso-contact steps summed over seeds; distance = mean CoG travel along x. On the ramp "
         "only cycles with all feet on the slope count. Landing legs that found no ground are "
         "extended until they touch only when the plane is used (k_α or k_β > 0, "
         '`gait_ground_search="auto"`): on the blocks the k_α and k_β rows ride on the tallest '
-        "blocks, the simple and k_z rows rest the torso on them (ZMP margin 0: no foot loaded).",
+        "blocks, the simple and k_z rows touch them with the torso (the simple row rests on "
+        "them: ZMP margin 0, no foot loaded).",
         "",
     ]
     for terrain in ("ramp", "blocks"):

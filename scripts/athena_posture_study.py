@@ -9,7 +9,7 @@ the per-gait-cycle RMS torso height, pitch-rate and roll-rate RMS and the ZMP st
 `athena_posture_study.json`, and prints the medians next to the paper's changes.
 
 Run: python scripts/athena_posture_study.py [--seeds 3] [--steps 1200] [--out reports/figures]
-     [--block-size 0.1]
+     [--block-size B]
 """
 
 from __future__ import annotations

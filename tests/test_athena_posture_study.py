@@ -1,13 +1,13 @@
 """Coelho et al. 2024 §5.2.3 in MuJoCo: posture control vs the "simple control" on the same seeds,
-one
-default episode (60 s, 30 gait cycles) per seed; the directions of the paper's results.
+one default episode (60 s, 30 gait cycles) per seed; the directions of the paper's results.
 
-Measured with the default env (servo_kp 8 N·m/rad; see reports/athena_gain_sweep.md), 4 seeds:
-ramp: median height +14.3 %, pitch-rate RMS -33.8 %, roll-rate RMS -16.9 % (paper +60.77,
--11.92, -35.98 %). Blocks: the non-adaptive simple controller's torso is on the blocks in 2668 of
-4800 steps and it walks 1.20 m; posture control touches in 192 steps and walks 1.77 m (paper:
-simple collided and walked less, posture was collision-free: not reached, see the xfail);
-the ZMP margin is higher with posture control.
+Measured with the default env (servo_kp 6.8 N·m/rad, calibrated to the paper's simple-control
+sag; 0.25 m blocks; see agents/reproduction.py), 4 seeds: ramp: median height +47.9 %, pitch-rate
+RMS -49.8 %, roll-rate RMS +1.9 % (paper +60.77, -11.92, -35.98 %; the roll rate is the xfail).
+Blocks: the non-adaptive simple controller's torso is on the blocks in 3128 of 4800 steps;
+posture control touches in 6 steps (1 of 4 episodes; paper: collision-free, see the xfail) and
+raises the pitch/roll-rate RMS (+45 %, +34 %; paper +54 %, +82 %); the ZMP margin is higher with
+posture control.
 """
 
 import json
@@ -34,11 +34,14 @@ def _median(result, name, metric):
     return result["summary"][name][f"{metric}_median"]
 
 
-def test_ramp_runs_stay_on_the_slope_without_collisions(ramp):
+def test_ramp_runs_stay_on_the_slope_and_posture_control_keeps_the_torso_off_it(ramp):
     for name in ("simple", "posture"):
         assert all(len(r.cycles) >= 25 for r in ramp[name])  # all cycles counted on the slope
-        assert all(r.torso_collisions == 0 and not r.tipped_over for r in ramp[name])
-        assert all(r.distance > 3.0 for r in ramp[name])
+        assert not any(r.tipped_over for r in ramp[name])
+    assert all(r.torso_collisions == 0 and r.distance > 3.0 for r in ramp["posture"])
+    # The calibrated servos sag under the simple control until the torso drags on the slope
+    # (the paper reports the sag, 0.068 m median height, not whether it touched).
+    assert all(r.distance > 2.0 for r in ramp["simple"])
 
 
 def test_ramp_posture_control_holds_the_torso_higher(ramp):
@@ -52,6 +55,14 @@ def test_ramp_posture_control_holds_the_torso_higher(ramp):
     assert iqr["posture"] < iqr["simple"]
 
 
+@pytest.mark.xfail(
+    strict=True,
+    reason=(
+        "Not reached with the calibrated servos (kp 6.8 N m/rad): posture control's roll-rate RMS "
+        "is 2 % above the simple control's (seeds 0-3; paper -36 %), while the simple control's "
+        "torso drags on the slope, which damps its roll. At kp 8 it was -17 %."
+    ),
+)
 def test_ramp_posture_control_lowers_the_roll_rate(ramp):
     """Paper: -35.98 % median roll-rate RMS."""
     assert _median(ramp, "posture", "roll_rate") < _median(ramp, "simple", "roll_rate")
@@ -78,11 +89,11 @@ def test_blocks_posture_control_cuts_the_torso_contacts(blocks):
 @pytest.mark.xfail(
     strict=True,
     reason=(
-        "Not reached: the posture controller's torso still grazes the blocks (16-139 of 1200 "
-        "steps per episode on 0.1 m blocks; collision-free in 5 of 8 beds with 0.15-0.2 m "
-        "blocks). Its height control holds the torso at the standing height above the one "
-        "block its infrared sensor sees (bottom 0.076 m above it), and neighbouring blocks up "
-        "to 0.09 m taller reach the torso's edges."
+        "Not reached: on the calibrated bed (0.25 m blocks) the posture controller's torso "
+        "still grazes the blocks in some episodes (1 of seeds 0-3, 3 of seeds 0-7; on 0.1 m "
+        "blocks 4 of 4). Its height control holds the torso at the standing height above the one "
+        "block its infrared sensor sees, and neighbouring blocks up to 0.09 m taller reach the "
+        "torso's edges."
     ),
 )
 def test_blocks_posture_control_is_collision_free(blocks):

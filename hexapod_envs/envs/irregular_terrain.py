@@ -25,10 +25,12 @@ lower friction, stiffness farther from nominal). ``info["task"]`` holds the valu
 
 Servos and gait. The paper's joints are servos with a 1.89 N·m stall torque. Ours are
 proportional position servos with that torque limit, a stiffness ``servo_kp`` and viscous damping
-``servo_damping``. The default stiffness, 8 N·m/rad, reaches the stall torque at 0.24 rad (13.5°)
+``servo_damping``. The default stiffness, 6.8 N·m/rad, reaches the stall torque at 0.28 rad (15.9°)
 of position error, a hobby servo's proportional band; a stance leg carrying a third to a half of
 the robot's weight sags by a few millimetres. The paper's own simple-control results (median torso
-height 0.068 m on the ramp against 0.104 m standing) show that its simulated servos sagged too:
+height 0.068 m on the ramp against 0.104 m standing) show that its simulated servos sagged too
+(6.8 N·m/rad is calibrated to that sag: 0.0681 m over seeds 0-3; 8 N·m/rad, the default before
+2026-11-24, gives 0.089 m):
 because every phase starts from the *measured* feet (eq. 12 on the encoders) the sag accumulates
 and the torso slowly sinks unless the height correction k_z δz brings it back. The phase start
 uses the measured heights but the commanded horizontal positions (``gait_start_from=
@@ -230,8 +232,9 @@ class IrregularTerrainSettings(EnvSettings):
     """t_g, duration of one gait phase [s]."""
     gait_start_from: str = choice("measured_height", START_FROM)
     gait_ground_search: str = choice("auto", GROUND_SEARCH)
-    servo_kp: float = number(8.0, strict=True)
-    """Servo stiffness [N·m/rad]."""
+    servo_kp: float = number(6.8, strict=True)
+    """Servo stiffness [N·m/rad] (calibrated to the paper's simple-control ramp sag, 0.068 m; 8
+    before 2026-11-24)."""
     servo_damping: float = number(0.2, strict=True)
     """Servo viscous damping [N·m·s/rad]."""
     friction: float = number(PAPER_FRICTION)
@@ -241,8 +244,9 @@ class IrregularTerrainSettings(EnvSettings):
     ramp_length: float = number(4.5, strict=True)
     block_height_range: tuple[float, float] = numbers((0.04, 0.13), size=2, ordered=True)
     """Block heights are drawn uniformly from this range [m]."""
-    block_size: tuple[float, float] = numbers((0.1, 0.1), size=2)
-    """Block edge lengths (x, y) [m]."""
+    block_size: tuple[float, float] = numbers((0.25, 0.25), size=2)
+    """Block edge lengths (x, y) [m] (the paper gives only the heights; calibrated, see
+    `agents.reproduction.ATHENA_PREVIOUS_DEFAULT`; 0.1 before 2026-11-24)."""
     block_region: tuple[tuple[float, float], tuple[float, float]] = numbers(
         ((-0.4, 3.0), (-0.5, 0.5)), size=2, low=None, ordered=True
     )
