@@ -10,6 +10,7 @@ simulated when the report is made, by the measurement code of the study scripts 
 from __future__ import annotations
 
 import math
+from collections import Counter
 from pathlib import Path
 
 import numpy as np
@@ -539,6 +540,12 @@ def _cone_counts(ctrl: dict) -> tuple[int, int, int]:
     return at_paper, len(ratios) - at_paper - dropped, dropped
 
 
+def _status_counts(ctrl: dict) -> str:
+    """The QP statuses of a Stewart run's supported steps, e.g. "optimal 1054"."""
+    counts = Counter(str(status) for status in ctrl["qp_status"])
+    return ", ".join(f"{status} {n}" for status, n in sorted(counts.items())) or "none"
+
+
 def _cone_row(id_: str, case: str, ctrl: dict, setting: str) -> dict:
     at_paper, wider, dropped = _cone_counts(ctrl)
     return _row(
@@ -550,8 +557,10 @@ def _cone_row(id_: str, case: str, ctrl: dict, setting: str) -> dict:
         "steps",
         "all at lambda 0.5",
         wider == 0 and dropped == 0,
-        setting + f"; t_s {ctrl['diagnostics']['t_s']}, recovery controller's default ladder "
-        "(lambda 0.5, then 0.65 / 0.8 / 0.95, then no cone)",
+        setting + f"; t_s {ctrl['diagnostics']['t_s']}, QP status per supported step "
+        f"{_status_counts(ctrl)}, recovery controller's default ladder (lambda 0.5, then "
+        "0.65 / 0.8 / 0.95, then no cone; cone radius = lambda x the support centroid's "
+        "distance to the nearest support edge)",
     )
 
 

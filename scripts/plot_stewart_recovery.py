@@ -58,8 +58,8 @@ def run(
     **policy_kwargs,
 ) -> dict:
     """One episode; per-step time series, the controller's final diagnostics, and the stability
-    cone's λ of every supported-phase QP step (``cone_ratios``; NaN: solved without the cone,
-    None: no QP that step).
+    cone's λ and the QP's status of every supported-phase step (``cone_ratios``: NaN solved
+    without the cone, None no QP that step; ``qp_status``).
 
     `env_kwargs` go to the env (e.g. tilt_rate_deg, max_tilt_deg), `policy_kwargs` to
     TippingRecoveryPolicy."""
@@ -69,7 +69,7 @@ def run(
     obs, info = env.reset(seed=seed)
     if policy is not None:
         policy.reset()
-    rows, planned, cone = [], [], []
+    rows, planned, cone, qp_status = [], [], [], []
     while True:
         action = policy(obs) if policy is not None else np.zeros(18)
         obs, _, terminated, truncated, info = env.step(action)
@@ -79,6 +79,7 @@ def run(
         rows.append((info["time"], info["fasm_margin_deg"], info["platform_tilt_deg"], edge, fz))
         if policy is not None and policy.diagnostics["phase"] == "supported":
             cone.append(policy.diagnostics["qp_cone_ratio"])
+            qp_status.append(policy.diagnostics["qp_status"])
         if policy is not None and policy.diagnostics["planned_forces"] is not None:
             d = policy.diagnostics
             plan = dict(zip(d["qp_legs"], d["planned_forces"][:, 2], strict=True))
@@ -98,6 +99,7 @@ def run(
         "end_time": float(info["time"]),
         "diagnostics": dict(policy.diagnostics) if policy is not None else None,
         "cone_ratios": cone,
+        "qp_status": qp_status,
         "env_adjustment_leg": info.get("adjustment_leg"),
     }
 
