@@ -17,8 +17,16 @@ it up. Scenarios are defined by what the robot feels:
 (1) left for LF-LR-RM, right for LM-RF-RR.
 
 The hold posture is a little taller and narrower than the walking stance (feet at |y| = 1.7 m,
-1.95 m below the hips) so that the side case tips within the platform's reach (the 6-UPS
-platform tilts at most ~44-46 deg; the walking stance would need 48.5 deg).
+`hold_depth` = 1.95 m below the hips) so that the side case tips within the platform's reach
+(the 6-UPS platform tilts at most ~44-46 deg; the walking stance would need 48.5 deg).
+
+The paper gives neither its tilt rate nor its final tilt. At the default 2 deg/s the FASM falls
+too slowly for the recovery's time budget (eq. 15) to come off its 3 s clamp; the calibrated
+profile of the reproduction report exercises it: ``scenario="climb"`` or ``"descend"`` with
+``tilt_rate_deg=7, max_tilt_deg=15``, ``scenario="side"`` with ``tilt_rate_deg=6,
+max_tilt_deg=30`` (`agents.reproduction.STEWART_EQ15`; t_s 2.24-2.32 s against the paper's
+0.74-2.31 s). ``hold_depth=1.79`` lets the paper's own reach model (eqs. 10-12) recover the side
+cases (`agents.reproduction.STEWART_PAPER_REACH`).
 
 Task distributions (``task_distribution=``): "paper" (default) runs `scenario`; "train" / "test"
 draw the held tripod, the tilt axis (one of the six paper cases or an arbitrary axis), the tilt
