@@ -18,6 +18,11 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def _tag(env_kwargs: dict | None) -> str:
+    """Row-id suffix of a calibration setting: "" or "@key=value,key=value"."""
+    return "@" + ",".join(f"{k}={v}" for k, v in env_kwargs.items()) if env_kwargs else ""
+
+
 def _row(id_, paper, quantity, paper_value, value, unit, tolerance, holds, setting):
     return {
         "id": id_,
@@ -284,9 +289,7 @@ def athena_rows(
         ),
     ]
     for row in rows:
-        terrain_kwargs = kwargs["blocks" if row["id"] in ("11", "11b", "11c") else "ramp"]
-        if terrain_kwargs:
-            row["id"] += "@" + ",".join(f"{k}={v}" for k, v in terrain_kwargs.items())
+        row["id"] += _tag(kwargs["blocks" if row["id"] in ("11", "11b", "11c") else "ramp"])
     return rows
 
 
@@ -377,7 +380,7 @@ def stewart_rows(seed: int = 0, cases=None, env_kwargs: dict | None = None) -> l
     from agents.tipping.judgment import XI_F_DEG
 
     mod = _script("plot_stewart_recovery")
-    tag = "" if not env_kwargs else "@" + ",".join(f"{k}={v}" for k, v in env_kwargs.items())
+    tag = _tag(env_kwargs)
     cases = mod.CASES if cases is None else cases
     rows, legs_ok = [], 0
     for scenario, stance in cases:
@@ -607,7 +610,7 @@ def stewart_paper_reach_rows(seed: int = 0, env_kwargs: dict | None = None) -> l
     """Row 6b: the side cases with the paper's reach model (eqs. 10-12) instead of ours; with
     `env_kwargs` (e.g. STEWART_PAPER_REACH) the row ids get the suffix "@" + the kwargs."""
     mod = _script("plot_stewart_recovery")
-    tag = "" if not env_kwargs else "@" + ",".join(f"{k}={v}" for k, v in env_kwargs.items())
+    tag = _tag(env_kwargs)
     rows = []
     for stance in ("LF-LR-RM", "LM-RF-RR"):
         ctrl = mod.run(
