@@ -245,8 +245,8 @@ class IrregularTerrainSettings(EnvSettings):
     block_height_range: tuple[float, float] = numbers((0.04, 0.13), size=2, ordered=True)
     """Block heights are drawn uniformly from this range [m]."""
     block_size: tuple[float, float] = numbers((0.25, 0.25), size=2)
-    """Block edge lengths (x, y) [m] (the paper gives only the heights; calibrated, see
-    `agents.reproduction.ATHENA_PREVIOUS_DEFAULT`; 0.1 before 2026-11-24)."""
+    """Block edge lengths (x, y) [m] (the paper gives only the heights; calibrated, see the
+    table under ATHENA_PREVIOUS_BLOCKS in agents/reproduction.py; 0.1 before 2026-11-24)."""
     block_region: tuple[tuple[float, float], tuple[float, float]] = numbers(
         ((-0.4, 3.0), (-0.5, 0.5)), size=2, low=None, ordered=True
     )
