@@ -9,6 +9,7 @@ simulated when the report is made, by the measurement code of the study scripts 
 
 from __future__ import annotations
 
+import functools
 import math
 from collections import Counter
 from pathlib import Path
@@ -200,7 +201,13 @@ def athena_rows(
         f"seeds 0-{n - 1} x {d['steps']} steps, medians of per-cycle RMS, posture vs simple "
         "(paper gains)"
     )
-    default = "default env (servo_kp 6.8 N m/rad, 0.25 m blocks)"
+    from hexapod_envs.envs.irregular_terrain import IrregularTerrainSettings
+
+    env_defaults = IrregularTerrainSettings()
+    default = (
+        f"default env (servo_kp {env_defaults.servo_kp:g} N m/rad, "
+        f"{env_defaults.block_size[0]:g} m blocks)"
+    )
     settings = {t: f"HexapodIrregularTerrain-v0 {kwargs[t] or default}, {protocol}" for t in kwargs}
     bs, bp = blocks["summary"]["simple"], blocks["summary"]["posture"]
 
@@ -358,8 +365,10 @@ def ditch_rows() -> list[dict]:
     return rows
 
 
+@functools.cache
 def _script(name: str):
-    """Load `scripts/<name>.py` as a module (to reuse its measurement code, not duplicate it)."""
+    """Load `scripts/<name>.py` as a module (to reuse its measurement code, not duplicate it),
+    once per process."""
     import importlib.util
 
     path = ROOT / "scripts" / f"{name}.py"
@@ -539,7 +548,7 @@ def _cone_counts(ctrl: dict) -> tuple[int, int, int]:
     """(QP steps at the paper's λ, at a wider λ, without the cone) of a Stewart run."""
     ratios = [r for r in ctrl["cone_ratios"] if r is not None]
     at_paper = sum(1 for r in ratios if r == PAPER_CONE_RATIO)
-    dropped = sum(1 for r in ratios if r != r)  # NaN: the QP was solved without the cone
+    dropped = sum(1 for r in ratios if math.isnan(r))  # the QP was solved without the cone
     return at_paper, len(ratios) - at_paper - dropped, dropped
 
 

@@ -191,17 +191,13 @@ class StewartTiltEnv(HeavyDutyEnv):
             foot[1] = side * HOLD_FOOT_Y
             if leg not in stance:
                 foot[2] += SWING_LIFT
+            unreachable = f"hold_depth={self.hold_depth} m: leg {leg} cannot reach its foothold"
             try:
                 leg_joints = joints_for_foot(leg, foot, self.robot)
             except ValueError as err:
-                leg_joints, why = None, str(err)
-            else:
-                why = "the joints would leave their ranges"
-            if leg_joints is None or not within_limits(leg_joints, self.robot):
-                raise ValueError(
-                    f"hold_depth={self.hold_depth} m: leg {leg} cannot reach its hold foothold "
-                    f"({why})"
-                )
+                raise ValueError(f"{unreachable} ({err})") from None
+            if not within_limits(leg_joints, self.robot):
+                raise ValueError(f"{unreachable} (the joints would leave their ranges)")
             joints.append(leg_joints)
         return np.concatenate(joints)
 
