@@ -144,6 +144,7 @@ HELD_OUT = {
     "HexapodIrregularTerrain-v0": [
         ("slope_deg", TERRAIN_TRAIN.slope_deg, TERRAIN_TEST.slope_deg),
         ("block_height_max", [TERRAIN_TRAIN.block_height_max], [TERRAIN_TEST.block_height_max]),
+        ("block_size", [TERRAIN_TRAIN.block_size], [TERRAIN_TEST.block_size]),
         ("friction", [TERRAIN_TRAIN.friction], [TERRAIN_TEST.friction]),
     ],
     "HexapodDitchCrossing-v0": [

@@ -111,25 +111,39 @@ def test_observation_info_and_reward_terms(terrain):
     assert obs[structure["posture_gains"]] == pytest.approx([0.6, 0.4, 0.4])
 
 
+def test_pitch_rate_factor_weighs_pitch_against_roll_in_the_rate_term():
+    env = gym.make(ENV_ID, action_mode="gains", rate_weight=2.0, pitch_rate_factor=10.0)
+    env.reset(seed=0)
+    for _ in range(30):
+        *_, info = env.step(np.array([0.8, 0.6, 0.0], dtype=np.float32))
+        pitch, roll = info["pitch_rate"], info["roll_rate"]
+        expected = -2.0 * min(10.0 * pitch**2 + roll**2, 4.0)
+        assert info["reward_steadiness_rate"] == pytest.approx(expected, rel=1e-12, abs=1e-15)
+    assert abs(pitch) > 1e-4  # the term is not trivially 0
+
+
 def test_gains_are_applied_only_at_gait_cycle_starts():
-    env = gym.make(ENV_ID, terrain="flat", action_mode="gains")
+    """The gains are read once per cycle, at its first step (the observation's start flag is up
+    then; it stays up while the gait waits there for the ground, and those actions are ignored)."""
+    env = gym.make(ENV_ID, terrain="ramp", action_mode="gains", gait_ground_search="always")
     base = env.unwrapped
     phase = base.observation_structure["gait_phase"]
     obs, _ = env.reset(seed=0)
     rng = np.random.default_rng(0)
-    applied = []
-    for _ in range(3 * base.ticks_per_cycle):
-        starts_cycle = obs[phase][2] == 1.0
+    applied, waits = [], 0
+    for _ in range(4 * base.ticks_per_cycle):
+        due = base.gains_due
+        waits += obs[phase][2] == 1.0 and not due
+        assert not due or obs[phase][2] == 1.0
         action = rng.uniform(0, 1, 3).astype(np.float32)
         obs, *_, info = env.step(action)
-        if starts_cycle:
+        if due:
             applied.append(action.astype(float))
             assert info["posture_gains"] == pytest.approx(tuple(action))
         else:
             assert info["posture_gains"] == pytest.approx(tuple(applied[-1]))
-    # three cycles, or more start flags when a landing leg waits for the ground (the flag stays
-    # up while a phase start waits, and each of those steps may set the gains)
-    assert len(applied) >= 3
+    assert len(applied) == info["gait_cycle"] + 1
+    assert waits > 0  # the ramp start waits for a landing leg: those steps set nothing
 
 
 def test_policy_gives_the_same_walk_in_every_action_mode():

@@ -72,6 +72,9 @@ class EnvSpec:
     reward_exclude: list[str] = field(default_factory=list)
     """Reward terms (``info["reward_<term>"]``) taken out of the reward the learner sees (see
     `ExcludeRewardTerms`); empty: the env's reward."""
+    decision: str = "step"
+    """"step": the learner acts at every env step; "gait_cycle": once per gait cycle, through
+    `hexapod_envs.wrappers.GainsPerCycle` (the irregular terrain's "gains" mode)."""
 
     def make(self, **extra: Any) -> gym.Env:
         """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
@@ -95,6 +98,16 @@ class EnvSpec:
                 raise UserError(f"cannot build the hybrid policy env on {self.id}: {exc}") from None
         if self.reward_exclude:
             env = ExcludeRewardTerms(env, self.reward_exclude)
+        if self.decision == "gait_cycle":
+            from hexapod_envs.wrappers import GainsPerCycle
+
+            try:
+                env = GainsPerCycle(env)
+            except ValueError as exc:
+                env.close()
+                raise UserError(f"env.decision='gait_cycle' on {self.id}: {exc}") from None
+        elif self.decision != "step":
+            raise UserError(f"env.decision must be 'step' or 'gait_cycle', got {self.decision!r}")
         return env
 
 

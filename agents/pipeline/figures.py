@@ -155,7 +155,8 @@ def success_bars(result: SuiteResult) -> bytes | None:
 
 
 def learning_curves(result: EnvResult) -> bytes | None:
-    """Evaluation success rate and mean return against env steps for every PPO policy whose
+    """Evaluation success rate and mean return against learner steps (env steps; gait cycles, in
+    a row of their own, for a run that acts once per cycle) for every PPO policy whose
     run directory holds an ``evaluations.npz`` (shipped model directories do not)."""
     from .learning_curve import load_learning_curve
 
@@ -168,17 +169,23 @@ def learning_curves(result: EnvResult) -> bytes | None:
                 break
     if not curves:
         return None
-    fig, (ax_s, ax_r) = plt.subplots(1, 2, figsize=(9, 3.0))
-    for label, curve in curves.items():
-        rate = curve.success_rate
-        if rate is not None:
-            ax_s.plot(curve.timesteps, rate, marker="o", ms=3, label=_short(label, 40))
-        ax_r.plot(curve.timesteps, curve.mean_return, marker="o", ms=3, label=_short(label, 40))
-    ax_s.set(xlabel="env steps", ylabel="success rate", ylim=(-0.05, 1.05))
-    ax_r.set(xlabel="env steps", ylabel="mean evaluation return")
-    for ax in (ax_s, ax_r):
-        ax.grid(alpha=0.3)
-    ax_r.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    units = sorted({curve.unit for curve in curves.values()})
+    # One row per unit: gait-cycle runs count other steps (and their learner's reward leaves
+    # terms out), so they get their own axes.
+    fig, axes = plt.subplots(len(units), 2, figsize=(9, 3.0 * len(units)), squeeze=False)
+    for (ax_s, ax_r), unit in zip(axes, units, strict=True):
+        for label, curve in curves.items():
+            if curve.unit != unit:
+                continue
+            rate = curve.success_rate
+            if rate is not None:
+                ax_s.plot(curve.timesteps, rate, marker="o", ms=3, label=_short(label, 40))
+            ax_r.plot(curve.timesteps, curve.mean_return, marker="o", ms=3, label=_short(label, 40))
+        ax_s.set(xlabel=unit, ylabel="success rate", ylim=(-0.05, 1.05))
+        ax_r.set(xlabel=unit, ylabel="mean evaluation return")
+        for ax in (ax_s, ax_r):
+            ax.grid(alpha=0.3)
+        ax_r.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
     return _png(fig)
 

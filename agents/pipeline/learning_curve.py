@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+import yaml
 
 from .errors import UserError
 
@@ -20,12 +21,15 @@ EVALUATIONS_FILE = "evaluations.npz"
 
 @dataclass(frozen=True)
 class LearningCurve:
-    """One run's evaluations: row i is the evaluation after ``timesteps[i]`` env steps."""
+    """One run's evaluations: row i is the evaluation after ``timesteps[i]`` learner steps."""
 
-    timesteps: np.ndarray  # (n,) env steps summed over the parallel envs
+    timesteps: np.ndarray  # (n,) learner steps (`unit`) summed over the parallel envs
     returns: np.ndarray  # (n, episodes) undiscounted, unnormalised episode returns
     lengths: np.ndarray  # (n, episodes) episode lengths [steps]
     successes: np.ndarray | None  # (n, episodes) 0/1; None if the env reports no is_success
+    unit: str = "env steps"
+    """What ``timesteps`` counts: the learner's steps, "env steps", or "gait cycles" for a run
+    whose learner acts once per gait cycle (``env.decision: gait_cycle`` in its config)."""
 
     @property
     def mean_return(self) -> np.ndarray:
@@ -56,6 +60,11 @@ def load_learning_curve(run_dir: str | Path) -> LearningCurve:
             f"{run_dir} has no {EVALUATIONS_FILE}: the run has not been evaluated yet "
             "(eval.freq 0, or fewer than eval.freq steps trained)"
         )
+    unit = "env steps"
+    config = Path(run_dir) / "config.yaml"
+    if config.is_file():
+        env = (yaml.safe_load(config.read_text()) or {}).get("env") or {}
+        unit = "gait cycles" if env.get("decision") == "gait_cycle" else unit
     with np.load(path) as data:
         successes = data["successes"] if "successes" in data and data["successes"].size else None
         return LearningCurve(
@@ -63,4 +72,5 @@ def load_learning_curve(run_dir: str | Path) -> LearningCurve:
             returns=np.asarray(data["results"], dtype=float),
             lengths=np.asarray(data["ep_lengths"], dtype=np.int64),
             successes=None if successes is None else np.asarray(successes, dtype=float),
+            unit=unit,
         )

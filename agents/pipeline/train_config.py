@@ -69,6 +69,11 @@ class EnvConfig:
     reward_exclude: list[str] = field(default_factory=list)
     """Reward terms (``info["reward_<term>"]``) taken out of the reward the learner sees
     (`agents.pipeline.envs.ExcludeRewardTerms`); the evaluation reports the env's own return."""
+    decision: Literal["step", "gait_cycle"] = "step"
+    """When the learner acts: every env step, or once per gait cycle (`gait_cycle`: the
+    irregular terrain's "gains" mode through `hexapod_envs.wrappers.GainsPerCycle`; training
+    steps then count gait cycles, and the training episodes' TensorBoard statistics see each
+    cycle's last step only; evaluations still run every env step, see the wrapper)."""
 
 
 @dataclass

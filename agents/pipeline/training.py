@@ -6,6 +6,7 @@ See `artifacts` for the run directory layout and `callbacks` for what goes to Te
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import os
 import shutil
 import signal
@@ -78,6 +79,7 @@ def env_spec(config: TrainConfig) -> EnvSpec:
         list(env.gym_packages),
         config.hybrid,
         list(env.reward_exclude),
+        env.decision,
     )
 
 
@@ -108,7 +110,10 @@ def _vec_envs(config: TrainConfig, seed: int, stats: NormalizationStats | None =
         subprocess=config.vec_env.use_subprocess,
         start_method=config.vec_env.start_method,
     )
-    eval_env = DummyVecEnv([EnvFactory(spec)]) if config.eval.freq > 0 else None
+    # Evaluations act at every env step (the same actions as per gait cycle, see GainsPerCycle),
+    # so that their episode metrics see every step's info.
+    eval_spec = dataclasses.replace(spec, decision="step")
+    eval_env = DummyVecEnv([EnvFactory(eval_spec)]) if config.eval.freq > 0 else None
     if eval_env is not None:
         eval_env.seed(seed + EVAL_SEED_OFFSET)
     norm = config.normalize

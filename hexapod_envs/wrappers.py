@@ -1,0 +1,58 @@
+"""Gymnasium wrappers that belong to one env's action mode.
+
+`GainsPerCycle`: HexapodIrregularTerrain-v0's "gains" mode reads its action once per gait cycle
+(40 control steps at the defaults) and ignores it in between, so a learner that acts at every
+step sees 39 actions without consequence for each one that counts, and a per-step reward whose
+effect shows up over the whole cycle. The wrapper makes one wrapped step of each gait cycle: the
+action is held until the env reads the next one, and the rewards of the cycle's steps are
+summed. It is the semi-MDP of "one decision per gait cycle" (the paper's gains are per cycle too).
+The env reads the gains at the first control step of a cycle; a wait for the stance feet to touch
+the ground at the cycle start (ground search) belongs to the cycle before.
+
+A policy trained through it acts identically without it: the env reads the action only at the
+cycle starts, and the wrapped env returns exactly the observation that the unwrapped env returns
+before each cycle start. Evaluation (which needs every step's info for its metrics) therefore
+runs the policy on the unwrapped env at every step.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import gymnasium as gym
+import numpy as np
+
+
+class GainsPerCycle(gym.Wrapper):
+    """One step per gait cycle of a "gains"-mode env (see the module docstring).
+
+    ``step`` returns the last control step's observation, termination, truncation and info, with
+    the reward summed over the cycle's control steps; ``info["cycle_steps"]`` is how many control
+    steps it ran (a cycle's, plus the ground-search waits before the next one; fewer when the
+    episode ended inside the cycle)."""
+
+    def __init__(self, env: gym.Env):
+        super().__init__(env)
+        base = env.unwrapped
+        if not hasattr(type(base), "gains_due"):
+            raise ValueError(
+                "GainsPerCycle needs an env with a gains action mode "
+                f"(HexapodIrregularTerrain-v0), got {type(base).__name__}"
+            )
+        if getattr(base, "action_mode", None) != "gains":
+            raise ValueError(
+                f"GainsPerCycle needs action_mode='gains', got {base.action_mode!r}; the other "
+                "modes read their action at every step"
+            )
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        base = self.env.unwrapped
+        total, steps = 0.0, 0
+        while True:
+            obs, reward, terminated, truncated, info = self.env.step(action)
+            total += float(reward)
+            steps += 1
+            if terminated or truncated or base.gains_due:
+                break
+        info["cycle_steps"] = steps
+        return obs, total, terminated, truncated, info

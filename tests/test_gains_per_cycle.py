@@ -1,0 +1,158 @@
+"""GainsPerCycle: one learner step per gait cycle of the irregular terrain's "gains" mode."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import hexapod_envs  # noqa: F401  (registers the env ids)
+from hexapod_envs.wrappers import GainsPerCycle
+
+ENV_ID = "HexapodIrregularTerrain-v0"
+GAINS = {"action_mode": "gains", "task_distribution": "train", "max_episode_steps": 200}
+
+
+def _policy(obs: np.ndarray) -> np.ndarray:
+    """Gains that depend on the observation, so that a shifted decision would change them."""
+    return np.clip(0.5 + 0.4 * np.tanh(obs[:3]), 0.0, 1.0).astype(np.float32)
+
+
+def _run(env: gym.Env, seed: int) -> tuple[np.ndarray, float, list[int]]:
+    obs, _ = env.reset(seed=seed)
+    total, cycle_steps = 0.0, []
+    while True:
+        obs, reward, terminated, truncated, info = env.step(_policy(obs))
+        total += reward
+        cycle_steps.append(info.get("cycle_steps", 1))
+        if terminated or truncated:
+            return obs, total, cycle_steps
+
+
+def test_a_policy_acts_the_same_per_cycle_and_per_step():
+    """The env reads the gains only at cycle starts, and the wrapper hands the policy exactly the
+    observation before each cycle start: same trajectory, same summed reward."""
+    wrapped = GainsPerCycle(gym.make(ENV_ID, **GAINS))
+    plain = gym.make(ENV_ID, **GAINS)
+    obs_w, return_w, cycle_steps = _run(wrapped, seed=4)
+    obs_p, return_p, _ = _run(plain, seed=4)
+    np.testing.assert_array_equal(obs_w, obs_p)
+    assert return_w == pytest.approx(return_p, rel=1e-12)
+    ticks = wrapped.unwrapped.controller.ticks_per_cycle
+    assert sum(cycle_steps) == 200
+    # A cycle's steps (plus ground-search waits at the next cycle start, if any).
+    assert min(cycle_steps[:-1]) >= ticks
+    assert len(cycle_steps) == pytest.approx(200 / ticks, abs=1)
+
+
+def test_the_gains_read_at_a_cycle_start_are_the_decision():
+    """Changing the action between cycle starts changes nothing; at a cycle start it does."""
+    env = gym.make(ENV_ID, **GAINS).unwrapped
+    env.reset(seed=0)
+    assert env.gains_due
+    env.step(np.array([0.2, 0.3, 0.4], dtype=np.float32))
+    assert not env.gains_due
+    env.step(np.array([1.0, 1.0, 1.0], dtype=np.float32))
+    assert env.controller.gains == pytest.approx((0.2, 0.3, 0.4))
+
+
+def test_other_action_modes_and_envs_are_refused_by_name():
+    with pytest.raises(ValueError, match="action_mode='gains'.*'residual'"):
+        GainsPerCycle(gym.make(ENV_ID))
+    with pytest.raises(ValueError, match="gains action mode.*CliffWalkEnv"):
+        GainsPerCycle(gym.make("HexapodCliffWalk-v0"))
+
+
+def test_env_spec_decision_builds_the_wrapper_and_names_bad_values():
+    from agents.pipeline.envs import EnvSpec
+    from agents.pipeline.errors import UserError
+
+    spec = EnvSpec(ENV_ID, dict(GAINS), gym_packages=["hexapod_envs"], decision="gait_cycle")
+    env = spec.make()
+    env.reset(seed=0)
+    assert env.step(np.zeros(3, dtype=np.float32))[-1]["cycle_steps"] >= 1
+    with pytest.raises(UserError, match="gait_cycle.*action_mode='gains'"):
+        EnvSpec(ENV_ID, gym_packages=["hexapod_envs"], decision="gait_cycle").make()
+    with pytest.raises(UserError, match="'step' or 'gait_cycle', got 'cycle'"):
+        EnvSpec(ENV_ID, dict(GAINS), gym_packages=["hexapod_envs"], decision="cycle").make()
+
+
+def test_learning_curve_unit_follows_the_run_config(tmp_path):
+    from agents.pipeline.learning_curve import load_learning_curve
+
+    np.savez(
+        tmp_path / "evaluations.npz",
+        timesteps=np.array([0, 10]),
+        results=np.zeros((2, 1)),
+        ep_lengths=np.ones((2, 1)),
+    )
+    assert load_learning_curve(tmp_path).unit == "env steps"
+    (tmp_path / "config.yaml").write_text("env: {id: X, decision: gait_cycle}\n")
+    assert load_learning_curve(tmp_path).unit == "gait cycles"
+
+
+def test_a_gait_cycle_run_trains_per_cycle_and_evaluates_per_step(tmp_path):
+    """train.py with env.decision=gait_cycle: the learner's steps are gait cycles (64 of them,
+    far more than 64 env steps), the evaluations play whole episodes of env steps, and the saved
+    model plays the env at every step, as evaluate.py does."""
+    from pathlib import Path
+
+    from agents.pipeline.cli import train_main
+    from agents.ppo import PPOPolicy
+
+    config = Path(__file__).resolve().parents[1] / "configs" / "irregular_terrain_gains.yaml"
+    overrides = [
+        "ppo.n_steps=32",
+        "ppo.batch_size=32",
+        "ppo.n_epochs=1",
+        "policy.pi=[16]",
+        "policy.vf=[16]",
+        "train.total_timesteps=64",
+        "env.max_episode_steps=120",
+        "eval.freq=64",
+        "eval.n_episodes=1",
+        "checkpoint.freq=64",
+        "logging.progress_bar=false",
+    ]
+    argv = ["--config", str(config), "--output-dir", str(tmp_path), "--run-name", "cycles"]
+    assert train_main([*argv, *[a for o in overrides for a in ("--set", o)]]) == 0
+    run = tmp_path / "cycles"
+    with np.load(run / "evaluations.npz") as log:
+        assert list(log["timesteps"]) == [0, 64]
+        assert (log["ep_lengths"] == 120).all()  # env steps, not gait cycles
+    from agents.pipeline.learning_curve import load_learning_curve
+
+    assert load_learning_curve(run).unit == "gait cycles"
+    env = gym.make(ENV_ID, action_mode="gains", task_distribution="test")
+    policy = PPOPolicy.load(run / "final", env)
+    obs, _ = env.reset(seed=0)
+    gains = policy(obs)
+    assert gains.shape == (3,) and ((gains >= 0.0) & (gains <= 1.0)).all()
+
+
+def test_learning_curves_of_gait_cycle_runs_get_their_own_row(tmp_path):
+    """Runs counted in env steps and in gait cycles are not drawn on one x axis."""
+    import io
+    from types import SimpleNamespace
+
+    import matplotlib.image
+
+    from agents.pipeline.figures import learning_curves
+
+    runs = {}
+    for name, decision in (("steps", "step"), ("cycles", "gait_cycle")):
+        run = tmp_path / name
+        run.mkdir()
+        np.savez(
+            run / "evaluations.npz",
+            timesteps=np.array([0, 10]),
+            results=np.zeros((2, 1)),
+            ep_lengths=np.ones((2, 1)),
+        )
+        (run / "config.yaml").write_text(f"env: {{id: X, decision: {decision}}}\n")
+        runs[name] = SimpleNamespace(model_dir=run)
+
+    def height(names):
+        result = SimpleNamespace(runs={n: runs[n] for n in names}, label=lambda n: n)
+        return matplotlib.image.imread(io.BytesIO(learning_curves(result))).shape[0]
+
+    assert height(["steps", "cycles"]) > 1.8 * height(["steps"])
+    assert height(["cycles"]) == height(["steps"])
