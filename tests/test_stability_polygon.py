@@ -178,16 +178,16 @@ def test_static_margin_errors():
         static_stability_margin(SQUARE, [0, 0])
 
 
-def test_stability_package_imports_only_numpy_and_the_standard_library():
+def test_stability_package_imports_only_numpy_numba_and_the_standard_library():
     """The stability measures must stay usable without MuJoCo (pure math, docs/architecture.md,
-    Layers)."""
+    Layers; numba only compiles the hot loops)."""
     import ast
     import pathlib
     import sys
 
     import hexapod_envs.stability as stability
 
-    allowed = {"numpy", "hexapod_envs", *sys.stdlib_module_names}
+    allowed = {"numpy", "numba", "hexapod_envs", *sys.stdlib_module_names}
     for path in pathlib.Path(stability.__file__).parent.glob("*.py"):
         for node in ast.walk(ast.parse(path.read_text())):
             if isinstance(node, ast.Import):

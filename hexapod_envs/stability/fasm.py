@@ -45,14 +45,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hexapod_envs.stability._geometry import (
-    REL_TOL,
-    as_points,
-    as_vec3,
-    hull_3d,
-    normal_and_centroid,
-    unit,
-)
+from hexapod_envs.stability import _compiled
 
 
 @dataclass(frozen=True, slots=True)
@@ -111,103 +104,69 @@ def fasm(feet, cog, force, moment=None, up=None) -> FasmResult:
             malformed / non-finite input. An edge whose tipping force vanishes (force along the
             edge and no moment about it) gets the angle 0 (critical) rather than an error.
     """
-    pts = as_points(feet, "feet")
+    pts = _points(feet)
     k = len(pts)
     if k < 3:
         raise ValueError(f"FASM needs at least 3 feet in contact, got {k}")
-    cog_v = as_vec3(cog, "cog")
-    force_v = as_vec3(force, "force")
-    moment_v = (0.0, 0.0, 0.0) if moment is None else as_vec3(moment, "moment")
-    angles, forces, edges = _edge_angles(pts, cog_v, force_v, moment_v, up)
-    margin = min(angles)
-    index = angles.index(margin)
+    cog_v = _vec3(cog, "cog")
+    force_v = _vec3(force, "force")
+    moment_v = _NO_MOMENT if moment is None else _vec3(moment, "moment")
+    up_v = _NO_MOMENT if up is None else _vec3(up, "up")
+    status, angles, forces, edges, index = _compiled.fasm_edges(
+        pts, cog_v, force_v, moment_v, up_v, up is not None
+    )
+    if status != _compiled.OK:
+        raise ValueError(_error_message(status, index, edges, k))
+    i, j = edges[index].tolist()
     return FasmResult(
-        margin_deg=margin,
-        angles_deg=np.array(angles),
-        edges=np.array(edges, dtype=np.intp),
-        edge=edges[index],
-        edge_index=index,
-        tipping_forces=np.array(forces),
+        margin_deg=float(angles[index]),
+        angles_deg=angles,
+        edges=edges,
+        edge=(i, j),
+        edge_index=int(index),
+        tipping_forces=forces,
     )
 
 
-def _edge_angles(pts, cog, force, moment, up):
-    """Per-edge angles [deg], tipping forces [N] and (i, j) edges on validated plain floats."""
-    gx, gy, gz = cog
-    fx, fy, fz = force
-    nx, ny, nz = moment
-    f_norm = math.sqrt(fx * fx + fy * fy + fz * fz)
-    if f_norm == 0.0:
-        raise ValueError(
+_NO_MOMENT = np.zeros(3)  # also the placeholder ``up`` when none is given (never written)
+_INPUT_NAMES = ("feet", "cog", "force", "moment", "up")
+
+
+def _points(value) -> np.ndarray:
+    """``value`` as a (k, 3) float64 array, else a ValueError."""
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise ValueError(f"feet must be an array of shape (k, 3), got shape {arr.shape}")
+    return arr
+
+
+def _vec3(value, name: str) -> np.ndarray:
+    """``value`` as a (3,) float64 array, else a ValueError naming ``name``."""
+    arr = np.asarray(value, dtype=float)
+    if arr.shape != (3,):
+        raise ValueError(f"{name} must be a 3-vector (shape (3,)), got shape {arr.shape}")
+    return arr
+
+
+def _error_message(status: int, index: int, edges: np.ndarray, k: int) -> str:
+    """The ValueError message for a status of :func:`_compiled.fasm_edges`."""
+    if status == _compiled.NOT_FINITE:
+        return f"{_INPUT_NAMES[index]} contains NaN or infinite values"
+    if status == _compiled.ZERO_FORCE:
+        return (
             "the net destabilising force is zero, so the force angles are undefined; "
             "pass gravity + external + inertial force (e.g. (0, 0, -m*g))"
         )
-    hull = _ordered_hull(pts, (gx, gy, gz), up)
-
-    m = len(hull)
-    angles = [0.0] * m
-    forces = [0.0] * m
-    edges = [(0, 0)] * m
-    for j in range(m):
-        i0 = hull[j]
-        i1 = hull[j + 1] if j + 1 < m else hull[0]
-        edges[j] = (i0, i1)
-        p = pts[i0]
-        q = pts[i1]
-        ax, ay, az = q[0] - p[0], q[1] - p[1], q[2] - p[2]
-        inv = 1.0 / math.sqrt(ax * ax + ay * ay + az * az)
-        ax *= inv
-        ay *= inv
-        az *= inv
-        # l = (I - a aᵀ)(p_{i+1} - p_G)
-        wx, wy, wz = q[0] - gx, q[1] - gy, q[2] - gz
-        t = wx * ax + wy * ay + wz * az
-        lx, ly, lz = wx - t * ax, wy - t * ay, wz - t * az
-        l_norm = math.sqrt(lx * lx + ly * ly + lz * lz)
-        if l_norm <= REL_TOL * math.sqrt(wx * wx + wy * wy + wz * wz):
-            raise ValueError(
-                f"the CoG lies on the line of support edge ({i0}, {i1}); FASM is undefined there"
-            )
-        # Components of ‖l‖ f* along l̂ and t̂ = a × l̂.
-        f_l = fx * lx + fy * ly + fz * lz
-        f_t = (
-            fx * (ay * lz - az * ly)
-            + fy * (az * lx - ax * lz)
-            + fz * (ax * ly - ay * lx)
-            - (nx * ax + ny * ay + nz * az)
-        )
-        size = math.hypot(f_l, f_t)
-        if size <= REL_TOL * (f_norm * l_norm + abs(nx * ax + ny * ay + nz * az)):
-            angles[j] = 0.0  # no tipping force about this edge: critical, sign undefined
-        else:
-            angles[j] = math.degrees(math.atan2(f_t, f_l))
-        forces[j] = size / l_norm
-
-    return angles, forces, edges
-
-
-def _ordered_hull(pts: list[list[float]], cog, up) -> list[int]:
-    """Hull indices counter-clockwise seen from ``up`` (default: plane normal to the CoG side)."""
-    gx, gy, gz = cog
-    if up is not None:
-        return hull_3d(pts, unit(as_vec3(up, "up"), "up"))
-    if len(pts) == 3:
-        # Triangle: the plane normal is the cross product; order so it points to the CoG side.
-        p0, p1, p2 = pts
-        ax, ay, az = p1[0] - p0[0], p1[1] - p0[1], p1[2] - p0[2]
-        bx, by, bz = p2[0] - p0[0], p2[1] - p0[1], p2[2] - p0[2]
-        nx, ny, nz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
-        size = ax * ax + ay * ay + az * az + bx * bx + by * by + bz * bz
-        if math.sqrt(nx * nx + ny * ny + nz * nz) <= REL_TOL * size:
-            raise ValueError("the 3 feet are collinear: they do not enclose a support polygon")
-        side = (gx - p0[0]) * nx + (gy - p0[1]) * ny + (gz - p0[2]) * nz
-        if side == 0.0:
-            side = nz
-        return [0, 1, 2] if side >= 0.0 else [0, 2, 1]
-    (ux, uy, uz), (cx, cy, cz) = normal_and_centroid(pts)
-    if (gx - cx) * ux + (gy - cy) * uy + (gz - cz) * uz < 0.0:
-        ux, uy, uz = -ux, -uy, -uz
-    return hull_3d(pts, (ux, uy, uz))
+    if status == _compiled.COG_ON_EDGE:
+        i0, i1 = edges[index].tolist()
+        return f"the CoG lies on the line of support edge ({i0}, {i1}); FASM is undefined there"
+    if status == _compiled.ZERO_UP:
+        return "up must be a non-zero vector"
+    if status == _compiled.TRIANGLE_COLLINEAR:
+        return "the 3 feet are collinear: they do not enclose a support polygon"
+    if status == _compiled.NO_PLANE:
+        return f"the {k} points are collinear (or coincident): they span no plane and no polygon"
+    return f"the {k} points are collinear (seen from above): they do not enclose a support polygon"
 
 
 def fasm_from_feet(
@@ -222,29 +181,14 @@ def fasm_from_feet(
     the edge as indices into `feet`, or (0, None) when the loaded feet span no support polygon
     (fewer than three, or collinear): the robot is at the tipping limit.
     """
-    idx = [i for i, on in enumerate(loaded.tolist()) if on]
-    if len(idx) < 3:
-        return 0.0, None
-    # Plain floats: at k <= 6 feet this is several times faster than numpy calls.
-    all_p, all_f = feet.tolist(), forces.tolist()
-    p = [all_p[i] for i in idx]
-    cx, cy, cz = cog.tolist()
-    fx = fy = fz = mx = my = mz = 0.0
-    for i, (px, py, pz) in zip(idx, p, strict=True):
-        gx, gy, gz = all_f[i]
-        rx, ry, rz = px - cx, py - cy, pz - cz
-        fx -= gx
-        fy -= gy
-        fz -= gz
-        mx -= ry * gz - rz * gy
-        my -= rz * gx - rx * gz
-        mz -= rx * gy - ry * gx
-    if not math.isfinite(fx + fy + fz + mx + my + mz + cx + cy + cz):
+    status, margin, i, j = _compiled.fasm_from_feet(
+        np.asarray(feet, dtype=float),
+        np.asarray(forces, dtype=float),
+        np.asarray(cog, dtype=float),
+        np.asarray(loaded, dtype=bool),
+    )
+    if status == _compiled.OK:
+        return margin, (i, j)
+    if status == _compiled.NOT_FINITE:
         raise ValueError("foot forces, feet or CoG contain NaN or infinite values")
-    try:  # the inputs are plain floats already: skip fasm()'s array validation
-        angles, _, edges = _edge_angles(p, (cx, cy, cz), (fx, fy, fz), (mx, my, mz), None)
-    except ValueError:  # collinear feet or zero force: no polygon to stand on
-        return 0.0, None
-    margin = min(angles)
-    i, j = edges[angles.index(margin)]
-    return margin, (idx[i], idx[j])
+    return 0.0, None  # fewer than 3 loaded feet, collinear, or zero force: no polygon

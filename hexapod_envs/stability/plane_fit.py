@@ -8,7 +8,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from hexapod_envs.stability._geometry import REL_TOL, centred_moments
+from hexapod_envs.stability import _compiled
+from hexapod_envs.stability._compiled import REL_TOL
 
 
 @dataclass(frozen=True)
@@ -77,12 +78,11 @@ def fit_plane(points) -> Plane:
     k = pts.shape[0]
     if k < 3:
         raise ValueError(f"fitting a plane needs at least 3 points, got {k}")
-    rows = pts.tolist()
-    # A finite sum proves every entry finite; only a non-finite one needs the element check.
-    if not math.isfinite(sum(map(sum, rows))) and not np.isfinite(pts).all():
+    if not _compiled.finite(pts.ravel()):
         raise ValueError("points contains NaN or infinite values")
-    # Plain floats: numpy reductions cost more than the arithmetic for a few feet.
-    (x0, y0, z0), (sxx, sxy, sxz, syy, syz, _) = centred_moments(rows)
+    centroid, moments = _compiled.centred_moments(pts)
+    x0, y0, z0 = centroid.tolist()
+    sxx, sxy, sxz, syy, syz, _ = moments.tolist()
     det = sxx * syy - sxy * sxy
     if not det > REL_TOL * (sxx + syy) ** 2:
         raise ValueError(

@@ -28,7 +28,8 @@ import math
 
 import numpy as np
 
-from hexapod_envs.stability._geometry import REL_TOL, as_points, hull_2d, signed_distance_2d
+from hexapod_envs.stability._compiled import REL_TOL
+from hexapod_envs.stability._geometry import as_points, hull_2d, signed_distance_2d
 
 DEFAULT_MIN_FORCE = 1e-6  # [N] normal force at or below which a foot counts as unloaded
 
