@@ -103,28 +103,30 @@ def hull_2d(xs, ys) -> list[int]:
     Fewer than 3 hull vertices (fewer than 3 points, or all collinear): ValueError. The
     algorithm is :func:`hexapod_envs.stability._compiled.hull_2d`'s.
     """
-    k = len(xs)
-    if k < 3:
-        raise ValueError(f"a support polygon needs at least 3 points, got {k}")
+    _check_count(len(xs))
     ring = _compiled.hull_2d(np.asarray(xs, dtype=float), np.asarray(ys, dtype=float))
-    if len(ring) < 3:
-        raise ValueError(_hull_collinear(k))
-    return ring.tolist()
+    return _checked_ring(ring, len(xs))
 
 
 def hull_3d(pts, up: Vec3) -> list[int]:
     """Strict convex hull of (k, 3) ``pts`` seen along unit ``up``, counter-clockwise from above."""
-    k = len(pts)
+    _check_count(len(pts))
+    ring = _compiled.hull_up(np.asarray(pts, dtype=float), np.asarray(up, dtype=float))
+    return _checked_ring(ring, len(pts))
+
+
+def _check_count(k: int) -> None:
     if k < 3:
         raise ValueError(f"a support polygon needs at least 3 points, got {k}")
-    ring = _compiled.hull_up(np.asarray(pts, dtype=float), np.asarray(up, dtype=float))
+
+
+def _checked_ring(ring: np.ndarray, k: int) -> list[int]:
+    """The hull kernel's ``ring`` as a list, or a ValueError when it is not a polygon."""
     if len(ring) < 3:
-        raise ValueError(_hull_collinear(k))
+        raise ValueError(
+            f"the {k} points are collinear (seen from above): they do not enclose a support polygon"
+        )
     return ring.tolist()
-
-
-def _hull_collinear(k: int) -> str:
-    return f"the {k} points are collinear (seen from above): they do not enclose a support polygon"
 
 
 def signed_distance_2d(xs: list[float], ys: list[float], hull: list[int], px: float, py: float):
