@@ -668,8 +668,11 @@ class TippingRecoveryPolicy:
         joints = np.asarray(targets).reshape(-1)
         if self.action_mode == "residual":
             raw = (joints - self.reference(observation)) / self._gain
-            self._saturated = self._saturated or bool(np.any(np.abs(raw) > 1.0 + 1e-9))
-            action = np.clip(raw, -1.0, 1.0)
+            # np.maximum.reduce / np.minimum(np.maximum()) are np.abs().max() / np.clip minus
+            # their Python wrappers (the same numbers; this runs every control period).
+            peak = float(np.maximum.reduce(np.abs(raw)))
+            self._saturated = self._saturated or peak > 1.0 + 1e-9
+            action = np.minimum(np.maximum(raw, -1.0), 1.0)
         else:
             action = self.action_map.to_action(joints)
         return action.astype(self._dtype)

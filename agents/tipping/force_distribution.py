@@ -55,8 +55,8 @@ try:  # daqp is what qpsolvers calls for solver='daqp'; see _solve_dense
 except ImportError:  # pragma: no cover - then qpsolvers reports the missing back end
     daqp = None
 
+from agents.tipping import _compiled
 from hexapod_envs.stability import fit_plane, support_polygon
-from hexapod_envs.stability._geometry import hull_3d, unit
 
 GRAVITY: float = 9.81
 """[m/s²]."""
@@ -209,10 +209,6 @@ def _v_unit(a):
     return (a[0] / n, a[1] / n, a[2] / n)
 
 
-_INV_SQRT2 = 1.0 / math.sqrt(2.0)
-_FACE_SIGNS = ((1.0, 0.0), (0.0, 1.0), (-1.0, 0.0), (0.0, -1.0))  # rows of S_M's upper block
-
-
 def stability_cone(
     feet: np.ndarray,
     cog: np.ndarray,
@@ -227,28 +223,25 @@ def stability_cone(
     not given. Raises ValueError when the CoG is not above that plane.
     """
     feet = np.asarray(feet, dtype=float)
-    cog_arr = np.asarray(cog, dtype=float)
-    hull_list = None if hull is None else np.asarray(hull).tolist()
-    return _make_cone(
-        _cone_geometry(
-            feet.tolist(),
-            cog_arr.tolist(),
-            np.asarray(normal, dtype=float).tolist(),
-            cone_ratio,
-            hull_list,
-        ),
-        cog_arr,
-    )
+    cog = np.asarray(cog, dtype=float)
+    proj, unit_normal = _compiled.project_feet(feet, np.asarray(normal, dtype=float))
+    if hull is None:
+        hull = support_polygon(proj, up=unit_normal)
+    return _cone(proj, cog, unit_normal, cone_ratio, np.asarray(hull, dtype=np.int64))
 
 
-def _make_cone(geometry: tuple, cog: np.ndarray) -> StabilityCone:
-    """:class:`StabilityCone` from :func:`_cone_geometry`'s plain floats.
+def _cone(proj, cog, normal, cone_ratio: float, hull) -> StabilityCone:
+    """:class:`StabilityCone` from the feet ``proj`` projected on the terrain plane (unit
+    ``normal``; kernel: :func:`agents.tipping._compiled.cone_geometry`)."""
+    status, values, d_min, radius = _compiled.cone_geometry(proj, cog, normal, cone_ratio, hull)
+    if status != _compiled.OK:
+        raise ValueError(_cog_below(cog, normal))
+    return _cone_from(values, d_min, radius, cog)
 
-    One array conversion for G_s, T_1..T_4, tan α and the faces together (they are views of
-    it), instead of one each.
-    """
-    g_s, d_min, radius, base, tan_alpha, faces = geometry
-    values = np.array((*g_s, *base[0], *base[1], *base[2], *base[3], *tan_alpha, *faces))
+
+def _cone_from(values: np.ndarray, d_min: float, radius: float, cog: np.ndarray) -> StabilityCone:
+    """The cone kernel's output as a :class:`StabilityCone` (G_s, T_1..T_4, tan α and the
+    faces are views of the one array ``values``)."""
     return StabilityCone(
         cog.copy(),
         values[:3],
@@ -260,119 +253,17 @@ def _make_cone(geometry: tuple, cog: np.ndarray) -> StabilityCone:
     )
 
 
-def _cone_geometry(rows, c, normal, cone_ratio: float, hull):
-    """Eqs. (21)-(22) and (24) on plain floats: (G_s, d_min, radius, T_1..T_4, tan α, faces).
+def _cog_below(cog: np.ndarray, normal: np.ndarray) -> str:
+    return f"the CoG {cog} is not above the support plane (normal {tuple(normal.tolist())})"
 
-    ``rows`` (k lists of 3 floats) are the stance feet [m], ``c`` the CoG [m], ``normal`` the
-    (not necessarily unit) terrain up-normal, ``hull`` the support polygon as indices into
-    ``rows`` (None: computed). Written out on floats without helper calls because it runs
-    every control period on 3-6 feet, where numpy's and Python's per-call overheads would
-    dominate; the operations and their order are those of the original vector-helper version,
-    so the results are bit-identical to it (tests/test_tipping_force_distribution.py).
-    """
-    n0, n1, n2 = normal
-    nn = math.sqrt(n0 * n0 + n1 * n1 + n2 * n2)
-    n0, n1, n2 = n0 / nn, n1 / nn, n2 / nn
-    k = len(rows)
-    c0 = c1 = c2 = 0  # an int start, as sum() has: 0 + x is x exactly
-    for r0, r1, r2 in rows:
-        c0 += r0
-        c1 += r1
-        c2 += r2
-    c0, c1, c2 = c0 / k, c1 / k, c2 / k
-    proj = []
-    for r0, r1, r2 in rows:
-        h = (r0 - c0) * n0 + (r1 - c1) * n1 + (r2 - c2) * n2
-        proj.append((r0 - h * n0, r1 - h * n1, r2 - h * n2))
-    if hull is None:
-        hull = support_polygon(np.array(proj), up=np.array((n0, n1, n2))).tolist()
-    poly = [proj[i] for i in hull]
-    m = len(poly)
-    # Area centroid by a triangle fan (the polygon is convex).
-    x0, y0, z0 = poly[0]
-    gx = gy = gz = total = 0.0
-    for j in range(1, m - 1):
-        x1, y1, z1 = poly[j]
-        x2, y2, z2 = poly[j + 1]
-        ux, uy, uz = x1 - x0, y1 - y0, z1 - z0
-        vx, vy, vz = x2 - x0, y2 - y0, z2 - z0
-        area = 0.5 * (
-            (uy * vz - uz * vy) * n0 + (uz * vx - ux * vz) * n1 + (ux * vy - uy * vx) * n2
-        )
-        total += area
-        gx += area * (x0 + x1 + x2)
-        gy += area * (y0 + y1 + y2)
-        gz += area * (z0 + z1 + z2)
-    s0, s1, s2 = gx / (3.0 * total), gy / (3.0 * total), gz / (3.0 * total)
-    # Eq. (21): distance from G_s to each edge line.
-    d_min = math.inf
-    for j in range(m):
-        ax, ay, az = poly[j]
-        bx, by, bz = poly[(j + 1) % m]
-        ex, ey, ez = bx - ax, by - ay, bz - az
-        en = math.sqrt(ex * ex + ey * ey + ez * ez)
-        ex, ey, ez = ex / en, ey / en, ez / en
-        wx, wy, wz = ax - s0, ay - s1, az - s2
-        t = wx * ex + wy * ey + wz * ez
-        px, py, pz = wx - t * ex, wy - t * ey, wz - t * ez
-        d_min = min(d_min, math.sqrt(px * px + py * py + pz * pz))
-    radius = cone_ratio * d_min
-    ex0, ex1, ex2 = _v_unit((1.0 - n0 * n0, -n0 * n1, -n0 * n2))
-    ey0, ey1, ey2 = n1 * ex2 - n2 * ex1, n2 * ex0 - n0 * ex2, n0 * ex1 - n1 * ex0
-    rp, rn = radius * 1.0, radius * -1.0
-    base = (
-        (s0 + rp * ex0, s1 + rp * ex1, s2 + rp * ex2),
-        (s0 + rp * ey0, s1 + rp * ey1, s2 + rp * ey2),
-        (s0 + rn * ex0, s1 + rn * ex1, s2 + rn * ex2),
-        (s0 + rn * ey0, s1 + rn * ey1, s2 + rn * ey2),
-    )
-    q0, q1, q2 = c
-    a0, a1, a2 = s0 - q0, s1 - q1, s2 - q2  # cone axis CoG -> G_s
-    if a0 * n0 + a1 * n1 + a2 * n2 >= 0.0:
-        raise ValueError(
-            f"the CoG {np.array(c)} is not above the support plane (normal {(n0, n1, n2)})"
-        )
-    tan_alpha = []
-    for t0, t1, t2 in base:
-        b0, b1, b2 = t0 - q0, t1 - q1, t2 - q2
-        r0, r1, r2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
-        tan_alpha.append(math.sqrt(r0 * r0 + r1 * r1 + r2 * r2) / abs(b0 * a0 + b1 * a1 + b2 * a2))
-    h0, h1, h2 = _v_unit((a0, a1, a2))  # ĝ, unit cone axis
-    eg = ex0 * h0 + ex1 * h1 + ex2 * h2
-    f0, f1, f2 = _v_unit((ex0 - eg * h0, ex1 - eg * h1, ex2 - eg * h2))  # e_1
-    e0, e1, e2 = f1 * h2 - f2 * h1, f2 * h0 - f0 * h2, f0 * h1 - f1 * h0  # e_2 = e_1 × ĝ
-    r2 = _INV_SQRT2
-    # faces = S_Mᵀ Qᵀ with Q = [e1 e2 -ĝ]: row j = s_1j e_1 + s_2j e_2 - (tan α_j/√2) ĝ, with
-    # (s_1j, s_2j) = (1, 0), (0, 1), (-1, 0), (0, -1) (multiplied out: zeros keep their sign).
-    faces = []
-    for (u, v), ta in zip(_FACE_SIGNS, tan_alpha, strict=True):
-        tr = ta * r2
-        faces += (u * f0 + v * e0 - tr * h0, u * f1 + v * e1 - tr * h1, u * f2 + v * e2 - tr * h2)
-    return (s0, s1, s2), d_min, radius, base, tan_alpha, faces
+
+def _cog_on_edge(edge: np.ndarray) -> str:
+    return f"the CoG lies on the line of support edge {tuple(edge.tolist())}"
 
 
 def _moment_rows(rel: np.ndarray) -> np.ndarray:
     """[[P_1]x ... [P_k]x] (3, 3k) for positions ``rel`` (k, 3) relative to the CoG."""
-    return _wrench_map(np.asarray(rel, dtype=float).tolist(), (0.0, 0.0, 0.0))[3:]
-
-
-def _wrench_map(rows, c) -> np.ndarray:
-    """A = [[E ... E], [[P_1]x ... [P_k]x]] (6, 3k) of eq. (17), P_j = rows[j] - c (floats)."""
-    k = len(rows)
-    top = _FORCE_SUM_ROWS.get(k)
-    if top is None:
-        top = _FORCE_SUM_ROWS[k] = [1.0, 0.0, 0.0] * k + [0.0, 1.0, 0.0] * k + [0.0, 0.0, 1.0] * k
-    m0, m1, m2 = [], [], []
-    q0, q1, q2 = c
-    for r0, r1, r2 in rows:
-        x, y, z = r0 - q0, r1 - q1, r2 - q2
-        m0 += (0.0, -z, y)
-        m1 += (z, 0.0, -x)
-        m2 += (-y, x, 0.0)
-    return np.array(top + m0 + m1 + m2).reshape(6, 3 * k)
-
-
-_FORCE_SUM_ROWS: dict[int, list[float]] = {}  # [E ... E] as a flat list per foot count
+    return _compiled.wrench_map(np.asarray(rel, dtype=float), np.zeros(3))[3:]
 
 
 def tipping_force_matrices(
@@ -389,50 +280,28 @@ def tipping_force_matrices(
     cog = np.asarray(cog, dtype=float)
     if moment_rows is None:
         moment_rows = _moment_rows(feet - cog)
-    return _tipping_matrices(feet.tolist(), cog.tolist(), np.asarray(edges).tolist(), moment_rows)
+    return _tipping_matrices(feet, cog, np.asarray(edges, dtype=np.int64), moment_rows)
 
 
-def _tipping_matrices(rows, c, edges, moment_rows: np.ndarray) -> np.ndarray:
-    """:func:`tipping_force_matrices` on plain floats (``edges`` a list of index pairs).
+def _tipping_matrices(feet, cog, edges, moment_rows: np.ndarray) -> np.ndarray:
+    """:func:`tipping_force_matrices` on arrays (``edges`` (m, 2) int64).
 
-    I - a âᵀ and the couple term (l̂ × a) aᵀ / ‖l‖ are written out per edge on floats (the
-    operations of the original vector-helper version, so the result is bit-identical to it),
-    then one matmul with the moment rows and one in-place add of I - a aᵀ per foot block.
+    The per-edge terms I - a aᵀ and (l̂ × a) aᵀ / ‖l‖ come from the compiled kernel, then one
+    matmul with the moment rows and one in-place add of I - a aᵀ per foot block.
     """
-    k = len(rows)
-    m = len(edges)
-    q0, q1, q2 = c
-    ima = []  # I - a aᵀ per edge, flat (0.0 - v, not -v: the sign of a zero must match)
-    couple = []  # (l̂ × a) aᵀ / ‖l‖ per edge, flat
-    for e0, e1 in edges:
-        p = rows[e0]
-        w0, w1, w2 = rows[e1]
-        a0, a1, a2 = w0 - p[0], w1 - p[1], w2 - p[2]
-        an = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
-        a0, a1, a2 = a0 / an, a1 / an, a2 / an
-        w0, w1, w2 = w0 - q0, w1 - q1, w2 - q2
-        t = w0 * a0 + w1 * a1 + w2 * a2
-        l0, l1, l2 = w0 - t * a0, w1 - t * a1, w2 - t * a2
-        l_norm = math.sqrt(l0 * l0 + l1 * l1 + l2 * l2)
-        if l_norm < 1e-9 * max(1.0, abs(w0), abs(w1), abs(w2)):
-            raise ValueError(f"the CoG lies on the line of support edge {(e0, e1)}")
-        ima += (
-            1.0 - a0 * a0, 0.0 - a0 * a1, 0.0 - a0 * a2,
-            0.0 - a1 * a0, 1.0 - a1 * a1, 0.0 - a1 * a2,
-            0.0 - a2 * a0, 0.0 - a2 * a1, 1.0 - a2 * a2,
-        )  # fmt: skip
-        # [l̂]x (a aᵀ) / ‖l‖ = (l̂ × a) aᵀ / ‖l‖
-        x0, x1, x2 = l1 * a2 - l2 * a1, l2 * a0 - l0 * a2, l0 * a1 - l1 * a0
-        inv = 1.0 / (l_norm * l_norm)
-        couple += (
-            x0 * a0 * inv, x0 * a1 * inv, x0 * a2 * inv,
-            x1 * a0 * inv, x1 * a1 * inv, x1 * a2 * inv,
-            x2 * a0 * inv, x2 * a1 * inv, x2 * a2 * inv,
-        )  # fmt: skip
-    out = np.array(couple).reshape(m, 3, 3) @ moment_rows  # (m, 3, 3k)
+    status, bad, ima, couple = _compiled.tipping_terms(feet, cog, edges)
+    if status != _compiled.OK:
+        raise ValueError(_cog_on_edge(edges[bad]))
+    return _add_tipping_products(ima, couple, moment_rows)
+
+
+def _add_tipping_products(ima, couple, moment_rows: np.ndarray) -> np.ndarray:
+    """V_i = couple_i [[P_1]x ... [P_k]x] + [I - a aᵀ ... I - a aᵀ] for every edge i."""
+    out = couple @ moment_rows  # (m, 3, 3k)
     # + [I - a aᵀ ... I - a aᵀ], added per foot block in place (np.tile cost a copy).
+    m, k = len(ima), moment_rows.shape[1] // 3
     blocks = out.reshape(m, 3, k, 3)
-    np.add(blocks, np.array(ima).reshape(m, 3, 1, 3), out=blocks)
+    np.add(blocks, ima.reshape(m, 3, 1, 3), out=blocks)
     return out
 
 
@@ -541,10 +410,10 @@ class ForceDistributor:
             raise ValueError(f"feet must have shape ({k}, 3), got {feet.shape}")
         if cog.shape != (3,) or b.shape != (6,):
             raise ValueError(f"cog must be (3,) and wrench (6,), got {cog.shape}, {b.shape}")
-        rows, c = feet.tolist(), cog.tolist()
         # A finite sum proves every entry finite (NaN and ±inf propagate); only an overflowing
         # or non-finite sum needs the element-wise check.
-        if not math.isfinite(sum(map(sum, rows)) + sum(c) + sum(b.tolist())) and not (
+        total = sum(feet.ravel().tolist()) + sum(cog.tolist()) + sum(b.tolist())
+        if not math.isfinite(total) and not (
             np.isfinite(feet).all() and np.isfinite(cog).all() and np.isfinite(b).all()
         ):
             raise ValueError("feet, cog and wrench must be finite")
@@ -552,8 +421,19 @@ class ForceDistributor:
             n = fit_plane(feet).normal
         else:
             n = np.array(_v_unit(np.asarray(normal, dtype=float).tolist()))
+        status, bad, a_mat, hull, edges, values, d_min, radius, ima, couple = _compiled.qp_geometry(
+            feet, cog, n, cfg.cone_ratio, cfg.stability_cone
+        )
+        if status == _compiled.HULL_COLLINEAR:
+            raise ValueError(
+                f"the {k} points are collinear (seen from above): they do not enclose a "
+                "support polygon"
+            )
+        if status == _compiled.COG_NOT_ABOVE:
+            raise ValueError(_cog_below(cog, n / np.sqrt(n @ n)))
+        if status == _compiled.COG_ON_EDGE:
+            raise ValueError(_cog_on_edge(edges[bad]))
 
-        a_mat = _wrench_map(rows, c)  # [[E ... E], [[P_1]x ... [P_k]x]]
         scale = max(math.sqrt(float(b[:3] @ b[:3])), k * cfg.min_normal_force, 1.0)
         b_scaled = b / scale
         sa = a_mat if self._unit_weights else self._s_col * a_mat  # 1.0 * v is v exactly
@@ -569,7 +449,6 @@ class ForceDistributor:
         t2 = (n1 * t1[2] - n2 * t1[1], n2 * t1[0] - n0 * t1[2], n0 * t1[1] - n1 * t1[0])
         friction_rows = self._pyramid @ np.array([t1, t2, nl])  # (4, 3); frame rows t1, t2, n
 
-        hull = hull_3d(rows, unit((n0, n1, n2), "up"))
         m = len(hull)
         g_buf, normal_block, friction_block, cone_block = self._g_buffer(m)
         normal_block[...] = -n
@@ -578,18 +457,11 @@ class ForceDistributor:
         h_vec[:k] = -cfg.min_normal_force / scale
         cone = None
         if cfg.stability_cone:
-            cone = _make_cone(_cone_geometry(rows, c, nl, cfg.cone_ratio, hull), cog)
-            edges = [(hull[j], hull[j + 1]) for j in range(m - 1)]
-            edges.append((hull[-1], hull[0]))
-            v_all = _tipping_matrices(rows, c, edges, a_mat[3:])
+            cone = _cone_from(values, d_min, radius, cog)
+            v_all = _add_tipping_products(ima, couple, a_mat[3:])
             # faces · f*_i <= 0 with f*_i = -V_i x: rows -(faces @ V_i), edge by edge.
             np.matmul(cone.faces, v_all, out=cone_block)
             np.negative(cone_block, out=cone_block)
-            edges = np.array(edges, dtype=np.intp)
-        else:
-            edges = np.empty((m, 2), dtype=np.intp)
-            edges[:, 0] = hull
-            edges[:-1, 1], edges[-1, 1] = hull[1:], hull[0]
         return ForceQp(
             U=u_mat,
             f=f_vec,

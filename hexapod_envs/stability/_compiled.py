@@ -61,6 +61,34 @@ def centred_moments(pts):
 
 
 @njit(cache=True)
+def fit_plane(pts):
+    """Least-squares z = a x + b y + c through (k, 3) ``pts`` (see .plane_fit.fit_plane).
+
+    Returns (status, (a, b, c) (3,), unit up-normal (3,), point above the centroid (3,));
+    status NOT_FINITE, or NO_PLANE when the points' (x, y) are collinear or coincident.
+    """
+    zero = np.zeros(3)
+    if not finite(pts.ravel()):
+        return NOT_FINITE, zero, zero, zero
+    centroid, mom = centred_moments(pts)
+    x0, y0, z0 = centroid[0], centroid[1], centroid[2]
+    sxx, sxy, sxz, syy, syz = mom[0], mom[1], mom[2], mom[3], mom[4]
+    det = sxx * syy - sxy * sxy
+    if not det > REL_TOL * (sxx + syy) ** 2:
+        return NO_PLANE, zero, zero, zero
+    a = (sxz * syy - sxy * syz) / det
+    b = (sxx * syz - sxy * sxz) / det
+    c = z0 - a * x0 - b * y0
+    s = 1.0 / math.sqrt(a * a + b * b + 1.0)
+    return (
+        OK,
+        np.array((a, b, c)),
+        np.array((-a * s, -b * s, s)),
+        np.array((x0, y0, a * x0 + b * y0 + c)),
+    )
+
+
+@njit(cache=True)
 def plane_normal(pts):
     """(unit normal (3,) with n_z >= 0, centroid (3,), ok) of the least-squares plane.
 

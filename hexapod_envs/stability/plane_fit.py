@@ -9,7 +9,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from hexapod_envs.stability import _compiled
-from hexapod_envs.stability._compiled import REL_TOL
 
 
 @dataclass(frozen=True)
@@ -78,16 +77,12 @@ def fit_plane(points) -> Plane:
     k = pts.shape[0]
     if k < 3:
         raise ValueError(f"fitting a plane needs at least 3 points, got {k}")
-    if not _compiled.finite(pts.ravel()):
+    status, coefficients, normal, point = _compiled.fit_plane(pts)
+    if status == _compiled.NOT_FINITE:
         raise ValueError("points contains NaN or infinite values")
-    centroid, moments = _compiled.centred_moments(pts)
-    x0, y0, z0 = centroid.tolist()
-    sxx, sxy, sxz, syy, syz, _ = moments.tolist()
-    det = sxx * syy - sxy * sxy
-    if not det > REL_TOL * (sxx + syy) ** 2:
+    if status != _compiled.OK:
         raise ValueError(
             f"the {k} points' (x, y) are collinear or coincident: z = a x + b y + c is undetermined"
         )
-    a = (sxz * syy - sxy * syz) / det
-    b = (sxx * syz - sxy * sxz) / det
-    return Plane.from_coefficients(a, b, z0 - a * x0 - b * y0, x0, y0)
+    a, b, c = coefficients.tolist()
+    return Plane(a=a, b=b, c=c, normal=normal, point=point)

@@ -1,0 +1,205 @@
+"""Compiled geometry of the force-distribution QP (private; numba).
+
+The QP is rebuilt every control period of the tipping recovery on 3-6 stance feet; as
+plain-float Python its geometry (stability cone, tipping-force terms, wrench map) took most of
+the build's time in interpreter overhead. These ``numba.njit`` kernels do the same arithmetic
+in the same order, so U, f, G and h stay bit-identical
+(tests/test_tipping_force_distribution.py checks it against the original assembly); the matrix
+products stay in numpy in :mod:`.force_distribution`. Compiled on first use and cached on disk,
+like :mod:`hexapod_envs.stability._compiled`. Kernels return status codes; the callers raise.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from hexapod_envs.stability._compiled import centred_moments, hull_up
+
+OK = 0
+COG_NOT_ABOVE = 1  # the CoG is not above the support plane
+COG_ON_EDGE = 2  # the CoG lies on a support edge's line
+HULL_COLLINEAR = 3  # the feet are collinear seen along the normal
+
+_INV_SQRT2 = 1.0 / math.sqrt(2.0)
+
+
+@njit(cache=True)
+def wrench_map(feet, cog):
+    """A = [[E ... E], [[P_1]x ... [P_k]x]] (6, 3k) of eq. (17), P_j = feet[j] - cog."""
+    k = feet.shape[0]
+    a = np.zeros((6, 3 * k))
+    for j in range(k):
+        x, y, z = feet[j, 0] - cog[0], feet[j, 1] - cog[1], feet[j, 2] - cog[2]
+        c = 3 * j
+        a[0, c] = a[1, c + 1] = a[2, c + 2] = 1.0
+        a[3, c + 1], a[3, c + 2] = -z, y
+        a[4, c], a[4, c + 2] = z, -x
+        a[5, c], a[5, c + 1] = -y, x
+    return a
+
+
+@njit(cache=True)
+def _unit3(x, y, z):
+    n = math.sqrt(x * x + y * y + z * z)
+    return x / n, y / n, z / n
+
+
+@njit(cache=True)
+def project_feet(feet, normal):
+    """(feet projected onto the plane through their centroid, unit normal) for any ``normal``."""
+    n0, n1, n2 = _unit3(normal[0], normal[1], normal[2])
+    k = feet.shape[0]
+    centroid, _ = centred_moments(feet)
+    c0, c1, c2 = centroid[0], centroid[1], centroid[2]
+    proj = np.empty((k, 3))
+    for i in range(k):
+        r0, r1, r2 = feet[i, 0], feet[i, 1], feet[i, 2]
+        h = (r0 - c0) * n0 + (r1 - c1) * n1 + (r2 - c2) * n2
+        proj[i, 0], proj[i, 1], proj[i, 2] = r0 - h * n0, r1 - h * n1, r2 - h * n2
+    return proj, np.array((n0, n1, n2))
+
+
+@njit(cache=True)
+def cone_geometry(proj, cog, normal, cone_ratio, hull):
+    """Eqs. (21)-(22) and (24) for feet ``proj`` already in the terrain plane (unit ``normal``).
+
+    Returns (status, values (31,), d_min, radius) with values = G_s (3), T_1..T_4 (12),
+    tan α_1..α_4 (4), pyramid faces (12); ``hull`` holds the support polygon's vertex indices
+    counter-clockwise from +normal.
+    """
+    n0, n1, n2 = normal[0], normal[1], normal[2]
+    m = hull.shape[0]
+    values = np.empty(31)
+    # Area centroid by a triangle fan (the polygon is convex).
+    p0 = hull[0]
+    x0, y0, z0 = proj[p0, 0], proj[p0, 1], proj[p0, 2]
+    gx = gy = gz = total = 0.0
+    for j in range(1, m - 1):
+        p1, p2 = hull[j], hull[j + 1]
+        x1, y1, z1 = proj[p1, 0], proj[p1, 1], proj[p1, 2]
+        x2, y2, z2 = proj[p2, 0], proj[p2, 1], proj[p2, 2]
+        ux, uy, uz = x1 - x0, y1 - y0, z1 - z0
+        vx, vy, vz = x2 - x0, y2 - y0, z2 - z0
+        area = 0.5 * (
+            (uy * vz - uz * vy) * n0 + (uz * vx - ux * vz) * n1 + (ux * vy - uy * vx) * n2
+        )
+        total += area
+        gx += area * (x0 + x1 + x2)
+        gy += area * (y0 + y1 + y2)
+        gz += area * (z0 + z1 + z2)
+    s0, s1, s2 = gx / (3.0 * total), gy / (3.0 * total), gz / (3.0 * total)
+    # Eq. (21): distance from G_s to each edge line.
+    d_min = math.inf
+    for j in range(m):
+        pa, pb = hull[j], hull[(j + 1) % m]
+        ax, ay, az = proj[pa, 0], proj[pa, 1], proj[pa, 2]
+        ex, ey, ez = proj[pb, 0] - ax, proj[pb, 1] - ay, proj[pb, 2] - az
+        en = math.sqrt(ex * ex + ey * ey + ez * ez)
+        ex, ey, ez = ex / en, ey / en, ez / en
+        wx, wy, wz = ax - s0, ay - s1, az - s2
+        t = wx * ex + wy * ey + wz * ez
+        px, py, pz = wx - t * ex, wy - t * ey, wz - t * ez
+        d_min = min(d_min, math.sqrt(px * px + py * py + pz * pz))
+    radius = cone_ratio * d_min
+    ex0, ex1, ex2 = _unit3(1.0 - n0 * n0, -n0 * n1, -n0 * n2)
+    ey0, ey1, ey2 = n1 * ex2 - n2 * ex1, n2 * ex0 - n0 * ex2, n0 * ex1 - n1 * ex0
+    values[0], values[1], values[2] = s0, s1, s2
+    # T_1..T_4 along +e_x, +e_y, -e_x, -e_y (radius * 1.0 and * -1.0, as the original).
+    for j in range(4):
+        r = radius * (1.0 if j < 2 else -1.0)
+        d0, d1, d2 = (ex0, ex1, ex2) if j % 2 == 0 else (ey0, ey1, ey2)
+        values[3 + 3 * j] = s0 + r * d0
+        values[4 + 3 * j] = s1 + r * d1
+        values[5 + 3 * j] = s2 + r * d2
+    q0, q1, q2 = cog[0], cog[1], cog[2]
+    a0, a1, a2 = s0 - q0, s1 - q1, s2 - q2  # cone axis CoG -> G_s
+    if a0 * n0 + a1 * n1 + a2 * n2 >= 0.0:
+        return COG_NOT_ABOVE, values, d_min, radius
+    for j in range(4):
+        b0, b1, b2 = values[3 + 3 * j] - q0, values[4 + 3 * j] - q1, values[5 + 3 * j] - q2
+        r0, r1, r2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+        values[15 + j] = math.sqrt(r0 * r0 + r1 * r1 + r2 * r2) / abs(b0 * a0 + b1 * a1 + b2 * a2)
+    h0, h1, h2 = _unit3(a0, a1, a2)  # ĝ, unit cone axis
+    eg = ex0 * h0 + ex1 * h1 + ex2 * h2
+    f0, f1, f2 = _unit3(ex0 - eg * h0, ex1 - eg * h1, ex2 - eg * h2)  # e_1
+    e0, e1, e2 = f1 * h2 - f2 * h1, f2 * h0 - f0 * h2, f0 * h1 - f1 * h0  # e_2 = e_1 × ĝ
+    # faces = S_Mᵀ Qᵀ with Q = [e1 e2 -ĝ]: row j = s_1j e_1 + s_2j e_2 - (tan α_j/√2) ĝ, with
+    # (s_1j, s_2j) = (1, 0), (0, 1), (-1, 0), (0, -1) (multiplied out: zeros keep their sign).
+    for j in range(4):
+        u = 1.0 if j == 0 else -1.0 if j == 2 else 0.0
+        v = 1.0 if j == 1 else -1.0 if j == 3 else 0.0
+        tr = values[15 + j] * _INV_SQRT2
+        values[19 + 3 * j] = u * f0 + v * e0 - tr * h0
+        values[20 + 3 * j] = u * f1 + v * e1 - tr * h1
+        values[21 + 3 * j] = u * f2 + v * e2 - tr * h2
+    return OK, values, d_min, radius
+
+
+@njit(cache=True)
+def tipping_terms(feet, cog, edges):
+    """Per support edge, I - a aᵀ and the couple term (l̂ × a) aᵀ / ‖l‖ of eq. (20).
+
+    Returns (status, index of the offending edge, ima (m, 3, 3), couple (m, 3, 3)); V_i is
+    couple_i [[P_1]x ... [P_k]x] + [I - a aᵀ ... I - a aᵀ] (the products are done in numpy).
+    """
+    m = edges.shape[0]
+    q0, q1, q2 = cog[0], cog[1], cog[2]
+    ima = np.empty((m, 3, 3))
+    couple = np.empty((m, 3, 3))
+    for e in range(m):
+        i0, i1 = edges[e, 0], edges[e, 1]
+        w0, w1, w2 = feet[i1, 0], feet[i1, 1], feet[i1, 2]
+        a0, a1, a2 = w0 - feet[i0, 0], w1 - feet[i0, 1], w2 - feet[i0, 2]
+        an = math.sqrt(a0 * a0 + a1 * a1 + a2 * a2)
+        a0, a1, a2 = a0 / an, a1 / an, a2 / an
+        w0, w1, w2 = w0 - q0, w1 - q1, w2 - q2
+        t = w0 * a0 + w1 * a1 + w2 * a2
+        l0, l1, l2 = w0 - t * a0, w1 - t * a1, w2 - t * a2
+        l_norm = math.sqrt(l0 * l0 + l1 * l1 + l2 * l2)
+        if l_norm < 1e-9 * max(1.0, abs(w0), abs(w1), abs(w2)):
+            return COG_ON_EDGE, e, ima, couple
+        a = (a0, a1, a2)
+        for r in range(3):
+            for c in range(3):
+                ima[e, r, c] = (1.0 if r == c else 0.0) - a[r] * a[c]  # 0.0 - v keeps +0.0
+        # [l̂]x (a aᵀ) / ‖l‖ = (l̂ × a) aᵀ / ‖l‖
+        x = (l1 * a2 - l2 * a1, l2 * a0 - l0 * a2, l0 * a1 - l1 * a0)
+        inv = 1.0 / (l_norm * l_norm)
+        for r in range(3):
+            for c in range(3):
+                couple[e, r, c] = x[r] * a[c] * inv
+    return OK, -1, ima, couple
+
+
+@njit(cache=True)
+def qp_geometry(feet, cog, normal, cone_ratio, with_cone):
+    """Everything geometric of one QP build, in one call (see ForceDistributor.build).
+
+    ``normal`` is the terrain's unit up-normal. Returns (status, detail, A (6, 3k), hull (m,),
+    edges (m, 2), cone values (31,), d_min, radius, ima (m, 3, 3), couple (m, 3, 3)); without
+    the cone the last five are placeholders. ``detail`` is the offending edge's index for
+    COG_ON_EDGE.
+    """
+    a_mat = wrench_map(feet, cog)
+    hull = hull_up(feet, np.array(_unit3(normal[0], normal[1], normal[2])))
+    m = hull.shape[0]
+    edges = np.empty((m, 2), dtype=np.int64)
+    values = np.empty(31)
+    ima = np.empty((m, 3, 3))
+    couple = np.empty((m, 3, 3))
+    if m < 3:
+        return HULL_COLLINEAR, -1, a_mat, hull, edges, values, 0.0, 0.0, ima, couple
+    for j in range(m):
+        edges[j, 0] = hull[j]
+        edges[j, 1] = hull[j + 1] if j + 1 < m else hull[0]
+    if not with_cone:
+        return OK, -1, a_mat, hull, edges, values, 0.0, 0.0, ima, couple
+    proj, unit_normal = project_feet(feet, normal)
+    status, values, d_min, radius = cone_geometry(proj, cog, unit_normal, cone_ratio, hull)
+    if status != OK:
+        return status, -1, a_mat, hull, edges, values, d_min, radius, ima, couple
+    status, bad, ima, couple = tipping_terms(feet, cog, edges)
+    return status, bad, a_mat, hull, edges, values, d_min, radius, ima, couple
