@@ -175,15 +175,32 @@ def tipping_terms(feet, cog, edges):
 
 
 @njit(cache=True)
+def tangent_frame(normal):
+    """(3, 3) rows t_1, t_2, n: t_1 the body x axis projected on the plane of unit ``normal``
+    (the y axis when x is within 1e-6 of the normal), t_2 = n × t_1."""
+    n0, n1, n2 = normal[0], normal[1], normal[2]
+    x, y, z = 1.0 - n0 * n0, -n0 * n1, -n0 * n2
+    if math.sqrt(x * x + y * y + z * z) < 1e-6:
+        x, y, z = -n1 * n0, 1.0 - n1 * n1, -n1 * n2
+    x, y, z = _unit3(x, y, z)
+    frame = np.empty((3, 3))
+    frame[0, 0], frame[0, 1], frame[0, 2] = x, y, z
+    frame[1, 0], frame[1, 1], frame[1, 2] = n1 * z - n2 * y, n2 * x - n0 * z, n0 * y - n1 * x
+    frame[2, 0], frame[2, 1], frame[2, 2] = n0, n1, n2
+    return frame
+
+
+@njit(cache=True)
 def qp_geometry(feet, cog, normal, cone_ratio, with_cone):
     """Everything geometric of one QP build, in one call (see ForceDistributor.build).
 
-    ``normal`` is the terrain's unit up-normal. Returns (status, detail, A (6, 3k), hull (m,),
-    edges (m, 2), cone values (31,), d_min, radius, ima (m, 3, 3), couple (m, 3, 3)); without
-    the cone the last five are placeholders. ``detail`` is the offending edge's index for
-    COG_ON_EDGE.
+    ``normal`` is the terrain's unit up-normal. Returns (status, detail, A (6, 3k), tangent
+    frame (3, 3) (see :func:`tangent_frame`), hull (m,), edges (m, 2), cone values (31,), d_min,
+    radius, ima (m, 3, 3), couple (m, 3, 3)); without the cone the last five are placeholders.
+    ``detail`` is the offending edge's index for COG_ON_EDGE.
     """
     a_mat = wrench_map(feet, cog)
+    frame = tangent_frame(normal)
     hull = hull_up(feet, np.array(_unit3(normal[0], normal[1], normal[2])))
     m = hull.shape[0]
     edges = np.empty((m, 2), dtype=np.int64)
@@ -191,15 +208,15 @@ def qp_geometry(feet, cog, normal, cone_ratio, with_cone):
     ima = np.empty((m, 3, 3))
     couple = np.empty((m, 3, 3))
     if m < 3:
-        return HULL_COLLINEAR, -1, a_mat, hull, edges, values, 0.0, 0.0, ima, couple
+        return HULL_COLLINEAR, -1, a_mat, frame, hull, edges, values, 0.0, 0.0, ima, couple
     for j in range(m):
         edges[j, 0] = hull[j]
         edges[j, 1] = hull[j + 1] if j + 1 < m else hull[0]
     if not with_cone:
-        return OK, -1, a_mat, hull, edges, values, 0.0, 0.0, ima, couple
+        return OK, -1, a_mat, frame, hull, edges, values, 0.0, 0.0, ima, couple
     proj, unit_normal = project_feet(feet, normal)
     status, values, d_min, radius = cone_geometry(proj, cog, unit_normal, cone_ratio, hull)
     if status != OK:
-        return status, -1, a_mat, hull, edges, values, d_min, radius, ima, couple
+        return status, -1, a_mat, frame, hull, edges, values, d_min, radius, ima, couple
     status, bad, ima, couple = tipping_terms(feet, cog, edges)
-    return status, bad, a_mat, hull, edges, values, d_min, radius, ima, couple
+    return status, bad, a_mat, frame, hull, edges, values, d_min, radius, ima, couple

@@ -56,6 +56,7 @@ except ImportError:  # pragma: no cover - then qpsolvers reports the missing bac
     daqp = None
 
 from agents.tipping import _compiled
+from hexapod_envs.stability import _compiled as _stability_kernels
 from hexapod_envs.stability import fit_plane, support_polygon
 
 GRAVITY: float = 9.81
@@ -412,17 +413,19 @@ class ForceDistributor:
             raise ValueError(f"cog must be (3,) and wrench (6,), got {cog.shape}, {b.shape}")
         # A finite sum proves every entry finite (NaN and ±inf propagate); only an overflowing
         # or non-finite sum needs the element-wise check.
-        total = sum(feet.ravel().tolist()) + sum(cog.tolist()) + sum(b.tolist())
-        if not math.isfinite(total) and not (
+        finite = _stability_kernels.finite
+        if not (finite(feet.ravel()) and finite(cog) and finite(b)) and not (
             np.isfinite(feet).all() and np.isfinite(cog).all() and np.isfinite(b).all()
         ):
             raise ValueError("feet, cog and wrench must be finite")
         if normal is None:
-            n = fit_plane(feet).normal
+            fitted, _, n, _ = _stability_kernels.fit_plane(feet)
+            if fitted != _stability_kernels.OK:
+                fit_plane(feet)  # raises the ValueError that names the problem
         else:
             n = np.array(_v_unit(np.asarray(normal, dtype=float).tolist()))
-        status, bad, a_mat, hull, edges, values, d_min, radius, ima, couple = _compiled.qp_geometry(
-            feet, cog, n, cfg.cone_ratio, cfg.stability_cone
+        status, bad, a_mat, frame, hull, edges, values, d_min, radius, ima, couple = (
+            _compiled.qp_geometry(feet, cog, n, cfg.cone_ratio, cfg.stability_cone)
         )
         if status == _compiled.HULL_COLLINEAR:
             raise ValueError(
@@ -440,14 +443,7 @@ class ForceDistributor:
         u_mat = 2.0 * a_mat.T @ sa + self._reg
         f_vec = -2.0 * sa.T @ b_scaled
 
-        nl = n.tolist()
-        n0, n1, n2 = nl
-        t1 = (1.0 - n0 * n0, -n0 * n1, -n0 * n2)
-        if math.sqrt(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2]) < 1e-6:
-            t1 = (-n1 * n0, 1.0 - n1 * n1, -n1 * n2)
-        t1 = _v_unit(t1)
-        t2 = (n1 * t1[2] - n2 * t1[1], n2 * t1[0] - n0 * t1[2], n0 * t1[1] - n1 * t1[0])
-        friction_rows = self._pyramid @ np.array([t1, t2, nl])  # (4, 3); frame rows t1, t2, n
+        friction_rows = self._pyramid @ frame  # (4, 3); frame rows t1, t2, n
 
         m = len(hull)
         g_buf, normal_block, friction_block, cone_block = self._g_buffer(m)
