@@ -6,7 +6,8 @@ envs and the recovery controller call; the earlier target was <= 20 µs). Inputs
 numpy arrays, as an environment passes them. Each case is timed in batches of 50 calls with
 ``time.perf_counter``; the median (and, as a load-insensitive figure, the minimum) over the
 batches is printed. For comparison, the edge loop of FASM is also timed as minimal vectorised
-numpy (same hull), the alternative to the plain-float loop the package uses.
+numpy (same hull), the alternative to the compiled kernels the package uses
+(hexapod_envs/stability/_compiled.py; each case's untimed first call compiles or loads them).
 """
 
 from __future__ import annotations
