@@ -9,6 +9,13 @@ summed. It is the semi-MDP of "one decision per gait cycle" (the paper's gains a
 The env reads the gains at the first control step of a cycle; a wait for the stance feet to touch
 the ground at the cycle start (ground search) belongs to the cycle before.
 
+With ``baseline_action`` the wrapper also plays each cycle a second time, on a copy of the env
+taken at the cycle start, with that action held (e.g. the zero residual: the paper's gains), and
+returns the difference of the two rewards: what the chosen action gained over the baseline on the
+same terrain, from the same state (common random numbers). On a block bed the terrain under the
+feet moves a cycle's reward far more than the gains do, so the plain reward ranks gain settings
+only at noise level; the difference cancels the terrain and leaves the gains' effect.
+
 A policy trained through it acts identically without it: the env reads the action only at the
 cycle starts, and the wrapped env returns exactly the observation that the unwrapped env returns
 before each cycle start. Evaluation (which needs every step's info for its metrics) therefore
@@ -17,6 +24,7 @@ runs the policy on the unwrapped env at every step.
 
 from __future__ import annotations
 
+import copy
 from typing import Any
 
 import gymnasium as gym
@@ -29,10 +37,24 @@ class GainsPerCycle(gym.Wrapper):
     ``step`` returns the last control step's observation, termination, truncation and info, with
     the reward summed over the cycle's control steps; ``info["cycle_steps"]`` is how many control
     steps it ran (a cycle's, plus the ground-search waits before the next one; fewer when the
-    episode ended inside the cycle)."""
+    episode ended inside the cycle).
 
-    def __init__(self, env: gym.Env):
+    With ``baseline_action`` (an action of the wrapped env) the reward is that sum minus the sum
+    over as many control steps (fewer if it ends first) of a copy of the wrapped env taken before
+    the cycle and driven with the baseline action; ``info["cycle_reward"]`` and
+    ``info["baseline_reward"]`` hold both sums and ``info["baseline_steps"]`` the copy's steps
+    (which count as simulated env steps: the cycle is simulated twice)."""
+
+    def __init__(self, env: gym.Env, baseline_action: Any = None):
         super().__init__(env)
+        self.baseline_action = None
+        if baseline_action is not None:
+            self.baseline_action = np.asarray(baseline_action, dtype=env.action_space.dtype)
+            if not env.action_space.contains(self.baseline_action):
+                raise ValueError(
+                    f"baseline_action {baseline_action!r} is not in the action space "
+                    f"{env.action_space}"
+                )
         base = env.unwrapped
         if not hasattr(type(base), "gains_due"):
             raise ValueError(
@@ -47,6 +69,7 @@ class GainsPerCycle(gym.Wrapper):
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         base = self.env.unwrapped
+        twin = None if self.baseline_action is None else copy.deepcopy(self.env)
         total, steps = 0.0, 0
         while True:
             obs, reward, terminated, truncated, info = self.env.step(action)
@@ -55,4 +78,15 @@ class GainsPerCycle(gym.Wrapper):
             if terminated or truncated or base.gains_due:
                 break
         info["cycle_steps"] = steps
-        return obs, total, terminated, truncated, info
+        if twin is None:
+            return obs, total, terminated, truncated, info
+        baseline, baseline_steps = 0.0, 0
+        while baseline_steps < steps:
+            _, reward, twin_terminated, twin_truncated, _ = twin.step(self.baseline_action)
+            baseline += float(reward)
+            baseline_steps += 1
+            if twin_terminated or twin_truncated:
+                break
+        twin.close()
+        info.update(cycle_reward=total, baseline_reward=baseline, baseline_steps=baseline_steps)
+        return obs, total - baseline, terminated, truncated, info

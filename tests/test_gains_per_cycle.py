@@ -75,6 +75,51 @@ def test_env_spec_decision_builds_the_wrapper_and_names_bad_values():
         EnvSpec(ENV_ID, dict(GAINS), gym_packages=["hexapod_envs"], decision="cycle").make()
 
 
+def test_a_baseline_cycle_is_replayed_from_the_same_state_and_subtracted():
+    """With baseline_action the reward is the cycle's reward minus that of the same cycle played
+    with the baseline action from the same state; the real trajectory is unchanged."""
+    paper = np.array([0.6, 0.4, 0.4], dtype=np.float32)
+    other = np.array([0.9, 0.1, 0.7], dtype=np.float32)
+    env = GainsPerCycle(gym.make(ENV_ID, **GAINS), baseline_action=paper)
+    env.reset(seed=2)
+    _, reward, _, _, info = env.step(paper)
+    assert reward == 0.0 and info["baseline_steps"] == info["cycle_steps"]
+    obs, reward, _, _, info = env.step(other)
+    assert reward == info["cycle_reward"] - info["baseline_reward"] != 0.0
+
+    # The same two cycles without a baseline: same observation, same cycle reward.
+    plain = GainsPerCycle(gym.make(ENV_ID, **GAINS))
+    plain.reset(seed=2)
+    plain.step(paper)
+    obs_plain, reward_plain, _, _, info_plain = plain.step(other)
+    np.testing.assert_array_equal(obs, obs_plain)
+    assert (info["cycle_reward"], info["cycle_steps"]) == (reward_plain, info_plain["cycle_steps"])
+    # The baseline: the paper's gains from the state after the first cycle, as many steps.
+    replay = GainsPerCycle(gym.make(ENV_ID, **GAINS))
+    replay.reset(seed=2)
+    replay.step(paper)
+    baseline = sum(float(replay.env.step(paper)[1]) for _ in range(info["baseline_steps"]))
+    assert info["baseline_reward"] == baseline
+
+
+def test_baseline_settings_are_checked_by_name():
+    from agents.pipeline.envs import EnvSpec
+    from agents.pipeline.errors import UserError
+
+    with pytest.raises(ValueError, match="baseline_action .* is not in the action space"):
+        GainsPerCycle(gym.make(ENV_ID, **GAINS), baseline_action=[2.0, 0.0, 0.0])
+    spec = EnvSpec(ENV_ID, dict(GAINS), gym_packages=["hexapod_envs"], cycle_baseline="zero")
+    with pytest.raises(UserError, match="'none' or 'zero_action', got 'zero'"):
+        spec.make()
+    spec = EnvSpec(ENV_ID, dict(GAINS), gym_packages=["hexapod_envs"], cycle_baseline="zero_action")
+    with pytest.raises(UserError, match="cycle_baseline needs env.decision: gait_cycle"):
+        spec.make()
+    spec.decision = "gait_cycle"
+    env = spec.make()
+    env.reset(seed=0)
+    assert env.step(np.zeros(3, dtype=np.float32))[1] == 0.0  # the zero action is the baseline
+
+
 def test_learning_curve_unit_follows_the_run_config(tmp_path):
     from agents.pipeline.learning_curve import load_learning_curve
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import gymnasium as gym
+import numpy as np
 
 from .errors import UserError
 
@@ -75,6 +76,9 @@ class EnvSpec:
     decision: str = "step"
     """"step": the learner acts at every env step; "gait_cycle": once per gait cycle, through
     `hexapod_envs.wrappers.GainsPerCycle` (the irregular terrain's "gains" mode)."""
+    cycle_baseline: str = "none"
+    """With decision "gait_cycle": "zero_action" rewards each cycle relative to the zero action
+    replayed from the same state (`GainsPerCycle`'s ``baseline_action``); "none": plain."""
 
     def make(self, **extra: Any) -> gym.Env:
         """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
@@ -98,16 +102,28 @@ class EnvSpec:
                 raise UserError(f"cannot build the hybrid policy env on {self.id}: {exc}") from None
         if self.reward_exclude:
             env = ExcludeRewardTerms(env, self.reward_exclude)
+        if self.cycle_baseline not in ("none", "zero_action"):
+            raise UserError(
+                f"env.cycle_baseline must be 'none' or 'zero_action', got {self.cycle_baseline!r}"
+            )
         if self.decision == "gait_cycle":
             from hexapod_envs.wrappers import GainsPerCycle
 
+            baseline = None
+            if self.cycle_baseline == "zero_action":
+                baseline = np.zeros(env.action_space.shape, dtype=env.action_space.dtype)
             try:
-                env = GainsPerCycle(env)
+                env = GainsPerCycle(env, baseline_action=baseline)
             except ValueError as exc:
                 env.close()
                 raise UserError(f"env.decision='gait_cycle' on {self.id}: {exc}") from None
         elif self.decision != "step":
             raise UserError(f"env.decision must be 'step' or 'gait_cycle', got {self.decision!r}")
+        elif self.cycle_baseline != "none":
+            raise UserError(
+                "env.cycle_baseline needs env.decision: gait_cycle (the baseline replays whole "
+                f"gait cycles), got decision {self.decision!r}"
+            )
         return env
 
 

@@ -74,6 +74,10 @@ class EnvConfig:
     irregular terrain's "gains" mode through `hexapod_envs.wrappers.GainsPerCycle`; training
     steps then count gait cycles, and the training episodes' TensorBoard statistics see each
     cycle's last step only; evaluations still run every env step, see the wrapper)."""
+    cycle_baseline: Literal["none", "zero_action"] = "none"
+    """With ``decision: gait_cycle``: "zero_action" makes each cycle's reward the difference to
+    the same cycle replayed from the same state with the zero action (a hybrid run's paper
+    gains), see `hexapod_envs.wrappers.GainsPerCycle`; every cycle is then simulated twice."""
 
 
 @dataclass

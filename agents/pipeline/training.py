@@ -80,6 +80,7 @@ def env_spec(config: TrainConfig) -> EnvSpec:
         config.hybrid,
         list(env.reward_exclude),
         env.decision,
+        env.cycle_baseline,
     )
 
 
@@ -112,7 +113,7 @@ def _vec_envs(config: TrainConfig, seed: int, stats: NormalizationStats | None =
     )
     # Evaluations act at every env step (the same actions as per gait cycle, see GainsPerCycle),
     # so that their episode metrics see every step's info.
-    eval_spec = dataclasses.replace(spec, decision="step")
+    eval_spec = dataclasses.replace(spec, decision="step", cycle_baseline="none")
     eval_env = DummyVecEnv([EnvFactory(eval_spec)]) if config.eval.freq > 0 else None
     if eval_env is not None:
         eval_env.seed(seed + EVAL_SEED_OFFSET)
