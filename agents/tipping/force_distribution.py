@@ -399,9 +399,10 @@ class ForceDistributor:
         ``normal`` is the terrain's unit up-normal in the body frame (default: least-squares
         plane through the feet). Raises ValueError on malformed input or degenerate geometry.
 
-        Runs every control period, so the geometry is computed on plain floats and written
-        into per-polygon-size buffers whose constant parts are built once (see
-        :meth:`_g_buffer`); the returned arrays are fresh copies.
+        Runs every control period, so the geometry comes from one compiled kernel
+        (:func:`agents.tipping._compiled.qp_geometry`) and is written into per-polygon-size
+        buffers whose constant parts are built once (see :meth:`_g_buffer`); the returned
+        arrays are fresh copies.
         """
         k, cfg = self.n_feet, self.config
         feet = np.asarray(feet, dtype=float)
