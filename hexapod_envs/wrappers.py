@@ -25,6 +25,7 @@ runs the policy on the unwrapped env at every step.
 from __future__ import annotations
 
 import copy
+from collections.abc import Callable
 from typing import Any
 
 import gymnasium as gym
@@ -70,23 +71,25 @@ class GainsPerCycle(gym.Wrapper):
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         base = self.env.unwrapped
         twin = None if self.baseline_action is None else copy.deepcopy(self.env)
-        total, steps = 0.0, 0
-        while True:
-            obs, reward, terminated, truncated, info = self.env.step(action)
-            total += float(reward)
-            steps += 1
-            if terminated or truncated or base.gains_due:
-                break
+        (obs, _, terminated, truncated, info), total, steps = _play(
+            self.env, action, lambda _: base.gains_due
+        )
         info["cycle_steps"] = steps
         if twin is None:
             return obs, total, terminated, truncated, info
-        baseline, baseline_steps = 0.0, 0
-        while baseline_steps < steps:
-            _, reward, twin_terminated, twin_truncated, _ = twin.step(self.baseline_action)
-            baseline += float(reward)
-            baseline_steps += 1
-            if twin_terminated or twin_truncated:
-                break
+        _, baseline, baseline_steps = _play(twin, self.baseline_action, lambda n: n >= steps)
         twin.close()
         info.update(cycle_reward=total, baseline_reward=baseline, baseline_steps=baseline_steps)
         return obs, total - baseline, terminated, truncated, info
+
+
+def _play(env: gym.Env, action: Any, done: Callable[[int], bool]) -> tuple[tuple, float, int]:
+    """Step ``env`` with ``action`` until the episode ends or ``done(steps so far)``; returns
+    the last step's result, the summed reward and the number of steps."""
+    total, steps = 0.0, 0
+    while True:
+        result = env.step(action)
+        total += float(result[1])
+        steps += 1
+        if result[2] or result[3] or done(steps):
+            return result, total, steps

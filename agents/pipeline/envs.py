@@ -84,6 +84,7 @@ class EnvSpec:
         """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
         turned into a UserError."""
         check_env_id(self.id, self.gym_packages)
+        self._check_decision()
         kwargs = {**self.kwargs, **extra}
         if self.max_episode_steps is not None:
             kwargs["max_episode_steps"] = self.max_episode_steps
@@ -102,10 +103,6 @@ class EnvSpec:
                 raise UserError(f"cannot build the hybrid policy env on {self.id}: {exc}") from None
         if self.reward_exclude:
             env = ExcludeRewardTerms(env, self.reward_exclude)
-        if self.cycle_baseline not in ("none", "zero_action"):
-            raise UserError(
-                f"env.cycle_baseline must be 'none' or 'zero_action', got {self.cycle_baseline!r}"
-            )
         if self.decision == "gait_cycle":
             from hexapod_envs.wrappers import GainsPerCycle
 
@@ -117,14 +114,22 @@ class EnvSpec:
             except ValueError as exc:
                 env.close()
                 raise UserError(f"env.decision='gait_cycle' on {self.id}: {exc}") from None
-        elif self.decision != "step":
+        return env
+
+    def _check_decision(self) -> None:
+        """`decision` and `cycle_baseline` name valid choices that fit together (before any env
+        is built)."""
+        if self.decision not in ("step", "gait_cycle"):
             raise UserError(f"env.decision must be 'step' or 'gait_cycle', got {self.decision!r}")
-        elif self.cycle_baseline != "none":
+        if self.cycle_baseline not in ("none", "zero_action"):
+            raise UserError(
+                f"env.cycle_baseline must be 'none' or 'zero_action', got {self.cycle_baseline!r}"
+            )
+        if self.cycle_baseline != "none" and self.decision != "gait_cycle":
             raise UserError(
                 "env.cycle_baseline needs env.decision: gait_cycle (the baseline replays whole "
                 f"gait cycles), got decision {self.decision!r}"
             )
-        return env
 
 
 class ExcludeRewardTerms(gym.Wrapper):

@@ -58,6 +58,7 @@ except ImportError:  # pragma: no cover - then qpsolvers reports the missing bac
 from agents.tipping import _compiled
 from hexapod_envs.stability import _compiled as _stability_kernels
 from hexapod_envs.stability import fit_plane, support_polygon
+from hexapod_envs.stability._geometry import hull_collinear_message
 
 GRAVITY: float = 9.81
 """[m/s²]."""
@@ -228,15 +229,11 @@ def stability_cone(
     proj, unit_normal = _compiled.project_feet(feet, np.asarray(normal, dtype=float))
     if hull is None:
         hull = support_polygon(proj, up=unit_normal)
-    return _cone(proj, cog, unit_normal, cone_ratio, np.asarray(hull, dtype=np.int64))
-
-
-def _cone(proj, cog, normal, cone_ratio: float, hull) -> StabilityCone:
-    """:class:`StabilityCone` from the feet ``proj`` projected on the terrain plane (unit
-    ``normal``; kernel: :func:`agents.tipping._compiled.cone_geometry`)."""
-    status, values, d_min, radius = _compiled.cone_geometry(proj, cog, normal, cone_ratio, hull)
+    status, values, d_min, radius = _compiled.cone_geometry(
+        proj, cog, unit_normal, cone_ratio, np.asarray(hull, dtype=np.int64)
+    )
     if status != _compiled.OK:
-        raise ValueError(_cog_below(cog, normal))
+        raise ValueError(_cog_below(cog, unit_normal))
     return _cone_from(values, d_min, radius, cog)
 
 
@@ -281,15 +278,7 @@ def tipping_force_matrices(
     cog = np.asarray(cog, dtype=float)
     if moment_rows is None:
         moment_rows = _moment_rows(feet - cog)
-    return _tipping_matrices(feet, cog, np.asarray(edges, dtype=np.int64), moment_rows)
-
-
-def _tipping_matrices(feet, cog, edges, moment_rows: np.ndarray) -> np.ndarray:
-    """:func:`tipping_force_matrices` on arrays (``edges`` (m, 2) int64).
-
-    The per-edge terms I - a aᵀ and (l̂ × a) aᵀ / ‖l‖ come from the compiled kernel, then one
-    matmul with the moment rows and one in-place add of I - a aᵀ per foot block.
-    """
+    edges = np.asarray(edges, dtype=np.int64)
     status, bad, ima, couple = _compiled.tipping_terms(feet, cog, edges)
     if status != _compiled.OK:
         raise ValueError(_cog_on_edge(edges[bad]))
@@ -429,12 +418,9 @@ class ForceDistributor:
             _compiled.qp_geometry(feet, cog, n, cfg.cone_ratio, cfg.stability_cone)
         )
         if status == _compiled.HULL_COLLINEAR:
-            raise ValueError(
-                f"the {k} points are collinear (seen from above): they do not enclose a "
-                "support polygon"
-            )
+            raise ValueError(hull_collinear_message(k))
         if status == _compiled.COG_NOT_ABOVE:
-            raise ValueError(_cog_below(cog, n / np.sqrt(n @ n)))
+            raise ValueError(_cog_below(cog, n))
         if status == _compiled.COG_ON_EDGE:
             raise ValueError(_cog_on_edge(edges[bad]))
 

@@ -17,27 +17,49 @@ from hexapod_envs.stability import _compiled
 Vec3 = tuple[float, float, float]
 
 
-def as_points(points, name: str, dims: tuple[int, ...] = (3,)) -> list[list[float]]:
-    """Validate a (k, d) array of finite points and return it as a list of float lists."""
+def points_array(points, name: str, dims: tuple[int, ...] = (3,)) -> np.ndarray:
+    """``points`` as a (k, d) float array (d in ``dims``), else a ValueError naming ``name``."""
     arr = np.asarray(points, dtype=float)
     if arr.ndim != 2 or arr.shape[1] not in dims:
         wanted = " or ".join(f"(k, {d})" for d in dims)
         raise ValueError(f"{name} must be an array of shape {wanted}, got shape {arr.shape}")
+    return arr
+
+
+def as_points(points, name: str, dims: tuple[int, ...] = (3,)) -> list[list[float]]:
+    """Validate a (k, d) array of finite points and return it as a list of float lists."""
+    arr = points_array(points, name, dims)
     rows = arr.tolist()
     if not math.isfinite(sum(arr.ravel().tolist())):
         raise ValueError(f"{name} contains NaN or infinite values")
     return rows
 
 
-def as_vec3(vector, name: str) -> Vec3:
-    """Validate a finite 3-vector and return it as a tuple of floats."""
+def vec3_array(vector, name: str) -> np.ndarray:
+    """``vector`` as a (3,) float array, else a ValueError naming ``name``."""
     arr = np.asarray(vector, dtype=float)
     if arr.shape != (3,):
         raise ValueError(f"{name} must be a 3-vector (shape (3,)), got shape {arr.shape}")
+    return arr
+
+
+def as_vec3(vector, name: str) -> Vec3:
+    """Validate a finite 3-vector and return it as a tuple of floats."""
+    arr = vec3_array(vector, name)
     x, y, z = arr.tolist()
     if not math.isfinite(x + y + z):
         raise ValueError(f"{name} contains NaN or infinite values: {arr}")
     return x, y, z
+
+
+def hull_collinear_message(k: int) -> str:
+    """The error of ``k`` points whose hull seen from above is no polygon."""
+    return f"the {k} points are collinear (seen from above): they do not enclose a support polygon"
+
+
+def no_plane_message(k: int) -> str:
+    """The error of ``k`` points (k > 3) without a least-squares plane."""
+    return f"the {k} points are collinear (or coincident): they span no plane and no polygon"
 
 
 def unit(v: Vec3, name: str) -> Vec3:
@@ -63,8 +85,7 @@ def normal_and_centroid(pts) -> tuple[Vec3, Vec3]:
     """(least-squares unit normal with n_z >= 0, centroid) of ``pts``; see least_squares_normal."""
     normal, centroid, ok = _compiled.plane_normal(np.asarray(pts, dtype=float))
     if not ok:
-        k = len(pts)
-        raise ValueError(f"the {k} points are collinear (or coincident): they span no plane")
+        raise ValueError(no_plane_message(len(pts)))
     return tuple(normal.tolist()), tuple(centroid.tolist())
 
 
@@ -123,9 +144,7 @@ def _check_count(k: int) -> None:
 def _checked_ring(ring: np.ndarray, k: int) -> list[int]:
     """The hull kernel's ``ring`` as a list, or a ValueError when it is not a polygon."""
     if len(ring) < 3:
-        raise ValueError(
-            f"the {k} points are collinear (seen from above): they do not enclose a support polygon"
-        )
+        raise ValueError(hull_collinear_message(k))
     return ring.tolist()
 
 

@@ -46,6 +46,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from hexapod_envs.stability import _compiled
+from hexapod_envs.stability._geometry import (
+    hull_collinear_message,
+    no_plane_message,
+    points_array,
+    vec3_array,
+)
 
 
 @dataclass(frozen=True, slots=True)
@@ -104,14 +110,14 @@ def fasm(feet, cog, force, moment=None, up=None) -> FasmResult:
             malformed / non-finite input. An edge whose tipping force vanishes (force along the
             edge and no moment about it) gets the angle 0 (critical) rather than an error.
     """
-    pts = _points(feet)
+    pts = points_array(feet, "feet")
     k = len(pts)
     if k < 3:
         raise ValueError(f"FASM needs at least 3 feet in contact, got {k}")
-    cog_v = _vec3(cog, "cog")
-    force_v = _vec3(force, "force")
-    moment_v = _NO_MOMENT if moment is None else _vec3(moment, "moment")
-    up_v = _NO_MOMENT if up is None else _vec3(up, "up")
+    cog_v = vec3_array(cog, "cog")
+    force_v = vec3_array(force, "force")
+    moment_v = _NO_MOMENT if moment is None else vec3_array(moment, "moment")
+    up_v = _NO_MOMENT if up is None else vec3_array(up, "up")
     status, angles, forces, edges, index = _compiled.fasm_edges(
         pts, cog_v, force_v, moment_v, up_v, up is not None
     )
@@ -132,22 +138,6 @@ _NO_MOMENT = np.zeros(3)  # also the placeholder ``up`` when none is given (neve
 _INPUT_NAMES = ("feet", "cog", "force", "moment", "up")
 
 
-def _points(value) -> np.ndarray:
-    """``value`` as a (k, 3) float64 array, else a ValueError."""
-    arr = np.asarray(value, dtype=float)
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise ValueError(f"feet must be an array of shape (k, 3), got shape {arr.shape}")
-    return arr
-
-
-def _vec3(value, name: str) -> np.ndarray:
-    """``value`` as a (3,) float64 array, else a ValueError naming ``name``."""
-    arr = np.asarray(value, dtype=float)
-    if arr.shape != (3,):
-        raise ValueError(f"{name} must be a 3-vector (shape (3,)), got shape {arr.shape}")
-    return arr
-
-
 def _error_message(status: int, index: int, edges: np.ndarray, k: int) -> str:
     """The ValueError message for a status of :func:`_compiled.fasm_edges`."""
     if status == _compiled.NOT_FINITE:
@@ -165,8 +155,8 @@ def _error_message(status: int, index: int, edges: np.ndarray, k: int) -> str:
     if status == _compiled.TRIANGLE_COLLINEAR:
         return "the 3 feet are collinear: they do not enclose a support polygon"
     if status == _compiled.NO_PLANE:
-        return f"the {k} points are collinear (or coincident): they span no plane and no polygon"
-    return f"the {k} points are collinear (seen from above): they do not enclose a support polygon"
+        return no_plane_message(k)
+    return hull_collinear_message(k)
 
 
 def fasm_from_feet(
