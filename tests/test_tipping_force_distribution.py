@@ -239,6 +239,29 @@ def test_degenerate_geometry_does_not_raise():
         ForceDistributor(3).solve(feet[:2], COG, b)
 
 
+def test_build_refuses_bad_input_with_the_reason():
+    feet = feet_of("LF", "LR", "RM", "RR")
+    b = desired_wrench(MASS, INERTIA, [0.0, 0.0, -GRAVITY])
+    build = ForceDistributor(4).build
+    for bad in (feet.copy(), COG.copy(), b.copy()):
+        bad.flat[1] = np.nan
+        args = [bad if x.shape == bad.shape else x for x in (feet, COG, b)]
+        with pytest.raises(ValueError, match="must be finite"):
+            build(*args)
+    huge = feet.copy()
+    huge[:2, 0] = 1e308  # finite entries whose sum overflows
+    with pytest.raises(ValueError, match="too large"):
+        build(huge, COG, b)
+    upright = feet.copy()
+    upright[:, :2] = 0.0  # one vertical line: no plane z = ax + by + c
+    with pytest.raises(ValueError, match="collinear|coincident"):
+        build(upright, COG, b)
+    # With the normal given, the same feet are collinear seen along it: no support polygon.
+    upright[:, 2] = np.arange(4.0)
+    with pytest.raises(ValueError, match="collinear"):
+        build(upright, COG, b, normal=np.array([1.0, 0.0, 0.0]))
+
+
 def test_config_validation_names_choices():
     with pytest.raises(ValueError, match="valid solvers"):
         ForceDistributionConfig(solver="osqp")

@@ -16,12 +16,14 @@ import math
 import numpy as np
 from numba import njit
 
-from hexapod_envs.stability._compiled import centred_moments, hull_up
+from hexapod_envs.stability._compiled import centred_moments, finite, fit_plane, hull_up
 
 OK = 0
 COG_NOT_ABOVE = 1  # the CoG is not above the support plane
 COG_ON_EDGE = 2  # the CoG lies on a support edge's line
 HULL_COLLINEAR = 3  # the feet are collinear seen along the normal
+NOT_FINITE = 4  # feet, CoG or wrench contain NaN or inf
+NO_PLANE = 5  # no plane fits the feet (their x, y collinear or coincident)
 
 _INV_SQRT2 = 1.0 / math.sqrt(2.0)
 
@@ -191,14 +193,22 @@ def tangent_frame(normal):
 
 
 @njit(cache=True)
-def qp_geometry(feet, cog, normal, cone_ratio, with_cone):
+def qp_geometry(feet, cog, wrench, normal, fit_normal, cone_ratio, with_cone):
     """Everything geometric of one QP build, in one call (see ForceDistributor.build).
 
-    ``normal`` is the terrain's unit up-normal. Returns (status, detail, A (6, 3k), tangent
-    frame (3, 3) (see :func:`tangent_frame`), hull (m,), edges (m, 2), cone values (31,), d_min,
-    radius, ima (m, 3, 3), couple (m, 3, 3)); without the cone the last five are placeholders.
-    ``detail`` is the offending edge's index for COG_ON_EDGE.
+    Checks that ``feet``, ``cog`` and ``wrench`` are finite; ``normal`` is the terrain's unit
+    up-normal, or with ``fit_normal`` the least-squares plane's through the feet (``normal`` is
+    then ignored). Returns (status, detail, normal (3,), A (6, 3k), tangent frame (3, 3) (see
+    :func:`tangent_frame`), hull (m,), edges (m, 2), cone values (31,), d_min, radius, ima
+    (m, 3, 3), couple (m, 3, 3)); without the cone the last five are placeholders. ``detail``
+    is the offending edge's index for COG_ON_EDGE.
     """
+    if not (finite(feet.ravel()) and finite(cog) and finite(wrench)):
+        return _failed(NOT_FINITE, feet, normal)
+    if fit_normal:
+        fitted, _, normal, _ = fit_plane(feet)
+        if fitted != OK:
+            return _failed(NO_PLANE, feet, normal)
     a_mat = wrench_map(feet, cog)
     frame = tangent_frame(normal)
     hull = hull_up(feet, np.array(_unit3(normal[0], normal[1], normal[2])))
@@ -208,15 +218,38 @@ def qp_geometry(feet, cog, normal, cone_ratio, with_cone):
     ima = np.empty((m, 3, 3))
     couple = np.empty((m, 3, 3))
     if m < 3:
-        return HULL_COLLINEAR, -1, a_mat, frame, hull, edges, values, 0.0, 0.0, ima, couple
+        return HULL_COLLINEAR, -1, normal, a_mat, frame, hull, edges, values, 0.0, 0.0, ima, couple
     for j in range(m):
         edges[j, 0] = hull[j]
         edges[j, 1] = hull[j + 1] if j + 1 < m else hull[0]
     if not with_cone:
-        return OK, -1, a_mat, frame, hull, edges, values, 0.0, 0.0, ima, couple
+        return OK, -1, normal, a_mat, frame, hull, edges, values, 0.0, 0.0, ima, couple
     proj, unit_normal = project_feet(feet, normal)
     status, values, d_min, radius = cone_geometry(proj, cog, unit_normal, cone_ratio, hull)
     if status != OK:
-        return status, -1, a_mat, frame, hull, edges, values, d_min, radius, ima, couple
+        return status, -1, normal, a_mat, frame, hull, edges, values, d_min, radius, ima, couple
     status, bad, ima, couple = tipping_terms(feet, cog, edges)
-    return status, bad, a_mat, frame, hull, edges, values, d_min, radius, ima, couple
+    return status, bad, normal, a_mat, frame, hull, edges, values, d_min, radius, ima, couple
+
+
+@njit(cache=True)
+def _failed(status, feet, normal):
+    """qp_geometry's result for inputs it refuses: ``status`` and empty placeholders."""
+    a_mat = np.zeros((6, 3 * feet.shape[0]))
+    hull = np.empty(0, dtype=np.int64)
+    edges = np.empty((0, 2), dtype=np.int64)
+    terms = np.empty((0, 3, 3))
+    return (
+        status,
+        -1,
+        normal,
+        a_mat,
+        np.zeros((3, 3)),
+        hull,
+        edges,
+        np.empty(31),
+        0.0,
+        0.0,
+        terms,
+        terms,
+    )

@@ -56,7 +56,6 @@ except ImportError:  # pragma: no cover - then qpsolvers reports the missing bac
     daqp = None
 
 from agents.tipping import _compiled
-from hexapod_envs.stability import _compiled as _stability_kernels
 from hexapod_envs.stability import fit_plane, support_polygon
 from hexapod_envs.stability._geometry import hull_collinear_message
 
@@ -204,6 +203,10 @@ class StabilityCone:
         """True when the force direction lies in the pyramid (faces · f <= tol ‖f‖)."""
         force = np.asarray(force, dtype=float)
         return bool(np.all(self.faces @ force <= tol * np.linalg.norm(force)))
+
+
+_NO_NORMAL = np.zeros(3)
+"""The placeholder normal of a build that fits the plane through the feet (never written)."""
 
 
 def _v_unit(a):
@@ -401,22 +404,22 @@ class ForceDistributor:
             raise ValueError(f"feet must have shape ({k}, 3), got {feet.shape}")
         if cog.shape != (3,) or b.shape != (6,):
             raise ValueError(f"cog must be (3,) and wrench (6,), got {cog.shape}, {b.shape}")
-        # A finite sum proves every entry finite (NaN and ±inf propagate); only an overflowing
-        # or non-finite sum needs the element-wise check.
-        finite = _stability_kernels.finite
-        if not (finite(feet.ravel()) and finite(cog) and finite(b)) and not (
-            np.isfinite(feet).all() and np.isfinite(cog).all() and np.isfinite(b).all()
-        ):
-            raise ValueError("feet, cog and wrench must be finite")
-        if normal is None:
-            fitted, _, n, _ = _stability_kernels.fit_plane(feet)
-            if fitted != _stability_kernels.OK:
-                fit_plane(feet)  # raises the ValueError that names the problem
+        fit_normal = normal is None
+        if fit_normal:
+            n = _NO_NORMAL
         else:
             n = np.array(_v_unit(np.asarray(normal, dtype=float).tolist()))
-        status, bad, a_mat, frame, hull, edges, values, d_min, radius, ima, couple = (
-            _compiled.qp_geometry(feet, cog, n, cfg.cone_ratio, cfg.stability_cone)
+        status, bad, n, a_mat, frame, hull, edges, values, d_min, radius, ima, couple = (
+            _compiled.qp_geometry(feet, cog, b, n, fit_normal, cfg.cone_ratio, cfg.stability_cone)
         )
+        if status == _compiled.NOT_FINITE:
+            # The kernel's check is a finite sum (NaN and ±inf propagate): finite entries fail
+            # it only when their sum overflows.
+            if np.isfinite(feet).all() and np.isfinite(cog).all() and np.isfinite(b).all():
+                raise ValueError("feet, cog and wrench are too large: their sum overflows")
+            raise ValueError("feet, cog and wrench must be finite")
+        if status == _compiled.NO_PLANE:
+            fit_plane(feet)  # raises the ValueError that names the problem
         if status == _compiled.HULL_COLLINEAR:
             raise ValueError(hull_collinear_message(k))
         if status == _compiled.COG_NOT_ABOVE:
