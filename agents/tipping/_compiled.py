@@ -253,3 +253,69 @@ def _failed(status, feet, normal):
         terms,
         terms,
     )
+
+
+@njit(cache=True)
+def body_feet_and_cog(joints, hips, l1, consts, hip_sums):
+    """(feet (6, 3), CoG (3,)) in the body frame from the (6, 3) encoder readings (see
+    HeavyDutyBodyModel.feet_and_cog, which packs ``consts``: k_x, k_z, L2, the moving links'
+    mass, the mass weighting the hip distance, the carriage's fixed mass moment, shank mass and
+    centre, foot mass and centre, leg mass, total mass)."""
+    k_x, k_z, l2, m_moving, y_mass, z_fixed = (
+        consts[0],
+        consts[1],
+        consts[2],
+        consts[3],
+        consts[4],
+        consts[5],
+    )
+    m_shank, shank_up, m_foot, foot_up, m_leg, total = (
+        consts[6],
+        consts[7],
+        consts[8],
+        consts[9],
+        consts[10],
+        consts[11],
+    )
+    feet = np.empty((6, 3))
+    sum_x = sum_y = sum_z = 0.0
+    for i in range(6):
+        c, s = math.cos(joints[i, 2]), math.sin(joints[i, 2])
+        x = k_x * joints[i, 0]
+        d = k_z * joints[i, 1] + l2
+        feet[i, 0] = hips[i, 0] + x
+        feet[i, 1] = hips[i, 1] + (l1[i] * c + d * s)
+        feet[i, 2] = hips[i, 2] + (l1[i] * s - d * c)
+        # Mass moment of the leg's links in its (unrotated) leg plane, rotated by the swing
+        # angle (the rotation is linear, so it commutes with the weighted sum).
+        y = y_mass * l1[i]
+        z = z_fixed + m_shank * (shank_up - d) + m_foot * (foot_up - d)
+        sum_x += x
+        sum_y += y * c - z * s
+        sum_z += y * s + z * c
+    cog = np.empty(3)
+    cog[0] = (m_leg * hip_sums[0] + m_moving * sum_x) / total
+    cog[1] = (m_leg * hip_sums[1] + sum_y) / total
+    cog[2] = (m_leg * hip_sums[2] + sum_z) / total
+    return feet, cog
+
+
+@njit(cache=True)
+def servo_change_for_force(joints, delta_force, legs, l1, k_z, l2, stiffness, joint_scale):
+    """(n, 3) servo target changes [ΔJ_x, ΔJ_z, ΔJ_θ] that add ``delta_force`` (n, 3) to the
+    feet of ``legs`` (see HeavyDutyBodyModel.target_change_for_force): Jᵀ ΔF per leg with J's
+    zero entries multiplied in (as the einsum it replaces did), then -K⁻¹ and the joint scale."""
+    n = legs.shape[0]
+    out = np.empty((n, 3))
+    for r in range(n):
+        leg = legs[r]
+        fx, fy, fz = delta_force[r, 0], delta_force[r, 1], delta_force[r, 2]
+        c, s = math.cos(joints[leg, 2]), math.sin(joints[leg, 2])
+        d = k_z * joints[leg, 1] + l2
+        g_x = 1.0 * fx + 0.0 * fy + 0.0 * fz
+        g_d = 0.0 * fx + s * fy + -c * fz
+        g_t = 0.0 * fx + (-l1[leg] * s + d * c) * fy + (l1[leg] * c + d * s) * fz
+        out[r, 0] = (-g_x / stiffness[0]) / joint_scale[0]
+        out[r, 1] = (-g_d / stiffness[1]) / joint_scale[1]
+        out[r, 2] = (-g_t / stiffness[2]) / joint_scale[2]
+    return out

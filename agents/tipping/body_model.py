@@ -1,7 +1,7 @@
 """What the heavy-duty hexapod knows about itself from its sensors: body-frame feet, CoG, forces.
 
-Pure numpy (no MuJoCo). Everything here is what the real robot computes from its joint encoders,
-its IMU and its 3-D foot force sensors, with the robot's known geometry and masses
+NumPy and numba (no MuJoCo). Everything here is what the real robot computes from its joint
+encoders, its IMU and its 3-D foot force sensors, with the robot's known geometry and masses
 (`HeavyDutyParams`):
 
 - feet in the body frame by forward kinematics (Zhang et al. 2024 eq. 1) of the encoders;
@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from agents.tipping import _compiled
 from hexapod_envs.robots.heavy_duty.params import LEG_NAMES, HeavyDutyParams
 
 GRAVITY: float = 9.81
@@ -39,6 +40,8 @@ CARRIAGE_TOP: float = 0.15
 """Carriage link extends this far above the leg-plane origin [m] (model geometry)."""
 SHANK_TOP: float = 0.7
 """Shank link extends this far above the sole [m] (model geometry)."""
+
+_ALL_LEGS = np.arange(6)
 
 
 def quat_to_matrix(quat: np.ndarray) -> np.ndarray:
@@ -76,7 +79,7 @@ class HeavyDutyBodyModel:
     def __init__(self, params: HeavyDutyParams | None = None):
         self.params = p = params or HeavyDutyParams()
         self.hips = np.array([p.hip_offsets[leg] for leg in LEG_NAMES])  # (6, 3)
-        self._hip_sums = self.hips.sum(axis=0).tolist()
+        self._hip_sums = self.hips.sum(axis=0)
         self.l1 = np.array([p.signed_l1(leg) for leg in LEG_NAMES])  # (6,)
         self.total_mass = p.total_mass
         m = p.leg_mass
@@ -94,11 +97,23 @@ class HeavyDutyBodyModel:
         )
         self.stiffness = np.array(p.foot_stiffness, dtype=float)
         self._joint_scale = np.array([p.k_x, p.k_z, 1.0])  # generalised = scale * J (+ L2 for d)
-        # The same constants as floats for the per-period float code.
-        self._hip_rows = [tuple(row) for row in self.hips.tolist()]
-        self._l1_list = self.l1.tolist()
-        self._stiffness_list = self.stiffness.tolist()
-        self._joint_scale_list = self._joint_scale.tolist()
+        m_moving = self._m_carriage + self._m_shank + self._m_foot
+        self._cog_consts = np.array(  # the constants of _compiled.body_feet_and_cog
+            [
+                p.k_x,
+                p.k_z,
+                p.l2,
+                m_moving,
+                0.5 * self._m_hip + m_moving,
+                self._m_carriage * self._carriage_z,
+                self._m_shank,
+                self._shank_up,
+                self._m_foot,
+                self._foot_up,
+                p.leg_mass,
+                self.total_mass,
+            ]
+        )
 
     # --- legs -------------------------------------------------------------------------------
     def leg_state(self, joints: np.ndarray) -> LegState:
@@ -115,48 +130,13 @@ class HeavyDutyBodyModel:
         """(:meth:`feet`, :meth:`cog`) from one pass over the legs (the controller needs both
         every period).
 
-        Plain floats after one np.cos / np.sin of the six swing angles: on six legs numpy's
-        per-call overhead cost more than the arithmetic (about 20 µs per period). The operations
-        and summation order are those of the former array expressions, so the numbers are
-        bit-identical to them (tests/test_tipping_recovery.py).
+        A compiled kernel (:func:`agents.tipping._compiled.body_feet_and_cog`): on six legs
+        numpy's per-call overhead cost more than the arithmetic. Its operations and summation
+        order are those of the former array expressions, so the numbers are bit-identical to
+        them (tests/test_tipping_recovery.py).
         """
         j = np.asarray(joints, dtype=float).reshape(6, 3)
-        theta = j[:, 2]
-        cos, sin = np.cos(theta).tolist(), np.sin(theta).tolist()
-        p = self.params
-        k_x, k_z, l2 = p.k_x, p.k_z, p.l2
-        m_moving = self._m_carriage + self._m_shank + self._m_foot
-        y_mass = 0.5 * self._m_hip + m_moving
-        z_fixed = self._m_carriage * self._carriage_z
-        m_shank, shank_up, m_foot, foot_up = (
-            self._m_shank,
-            self._shank_up,
-            self._m_foot,
-            self._foot_up,
-        )
-        feet = []
-        sum_x = sum_y = sum_z = 0.0
-        for (jx, jz, _), (hx, hy, hz), l1, c, s in zip(
-            j.tolist(), self._hip_rows, self._l1_list, cos, sin, strict=True
-        ):
-            x = k_x * jx
-            d = k_z * jz + l2
-            feet.append((hx + x, hy + (l1 * c + d * s), hz + (l1 * s - d * c)))
-            # Mass moment of the leg's links in its (unrotated) leg plane, rotated by the swing
-            # angle (the rotation is linear, so it commutes with the weighted sum).
-            y = y_mass * l1
-            z = z_fixed + m_shank * (shank_up - d) + m_foot * (foot_up - d)
-            sum_x += x
-            sum_y += y * c - z * s
-            sum_z += y * s + z * c
-        m_leg, total = p.leg_mass, self.total_mass
-        hips = self._hip_sums
-        cog = (
-            (m_leg * hips[0] + m_moving * sum_x) / total,
-            (m_leg * hips[1] + sum_y) / total,
-            (m_leg * hips[2] + sum_z) / total,
-        )
-        return np.array(feet), np.array(cog)
+        return _compiled.body_feet_and_cog(j, self.hips, self.l1, self._cog_consts, self._hip_sums)
 
     def foot_velocities(self, joints: np.ndarray, joint_velocities: np.ndarray) -> np.ndarray:
         """(6, 3) sole velocities relative to the body [m/s] from encoder rates."""
@@ -191,31 +171,13 @@ class HeavyDutyBodyModel:
         Returns:
             (n, 3) target changes in joint units (m, m, rad).
         """
-        legs = list(range(6)) if legs is None else np.asarray(legs).tolist()
-        j = np.asarray(joints, dtype=float).reshape(6, 3)[legs]
-        df = np.asarray(delta_force, dtype=float).reshape(len(legs), 3).tolist()
-        cos, sin = np.cos(j[:, 2]).tolist(), np.sin(j[:, 2]).tolist()
-        k_z, l2 = self.params.k_z, self.params.l2
-        k_x_stiff, k_d_stiff, k_t_stiff = self._stiffness_list
-        scale_x, scale_d, scale_t = self._joint_scale_list
-        out = []
-        # Jᵀ ΔF per leg on floats (J as in :meth:`jacobians`, columns x, d, θ; its zero entries
-        # multiplied in as the einsum did, so the numbers are bit-identical), then -K⁻¹ and the
-        # joint scale.
-        for leg, (fx, fy, fz), jz, c, s in zip(legs, df, j[:, 1].tolist(), cos, sin, strict=True):
-            l1 = self._l1_list[leg]
-            d = k_z * jz + l2
-            g_x = 1.0 * fx + 0.0 * fy + 0.0 * fz
-            g_d = 0.0 * fx + s * fy + -c * fz
-            g_t = 0.0 * fx + (-l1 * s + d * c) * fy + (l1 * c + d * s) * fz
-            out.append(
-                (
-                    (-g_x / k_x_stiff) / scale_x,
-                    (-g_d / k_d_stiff) / scale_d,
-                    (-g_t / k_t_stiff) / scale_t,
-                )
-            )
-        return np.array(out)
+        legs = _ALL_LEGS if legs is None else np.asarray(legs, dtype=np.int64).reshape(-1)
+        j = np.asarray(joints, dtype=float).reshape(6, 3)
+        df = np.asarray(delta_force, dtype=float).reshape(len(legs), 3)
+        p = self.params
+        return _compiled.servo_change_for_force(
+            j, df, legs, self.l1, p.k_z, p.l2, self.stiffness, self._joint_scale
+        )
 
     # --- whole body ------------------------------------------------------------------------
     def cog(self, joints: np.ndarray) -> np.ndarray:
