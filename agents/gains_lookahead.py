@@ -1,0 +1,142 @@
+"""How much per-gait-cycle posture gains can gain over the paper's fixed gains, without learning.
+
+A gains policy (HexapodIrregularTerrain-v0's ``action_mode="gains"``, e.g. the shipped
+``models/HexapodIrregularTerrain-v0/gains_blocks``) picks (k_z, k_α, k_β) of Coelho et al.
+2024's posture controller once per gait cycle. Two measurements bound what it can achieve on a
+task distribution:
+
+- **fixed gains**: every setting of a grid held for whole episodes (a constant policy, which
+  PPO can represent);
+- **look-ahead**: at every cycle start the env is copied and each candidate setting is played
+  for one cycle on its own copy; the one with the lowest pitch-rate + roll-rate RMS among those
+  with no more torso-contact steps than the reference gains in that cycle is applied. It sees
+  the terrain the cycle will meet, which the observation does not carry, so it is optimistic
+  for a greedy per-cycle choice (though not a bound on policies that plan over several cycles).
+
+The figures are those the evaluation reports for gains (the pooled medians of the per-cycle
+pitch- and roll-rate RMS, ``info["cycle_stats"]``; torso-contact steps, successes).
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+from collections.abc import Callable, Sequence
+from typing import NamedTuple
+
+import gymnasium as gym
+import numpy as np
+
+Gains = tuple[float, float, float]
+Chooser = Callable[[gym.Env], Gains]
+"""Returns the gains for the cycle about to start in the given env."""
+
+
+class CycleOutcome(NamedTuple):
+    """One gait cycle played with one gain setting."""
+
+    pitch_rate_rms: float
+    """[rad/s]"""
+    roll_rate_rms: float
+    """[rad/s]"""
+    contact_steps: int
+    """Control steps with torso-terrain contact."""
+
+
+def gain_grid(levels: Sequence[float]) -> list[Gains]:
+    """Every (k_z, k_α, k_β) with each gain in ``levels``."""
+    return [tuple(float(v) for v in g) for g in itertools.product(levels, repeat=3)]
+
+
+def play_cycle(env: gym.Env, gains: Gains) -> CycleOutcome:
+    """Play one gait cycle with ``gains`` on a copy of ``env`` (at a cycle start; ``env`` is
+    left as it was)."""
+    twin = copy.deepcopy(env)
+    base = twin.unwrapped
+    action = np.asarray(gains, dtype=twin.action_space.dtype)
+    pitch_sq = roll_sq = 0.0
+    steps = contacts = 0
+    while True:
+        _, _, terminated, truncated, info = twin.step(action)
+        pitch_sq += info["pitch_rate"] ** 2
+        roll_sq += info["roll_rate"] ** 2
+        contacts += bool(info["torso_contact"])
+        steps += 1
+        if terminated or truncated or base.gains_due:
+            break
+    twin.close()
+    return CycleOutcome(float(np.sqrt(pitch_sq / steps)), float(np.sqrt(roll_sq / steps)), contacts)
+
+
+def fixed(gains: Gains) -> Chooser:
+    return lambda env: gains
+
+
+def lookahead(candidates: Sequence[Gains], reference: Gains) -> Chooser:
+    """The look-ahead choice (module docstring) over ``candidates``, constrained by the torso
+    contacts of ``reference`` in the same cycle (so the reference itself is always allowed)."""
+    options = list(dict.fromkeys([*candidates, reference]))
+
+    def choose(env: gym.Env) -> Gains:
+        outcomes = [play_cycle(env, g) for g in options]
+        allowed = outcomes[options.index(reference)].contact_steps
+        cost, best = min(
+            (o.pitch_rate_rms + o.roll_rate_rms, i)
+            for i, o in enumerate(outcomes)
+            if o.contact_steps <= allowed
+        )
+        return options[best]
+
+    return choose
+
+
+def run_episode(env: gym.Env, seed: int, choose: Chooser) -> dict:
+    """One episode in the "gains" action mode, ``choose`` asked at every cycle start.
+
+    Returns the per-cycle pitch- and roll-rate RMS lists, torso-contact steps and success."""
+    base = env.unwrapped
+    if getattr(base, "action_mode", None) != "gains":
+        raise ValueError("run_episode needs HexapodIrregularTerrain-v0 with action_mode='gains'")
+    env.reset(seed=seed)
+    pitch, roll = [], []
+    action = np.asarray(base.reference_gains, dtype=env.action_space.dtype)
+    while True:
+        if base.gains_due:
+            action = np.asarray(choose(env), dtype=env.action_space.dtype)
+        _, _, terminated, truncated, info = env.step(action)
+        stats = info["cycle_stats"]
+        if stats is not None:
+            pitch.append(stats["pitch_rate_rms"])
+            roll.append(stats["roll_rate_rms"])
+        if terminated or truncated:
+            break
+    return {
+        "pitch_rate_rms": pitch,
+        "roll_rate_rms": roll,
+        "contact_steps": int(info["torso_collisions"]),
+        "success": bool(info["is_success"]),
+    }
+
+
+def summarize(episodes: list[dict]) -> dict:
+    """Pooled medians over all cycles of all episodes, summed contacts, successes."""
+    pitch = [v for e in episodes for v in e["pitch_rate_rms"]]
+    roll = [v for e in episodes for v in e["roll_rate_rms"]]
+    return {
+        "pitch_rate_median": float(np.median(pitch)),
+        "roll_rate_median": float(np.median(roll)),
+        "contact_steps": sum(e["contact_steps"] for e in episodes),
+        "successes": sum(e["success"] for e in episodes),
+        "episodes": len(episodes),
+        "cycles": len(pitch),
+    }
+
+
+def beats(row: dict, reference: dict) -> bool:
+    """Lower pitch- and roll-rate medians than ``reference`` with no more contact steps (the
+    gains target of the learned agents)."""
+    return (
+        row["pitch_rate_median"] < reference["pitch_rate_median"]
+        and row["roll_rate_median"] < reference["roll_rate_median"]
+        and row["contact_steps"] <= reference["contact_steps"]
+    )

@@ -1,0 +1,96 @@
+"""The per-cycle gains measurements (agents/gains_lookahead.py, scripts/gains_ceiling.py)."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from test_athena_posture_study import _script
+
+import hexapod_envs  # noqa: F401
+from agents.athena_policy import PAPER_GAINS
+from agents.gains_lookahead import (
+    beats,
+    fixed,
+    gain_grid,
+    lookahead,
+    play_cycle,
+    run_episode,
+    summarize,
+)
+
+PAPER = PAPER_GAINS["blocks"]
+
+
+def _env(steps: int = 160) -> gym.Env:
+    return gym.make(
+        "HexapodIrregularTerrain-v0",
+        task_distribution="test",
+        terrain="blocks",
+        gait_ground_search="always",
+        action_mode="gains",
+        max_episode_steps=steps,
+    )
+
+
+def test_grid_and_the_beats_rule():
+    grid = gain_grid([0.0, 1.0])
+    assert len(grid) == 8 and (0.0, 0.0, 0.0) in grid and (1.0, 1.0, 1.0) in grid
+    ref = {"pitch_rate_median": 0.1, "roll_rate_median": 0.1, "contact_steps": 5}
+    assert beats({**ref, "pitch_rate_median": 0.09, "roll_rate_median": 0.09}, ref)
+    assert not beats({**ref, "pitch_rate_median": 0.09}, ref)  # roll not lower
+    assert not beats(
+        {**ref, "pitch_rate_median": 0.09, "roll_rate_median": 0.09, "contact_steps": 6}, ref
+    )
+
+
+def test_play_cycle_leaves_the_env_as_it_was():
+    env, other = _env(), _env()
+    action = np.asarray(PAPER, dtype=np.float32)
+    for e in (env, other):
+        e.reset(seed=3)
+        e.step(action)
+        while not e.unwrapped.gains_due:
+            e.step(action)
+    outcome = play_cycle(env, (0.2, 0.2, 0.2))
+    assert outcome.contact_steps >= 0 and outcome.pitch_rate_rms > 0.0
+    for _ in range(30):
+        a, b = env.step(action), other.step(action)
+        np.testing.assert_array_equal(a[0], b[0])
+
+
+def test_lookahead_never_allows_more_contact_than_the_reference_in_the_cycle():
+    env = _env()
+    env.reset(seed=1)
+    candidates = gain_grid([0.2, 0.8])
+    choice = lookahead(candidates, PAPER)(env)
+    assert choice in candidates or choice == PAPER
+    chosen, reference = play_cycle(env, choice), play_cycle(env, PAPER)
+    assert chosen.contact_steps <= reference.contact_steps
+    assert (
+        chosen.pitch_rate_rms + chosen.roll_rate_rms
+        <= reference.pitch_rate_rms + reference.roll_rate_rms
+    )
+    assert lookahead([], PAPER)(env) == PAPER
+
+
+def test_run_episode_collects_every_finished_cycle():
+    env = _env()
+    episode = run_episode(env, 0, fixed(PAPER))
+    # 160 steps of 50 ms hold a few 2 s gait cycles (plus ground-search waits).
+    assert 2 <= len(episode["pitch_rate_rms"]) == len(episode["roll_rate_rms"]) <= 4
+    again = run_episode(env, 0, fixed(PAPER))
+    assert again == episode  # same seed, same episode
+    summary = summarize([episode, again])
+    assert summary["cycles"] == 2 * len(episode["pitch_rate_rms"])
+    with pytest.raises(ValueError, match="gains"):
+        run_episode(gym.make("HexapodIrregularTerrain-v0"), 0, fixed(PAPER))
+
+
+def test_script_writes_the_table(tmp_path, monkeypatch):
+    script = _script("gains_ceiling")
+    monkeypatch.setattr(script, "make_env", lambda terrain: _env(120))
+    script.main(["--episodes", "1", "--levels", "0.5", "--out-dir", str(tmp_path)])
+    text = (tmp_path / "gains_ceiling_blocks.md").read_text()
+    assert "| paper (0.6, 0.4, 0.4) |" in text and "| look-ahead over the grid |" in text
+    assert (tmp_path / "gains_ceiling_blocks.json").exists()
