@@ -11,6 +11,7 @@ import hexapod_envs  # noqa: F401
 from agents.athena_policy import PAPER_GAINS
 from agents.gains_lookahead import (
     beats,
+    cycle_cost,
     fixed,
     gain_grid,
     lookahead,
@@ -59,19 +60,21 @@ def test_play_cycle_leaves_the_env_as_it_was():
         np.testing.assert_array_equal(a[0], b[0])
 
 
-def test_lookahead_never_allows_more_contact_than_the_reference_in_the_cycle():
+def test_lookahead_applies_the_cheapest_cycle():
     env = _env()
     env.reset(seed=1)
-    candidates = gain_grid([0.2, 0.8])
-    choice = lookahead(candidates, PAPER)(env)
-    assert choice in candidates or choice == PAPER
-    chosen, reference = play_cycle(env, choice), play_cycle(env, PAPER)
-    assert chosen.contact_steps <= reference.contact_steps
-    assert (
-        chosen.pitch_rate_rms + chosen.roll_rate_rms
-        <= reference.pitch_rate_rms + reference.roll_rate_rms
+    candidates = [*gain_grid([0.2, 0.8]), PAPER]
+    choice = lookahead(candidates)(env)
+    costs = {g: cycle_cost(play_cycle(env, g)) for g in candidates}
+    assert costs[choice] == min(costs.values())
+    # A huge contact cost makes the contact steps decide first.
+    strict = lookahead(candidates, contact_cost=1e6)(env)
+    assert play_cycle(env, strict).contact_steps == min(
+        play_cycle(env, g).contact_steps for g in candidates
     )
-    assert lookahead([], PAPER)(env) == PAPER
+    assert lookahead([PAPER])(env) == PAPER
+    with pytest.raises(ValueError, match="at least one"):
+        lookahead([])
 
 
 def test_run_episode_collects_every_finished_cycle():
@@ -92,5 +95,8 @@ def test_script_writes_the_table(tmp_path, monkeypatch):
     monkeypatch.setattr(script, "make_env", lambda terrain: _env(120))
     script.main(["--episodes", "1", "--levels", "0.5", "--out-dir", str(tmp_path)])
     text = (tmp_path / "gains_ceiling_blocks.md").read_text()
-    assert "| paper (0.6, 0.4, 0.4) |" in text and "| look-ahead over the grid |" in text
+    assert (
+        "| paper (0.6, 0.4, 0.4) |" in text
+        and "| look-ahead over the grid and the paper's |" in text
+    )
     assert (tmp_path / "gains_ceiling_blocks.json").exists()

@@ -228,6 +228,37 @@ def test_blocks_start_resting_on_the_bed():
     assert info["cog"][2] > 0.04 + 0.08  # above the lowest blocks, not on the floor
 
 
+@pytest.mark.parametrize("terrain", TERRAINS)
+def test_terrain_scan_is_the_torso_height_above_the_terrain_around_it(terrain):
+    from hexapod_envs.envs.irregular_terrain import SCAN_X, SCAN_Y
+
+    plain = gym.make(ENV_ID, terrain=terrain)
+    env = gym.make(ENV_ID, terrain=terrain, terrain_scan=True)
+    assert env.observation_space.shape[0] == plain.observation_space.shape[0] + 15
+    obs, _ = env.reset(seed=2)
+    for _ in range(5):
+        obs, *_ = env.step(np.zeros(env.action_space.shape))
+    base = env.unwrapped
+    scan = obs[base.observation_structure["terrain_scan"]].reshape(len(SCAN_X), len(SCAN_Y))
+    x, y, z = base.sensors.torso_position().tolist()
+    rot = base.sensors.torso_rotation()
+    heading = math.atan2(rot[1, 0], rot[0, 0])
+    for i, ahead in enumerate(SCAN_X):
+        for j, left in enumerate(SCAN_Y):
+            px = x + math.cos(heading) * ahead - math.sin(heading) * left
+            py = y + math.sin(heading) * ahead + math.cos(heading) * left
+            info = base.terrain_info
+            ground = 0.0 if info is None else info.height_at(px, py)
+            assert scan[i, j] == pytest.approx(z - ground, abs=1e-6)  # float32 observation
+    if terrain == "ramp":  # on the slope: the ground rises by 0.1 m x tan 10° per row ahead
+        rows = scan.mean(axis=1)
+        np.testing.assert_allclose(np.diff(rows), -0.1 * math.tan(math.radians(10)), atol=2e-3)
+    if terrain == "flat":
+        np.testing.assert_allclose(scan, z, atol=1e-6)
+    with pytest.raises(ValueError, match="terrain_scan must be one of"):
+        gym.make(ENV_ID, terrain_scan="yes")
+
+
 def test_torso_contact_is_detected_and_penalised():
     """Legs folded up in joint mode: the torso drops onto the ground."""
     env = gym.make(ENV_ID, terrain="flat", action_mode="joint", collision_penalty=2.0)

@@ -353,6 +353,32 @@ def test_each_policy_is_evaluated_in_the_action_mode_it_was_built_for(run):
     assert trained == {"action_mode": "residual", "residual_scale": 0.25}
 
 
+def test_a_run_is_evaluated_with_the_observation_it_was_trained_on(monkeypatch):
+    """terrain_scan shapes the observation: it comes from the run, not from the suite."""
+    from agents.pipeline import artifacts
+    from agents.pipeline.evaluation import policy_env_kwargs
+
+    class Run:
+        def __init__(self, kwargs):
+            self.kwargs = kwargs
+
+        def training_config(self):
+            return {"env": {"kwargs": self.kwargs}}
+
+    scan = {"terrain": "blocks", "action_mode": "gains", "terrain_scan": True}
+    monkeypatch.setattr(artifacts, "find_model", lambda path: Run(scan))
+    env_id = "HexapodIrregularTerrain-v0"
+    assert policy_env_kwargs("ppo:x", env_id, {"terrain": "ramp"}) == {
+        "action_mode": "gains",
+        "terrain_scan": True,
+    }
+    monkeypatch.setattr(artifacts, "find_model", lambda path: Run({"action_mode": "gains"}))
+    assert policy_env_kwargs("ppo:x", env_id, {"terrain_scan": True}) == {
+        "action_mode": "gains",
+        "terrain_scan": False,
+    }
+
+
 def test_reward_exclude_takes_the_named_terms_out_of_the_reward():
     """env.reward_exclude: the learner's reward is the env's minus those info terms; a term the
     env does not report is an error at the first step."""

@@ -114,23 +114,25 @@ def _env_spec(suite: EvaluationSuite, env: SuiteEnv, **extra: Any) -> EnvSpec:
     return EnvSpec(env.id, {**env.kwargs, **extra}, suite.env_time_limit(env), suite.gym_packages)
 
 
-ACTION_SETTINGS = (
+POLICY_SETTINGS = (
     "action_mode",
     "residual_scale",
     "residual_filter_tau",
     "residual_limb_m",
     "residual_leg_m",
     "gait_ground_search",
+    "terrain_scan",
 )
-"""Env kwargs that say how an action is read (not which task is posed): a policy is evaluated
-with the ones it was built for, on the suite's task."""
+"""Env kwargs that say how an action is read or what the observation holds (not which task is
+posed): a policy is evaluated with the ones it was built for, on the suite's task."""
 
 
 def policy_env_kwargs(name: str, env_id: str, suite_kwargs: dict | None = None) -> dict[str, Any]:
     """The env kwargs `name` needs on top of the suite's (`suite_kwargs`): the analytical
-    controller's action mode (`agents.registry.ANALYTICAL_ENV_KWARGS`); a PPO run's trained action
-    settings (a setting the suite sets but the run left at its default goes back to the default);
-    none for the zero and random actions (the env's default mode: zero is the reference motion)."""
+    controller's action mode (`agents.registry.ANALYTICAL_ENV_KWARGS`); a PPO run's trained
+    `POLICY_SETTINGS` (a setting the suite sets but the run left at its default goes back to the
+    default); none for the zero and random actions (the env's default mode: zero is the
+    reference motion)."""
     if name == "analytical":
         from ..registry import ANALYTICAL_ENV_KWARGS
 
@@ -141,8 +143,8 @@ def policy_env_kwargs(name: str, env_id: str, suite_kwargs: dict | None = None) 
 
     config = find_model(_ppo_path(name, env_id)).training_config() or {}
     trained = (config.get("env") or {}).get("kwargs") or {}
-    extra = {k: trained[k] for k in ACTION_SETTINGS if k in trained}
-    reset = [k for k in ACTION_SETTINGS if k in (suite_kwargs or {}) and k not in trained]
+    extra = {k: trained[k] for k in POLICY_SETTINGS if k in trained}
+    reset = [k for k in POLICY_SETTINGS if k in (suite_kwargs or {}) and k not in trained]
     if reset:
         defaults = _registered_defaults(env_id)
         extra.update({k: defaults[k] for k in reset if k in defaults})
@@ -255,7 +257,7 @@ def _kwargs_note(
     policy_kwargs: dict[str, Any],
 ) -> str | None:
     """A warning when a model was trained with env kwargs (defaults filled in) other than the
-    suite's with `policy_kwargs` (its action settings) on top."""
+    suite's with `policy_kwargs` (its action and observation settings) on top."""
     if trained is None:
         return None
     defaults = _constructor_defaults(env)

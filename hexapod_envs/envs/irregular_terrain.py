@@ -55,6 +55,13 @@ non-adaptive "simple control".
 | torso_height | 1 | infrared torso-height reading along the torso's -z [m] (-1: nothing below) |
 | gait_phase | 3 | sin, cos of 2π x the gait-cycle phase; 1 if the next step starts a gait cycle |
 | posture_gains | 3 | ("gains" mode only) (k_z, k_α, k_β) in effect this cycle |
+| terrain_scan | 15 | (``terrain_scan=True``) torso height above the terrain at 5 x 3 points [m] |
+
+``terrain_scan=True`` adds what the robot's sensors cannot give: the true terrain around and
+ahead of the torso, at `SCAN_X` (0.15 m behind to 0.25 m ahead along the torso's heading) x
+`SCAN_Y` (the feet's lateral span) - the privileged height samples that legged-robot RL
+commonly feeds a policy on rough ground (for a learner or a teacher policy; the paper's robot
+has no such sensor).
 
 Action modes (``action_mode=``):
 
@@ -197,6 +204,12 @@ MIN_PROGRESS = 0.5
 HEIGHT_CLIP_M = 0.1
 """Bound of the steadiness term's torso-height deviation [m]."""
 
+SCAN_X = (-0.15, -0.05, 0.05, 0.15, 0.25)
+"""Terrain-scan rows: distance ahead of the torso centre along its heading [m]."""
+SCAN_Y = (-0.15, 0.0, 0.15)
+"""Terrain-scan columns: distance to the left of the torso centre [m] (the feet stand at about
+±0.15 m)."""
+
 _CONTACT_CHECKS = 5
 """Torso-terrain contact is looked for this many times per control period (every 10 ms)."""
 
@@ -244,6 +257,8 @@ class IrregularTerrainSettings(EnvSettings):
     """t_g, duration of one gait phase [s]."""
     gait_start_from: str = choice("measured_height", START_FROM)
     gait_ground_search: str = choice("auto", GROUND_SEARCH)
+    terrain_scan: bool = choice(False, (False, True))
+    """Add the privileged ``terrain_scan`` observation piece (see the module docstring)."""
     servo_kp: float = number(6.8, strict=True)
     """Servo stiffness [N·m/rad] (calibrated to the paper's simple-control ramp sag, 0.068 m; 8
     before 2026-11-24)."""
@@ -322,6 +337,8 @@ class IrregularTerrainEnv(HexapodEnv):
 
     def _setup(self) -> None:
         s = self.settings
+        ahead, left = np.meshgrid(SCAN_X, SCAN_Y, indexing="ij")
+        self._scan_offsets = (ahead.reshape(-1), left.reshape(-1))
         if self.n_substeps % _CONTACT_CHECKS:
             raise ValueError(
                 f"control_dt / physics_dt = {self.n_substeps} substeps must be a multiple of "
@@ -686,7 +703,22 @@ class IrregularTerrainEnv(HexapodEnv):
         }
         if self.action_mode == "gains":
             pieces["posture_gains"] = (3, lambda: self.controller.gains)
+        if self.settings.terrain_scan:
+            pieces["terrain_scan"] = (len(SCAN_X) * len(SCAN_Y), self.terrain_scan)
         return pieces
+
+    def terrain_scan(self) -> np.ndarray:
+        """(15,) torso centre height above the terrain at the scan points [m], rows `SCAN_X`
+        ahead along the torso's heading, columns `SCAN_Y` to its left (privileged: the terrain
+        model and the true pose)."""
+        x, y, z = self.sensors.torso_position().tolist()
+        rot = self.sensors.torso_rotation()
+        heading = math.atan2(float(rot[1, 0]), float(rot[0, 0]))
+        c, s = math.cos(heading), math.sin(heading)
+        ahead, left = self._scan_offsets
+        px, py = x + c * ahead - s * left, y + s * ahead + c * left
+        ground = 0.0 if self.terrain_info is None else self.terrain_info.surface_height(px, py)
+        return z - ground
 
     def step_cost_bound(self) -> float:
         """The largest cost one step can carry (the bounded negative parts of every term but
