@@ -26,6 +26,7 @@ from __future__ import annotations
 import copy
 import itertools
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import NamedTuple
 
 import gymnasium as gym
@@ -72,26 +73,36 @@ def play_cycle(env: gym.Env, gains: Gains) -> CycleOutcome:
     return CycleOutcome(float(np.sqrt(pitch_sq / steps)), float(np.sqrt(roll_sq / steps)), contacts)
 
 
-def fixed(gains: Gains) -> Chooser:
-    return lambda env: gains
-
-
 def cycle_cost(outcome: CycleOutcome, contact_cost: float = 1.0) -> float:
     """Pitch-rate RMS + roll-rate RMS [rad/s] + ``contact_cost`` per torso-contact step."""
     return outcome.pitch_rate_rms + outcome.roll_rate_rms + contact_cost * outcome.contact_steps
 
 
-def lookahead(candidates: Sequence[Gains], contact_cost: float = 1.0) -> Chooser:
+@dataclass(frozen=True)
+class Fixed:
+    """The same gains every cycle."""
+
+    gains: Gains
+
+    def __call__(self, env: gym.Env) -> Gains:
+        return self.gains
+
+
+@dataclass(frozen=True)
+class Lookahead:
     """The look-ahead choice (module docstring) over ``candidates`` (the first of equal cost)."""
-    options = list(dict.fromkeys(candidates))
-    if not options:
-        raise ValueError("lookahead needs at least one candidate setting")
 
-    def choose(env: gym.Env) -> Gains:
-        costs = [cycle_cost(play_cycle(env, g), contact_cost) for g in options]
-        return options[costs.index(min(costs))]
+    candidates: tuple[Gains, ...]
+    contact_cost: float = 1.0
 
-    return choose
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "candidates", tuple(dict.fromkeys(self.candidates)))
+        if not self.candidates:
+            raise ValueError("Lookahead needs at least one candidate setting")
+
+    def __call__(self, env: gym.Env) -> Gains:
+        costs = [cycle_cost(play_cycle(env, g), self.contact_cost) for g in self.candidates]
+        return self.candidates[costs.index(min(costs))]
 
 
 def run_episode(env: gym.Env, seed: int, choose: Chooser) -> dict:

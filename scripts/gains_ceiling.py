@@ -9,18 +9,20 @@ rates with no more contact steps.
 
 Writes `reports/gains_ceiling_<terrain>.md` and `.json`. The committed blocks report is the
 default run (20 episodes, levels 0.2 0.5 0.8: about 30 min on one core, most of it the
-look-ahead, which plays every candidate for every cycle).
+look-ahead, which plays every candidate for every cycle; `--workers 2` halves that).
 
 Run: python scripts/gains_ceiling.py [--terrain blocks] [--episodes 20] [--levels 0.2 0.5 0.8]
-     [--no-lookahead] [--out-dir reports]
+     [--no-lookahead] [--workers 1] [--out-dir reports]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import multiprocessing
 import sys
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import gymnasium as gym
@@ -29,10 +31,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import hexapod_envs  # noqa: E402, F401
 from agents.athena_policy import PAPER_GAINS  # noqa: E402
 from agents.gains_lookahead import (  # noqa: E402
+    Fixed,
+    Lookahead,
     beats,
-    fixed,
     gain_grid,
-    lookahead,
     run_episode,
     summarize,
 )
@@ -48,23 +50,40 @@ def make_env(terrain: str) -> gym.Env:
     )
 
 
-def measure(terrain: str, episodes: int, levels: list[float], with_lookahead: bool) -> dict:
-    """{label: summary} for the paper's gains, each grid setting and the look-ahead."""
+def _row(terrain: str, episodes: int, choose) -> dict:
     env = make_env(terrain)
+    start = time.perf_counter()
+    row = summarize([run_episode(env, seed, choose) for seed in range(episodes)])
+    row["wall_s"] = round(time.perf_counter() - start, 1)
+    env.close()
+    return row
+
+
+def measure(
+    terrain: str, episodes: int, levels: list[float], with_lookahead: bool, workers: int = 1
+) -> dict:
+    """{label: summary} for the paper's gains, each grid setting and the look-ahead, the rows
+    spread over `workers` processes."""
     paper = PAPER_GAINS[terrain]
     grid = gain_grid(levels)
-    choosers = {f"paper {paper}": fixed(paper)}
-    choosers.update({f"fixed {g}": fixed(g) for g in grid if g != paper})
-    if with_lookahead:
-        choosers["look-ahead over the grid and the paper's"] = lookahead([*grid, paper])
-    rows = {}
-    for label, choose in choosers.items():
-        start = time.perf_counter()
-        rows[label] = summarize([run_episode(env, seed, choose) for seed in range(episodes)])
-        rows[label]["wall_s"] = round(time.perf_counter() - start, 1)
-        print(label, rows[label], flush=True)
-    env.close()
-    return rows
+    choosers = {}
+    if with_lookahead:  # the longest row first, so that the others fill the other workers
+        choosers["look-ahead over the grid and the paper's"] = Lookahead((*grid, paper))
+    choosers[f"paper {paper}"] = Fixed(paper)
+    choosers.update({f"fixed {g}": Fixed(g) for g in grid if g != paper})
+    if workers == 1:
+        rows = {label: _row(terrain, episodes, c) for label, c in choosers.items()}
+    else:
+        with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+            futures = {
+                label: pool.submit(_row, terrain, episodes, c) for label, c in choosers.items()
+            }
+            rows = {label: f.result() for label, f in futures.items()}
+    for label, row in rows.items():
+        print(label, row, flush=True)
+    # The paper's row first (the reference of the table), the look-ahead last.
+    order = [f"paper {paper}", *(k for k in rows if k.startswith("fixed")), *choosers]
+    return {k: rows[k] for k in dict.fromkeys(order) if k in rows}
 
 
 def report(rows: dict, terrain: str, args: argparse.Namespace) -> str:
@@ -104,9 +123,10 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--episodes", type=int, default=20)
     parser.add_argument("--levels", type=float, nargs="+", default=[0.2, 0.5, 0.8])
     parser.add_argument("--no-lookahead", dest="lookahead", action="store_false")
+    parser.add_argument("--workers", type=int, default=1, help="processes (one core each)")
     parser.add_argument("--out-dir", type=Path, default=Path("reports"))
     args = parser.parse_args(argv)
-    rows = measure(args.terrain, args.episodes, args.levels, args.lookahead)
+    rows = measure(args.terrain, args.episodes, args.levels, args.lookahead, args.workers)
     args.out_dir.mkdir(parents=True, exist_ok=True)
     stem = args.out_dir / f"gains_ceiling_{args.terrain}"
     stem.with_suffix(".md").write_text(report(rows, args.terrain, args))

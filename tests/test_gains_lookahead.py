@@ -10,11 +10,11 @@ from test_athena_posture_study import _script
 import hexapod_envs  # noqa: F401
 from agents.athena_policy import PAPER_GAINS
 from agents.gains_lookahead import (
+    Fixed,
+    Lookahead,
     beats,
     cycle_cost,
-    fixed,
     gain_grid,
-    lookahead,
     play_cycle,
     run_episode,
     summarize,
@@ -64,30 +64,30 @@ def test_lookahead_applies_the_cheapest_cycle():
     env = _env()
     env.reset(seed=1)
     candidates = [*gain_grid([0.2, 0.8]), PAPER]
-    choice = lookahead(candidates)(env)
+    choice = Lookahead(tuple(candidates))(env)
     costs = {g: cycle_cost(play_cycle(env, g)) for g in candidates}
     assert costs[choice] == min(costs.values())
     # A huge contact cost makes the contact steps decide first.
-    strict = lookahead(candidates, contact_cost=1e6)(env)
+    strict = Lookahead(tuple(candidates), contact_cost=1e6)(env)
     assert play_cycle(env, strict).contact_steps == min(
         play_cycle(env, g).contact_steps for g in candidates
     )
-    assert lookahead([PAPER])(env) == PAPER
+    assert Lookahead((PAPER,))(env) == PAPER
     with pytest.raises(ValueError, match="at least one"):
-        lookahead([])
+        Lookahead(())
 
 
 def test_run_episode_collects_every_finished_cycle():
     env = _env()
-    episode = run_episode(env, 0, fixed(PAPER))
+    episode = run_episode(env, 0, Fixed(PAPER))
     # 160 steps of 50 ms hold a few 2 s gait cycles (plus ground-search waits).
     assert 2 <= len(episode["pitch_rate_rms"]) == len(episode["roll_rate_rms"]) <= 4
-    again = run_episode(env, 0, fixed(PAPER))
+    again = run_episode(env, 0, Fixed(PAPER))
     assert again == episode  # same seed, same episode
     summary = summarize([episode, again])
     assert summary["cycles"] == 2 * len(episode["pitch_rate_rms"])
     with pytest.raises(ValueError, match="gains"):
-        run_episode(gym.make("HexapodIrregularTerrain-v0"), 0, fixed(PAPER))
+        run_episode(gym.make("HexapodIrregularTerrain-v0"), 0, Fixed(PAPER))
 
 
 def test_script_writes_the_table(tmp_path, monkeypatch):
