@@ -2,8 +2,8 @@
 
 A gains policy (HexapodIrregularTerrain-v0's ``action_mode="gains"``, e.g. the shipped
 ``models/HexapodIrregularTerrain-v0/gains_blocks``) picks (k_z, k_α, k_β) of Coelho et al.
-2024's posture controller once per gait cycle. Two measurements bound what it can achieve on a
-task distribution:
+2024's posture controller once per gait cycle. Two measurements show what such choices can
+achieve on a task distribution:
 
 - **fixed gains**: every setting of a grid held for whole episodes (a constant policy, which
   PPO can represent);
