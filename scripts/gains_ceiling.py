@@ -66,24 +66,23 @@ def measure(
     spread over `workers` processes."""
     paper = PAPER_GAINS[terrain]
     grid = gain_grid(levels)
-    choosers = {}
-    if with_lookahead:  # the longest row first, so that the others fill the other workers
-        choosers["look-ahead over the grid and the paper's"] = Lookahead((*grid, paper))
-    choosers[f"paper {paper}"] = Fixed(paper)
+    choosers = {f"paper {paper}": Fixed(paper)}  # in the table's order
     choosers.update({f"fixed {g}": Fixed(g) for g in grid if g != paper})
+    if with_lookahead:
+        choosers["look-ahead over the grid and the paper's"] = Lookahead((*grid, paper))
     if workers == 1:
         rows = {label: _row(terrain, episodes, c) for label, c in choosers.items()}
     else:
+        # The look-ahead (the longest row) first, so that the other rows fill the other workers.
+        first = sorted(choosers, key=lambda label: not isinstance(choosers[label], Lookahead))
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
             futures = {
-                label: pool.submit(_row, terrain, episodes, c) for label, c in choosers.items()
+                label: pool.submit(_row, terrain, episodes, choosers[label]) for label in first
             }
-            rows = {label: f.result() for label, f in futures.items()}
+            rows = {label: futures[label].result() for label in choosers}
     for label, row in rows.items():
         print(label, row, flush=True)
-    # The paper's row first (the reference of the table), the look-ahead last.
-    order = [f"paper {paper}", *(k for k in rows if k.startswith("fixed")), *choosers]
-    return {k: rows[k] for k in dict.fromkeys(order) if k in rows}
+    return rows
 
 
 def report(rows: dict, terrain: str, args: argparse.Namespace) -> str:

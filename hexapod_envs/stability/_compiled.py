@@ -262,19 +262,17 @@ def fasm_edges(pts, cog, force, moment, up, has_up):
     """
     empty = np.empty(0)
     no_edges = np.empty((0, 2), dtype=np.int64)
-    bad = (
-        0
-        if not finite(pts.ravel())
-        else 1
-        if not finite(cog)
-        else 2
-        if not finite(force)
-        else 3
-        if not finite(moment)
-        else 4
-        if has_up and not finite(up)
-        else -1
-    )
+    bad = -1
+    if not finite(pts.ravel()):
+        bad = 0
+    elif not finite(cog):
+        bad = 1
+    elif not finite(force):
+        bad = 2
+    elif not finite(moment):
+        bad = 3
+    elif has_up and not finite(up):
+        bad = 4
     if bad >= 0:
         return NOT_FINITE, empty, empty, no_edges, bad
     gx, gy, gz = cog[0], cog[1], cog[2]
