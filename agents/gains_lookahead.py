@@ -46,6 +46,8 @@ class CycleOutcome(NamedTuple):
     """[rad/s]"""
     contact_steps: int
     """Control steps with torso-terrain contact."""
+    steps: int = 0
+    """Control steps simulated (what the look-ahead spends of an env-step budget)."""
 
 
 def gain_grid(levels: Sequence[float]) -> list[Gains]:
@@ -70,7 +72,9 @@ def play_cycle(env: gym.Env, gains: Gains) -> CycleOutcome:
         if terminated or truncated or base.gains_due:
             break
     twin.close()
-    return CycleOutcome(float(np.sqrt(pitch_sq / steps)), float(np.sqrt(roll_sq / steps)), contacts)
+    return CycleOutcome(
+        float(np.sqrt(pitch_sq / steps)), float(np.sqrt(roll_sq / steps)), contacts, steps
+    )
 
 
 def cycle_cost(outcome: CycleOutcome, contact_cost: float = 1.0) -> float:
@@ -100,9 +104,16 @@ class Lookahead:
         if not self.candidates:
             raise ValueError("Lookahead needs at least one candidate setting")
 
-    def __call__(self, env: gym.Env) -> Gains:
-        costs = [cycle_cost(play_cycle(env, g), self.contact_cost) for g in self.candidates]
+    def outcomes(self, env: gym.Env) -> list[CycleOutcome]:
+        """Every candidate's coming cycle, in `candidates` order."""
+        return [play_cycle(env, g) for g in self.candidates]
+
+    def choose(self, outcomes: Sequence[CycleOutcome]) -> Gains:
+        costs = [cycle_cost(o, self.contact_cost) for o in outcomes]
         return self.candidates[costs.index(min(costs))]
+
+    def __call__(self, env: gym.Env) -> Gains:
+        return self.choose(self.outcomes(env))
 
 
 def run_episode(env: gym.Env, seed: int, choose: Chooser) -> dict:

@@ -140,6 +140,37 @@ def _vec_envs(config: TrainConfig, seed: int, stats: NormalizationStats | None =
     return venv, eval_env
 
 
+def new_model(config: TrainConfig, venv: Any) -> Any:
+    """An untrained SB3 PPO model of `config` on `venv`; with a zero-initialised action net when
+    the config asks (it then starts exactly at the analytical controller or reference motion)."""
+    from stable_baselines3 import PPO
+
+    model = PPO(
+        "MlpPolicy",
+        venv,
+        policy_kwargs=config.policy.policy_kwargs(),
+        seed=config.train.seed,
+        device=config.train.device,
+        verbose=config.logging.verbose,
+        **config.ppo.sb3_kwargs(),
+    )
+    hybrid_zero = config.hybrid is not None and config.hybrid.zero_init_action_net
+    if hybrid_zero or config.policy.zero_init_action_net:
+        from ..hybrid import zero_init_action_net
+
+        zero_init_action_net(model)
+    return model
+
+
+def untrained_model(config: TrainConfig) -> Any:
+    """`new_model` on the config's training vec env (VecNormalize on top when configured), for
+    models fitted outside PPO (e.g. `agents.gains_distill`) that PPO can then fine-tune."""
+    venv, eval_env = _vec_envs(config, config.train.seed)
+    if eval_env is not None:
+        eval_env.close()
+    return new_model(config, venv)
+
+
 def start_training(
     config: TrainConfig,
     output_dir: str | Path = "runs",
@@ -155,8 +186,6 @@ def start_training(
     evaluation (its ``parent`` is the EvalCallback); sweeps use it to report the evaluation
     metrics to Ray Tune.
     """
-    from stable_baselines3 import PPO
-
     spec = env_spec(config)
     new_accumulator = _probe(spec)
     name = name or run_name(config.env.id, config.train.seed)
@@ -166,21 +195,7 @@ def start_training(
         atomic_write_text(run_dir / CONFIG_FILE, dump_yaml(config))
         atomic_write_text(run_dir / COMMAND_FILE, command + "\n")
         venv, eval_env = _vec_envs(config, config.train.seed)
-        model = PPO(
-            "MlpPolicy",
-            venv,
-            policy_kwargs=config.policy.policy_kwargs(),
-            seed=config.train.seed,
-            device=config.train.device,
-            verbose=config.logging.verbose,
-            **config.ppo.sb3_kwargs(),
-        )
-        hybrid_zero = config.hybrid is not None and config.hybrid.zero_init_action_net
-        if hybrid_zero or config.policy.zero_init_action_net:
-            from ..hybrid import zero_init_action_net
-
-            # start exactly at the analytical controller (hybrid) or the reference motion
-            zero_init_action_net(model)
+        model = new_model(config, venv)
     except BaseException:
         shutil.rmtree(run_dir, ignore_errors=True)
         raise

@@ -1,0 +1,268 @@
+"""A learned gains policy taught by the one-cycle look-ahead (teacher-student distillation).
+
+The look-ahead of `agents.gains_lookahead` beats the paper's fixed blocks gains by a wide margin
+(pitch- and roll-rate medians -25 % and -19 %, 87 % fewer torso-contact steps on the held-out
+beds), but it needs a copy of the simulator. PPO on the privileged terrain scan
+(``terrain_scan=True``), with ≤ 2 M env steps, did not find those choices: one decision per
+gait cycle gives a few thousand noisy rewards. The look-ahead gives more per decision: the
+outcome of *every* candidate setting from the same state. Learning from it is the
+teacher-student scheme of legged locomotion (a privileged teacher, a student that acts from what
+it observes):
+
+1. `demonstrate`: the teacher walks training beds; at every cycle start the student's
+   observation is stored with every candidate's outcome (pitch- and roll-rate RMS, contact
+   steps) and the teacher's choice is applied.
+2. `fit_actor`: the actor of an SB3 PPO model (the architecture of the run config, the hybrid
+   residual over the paper's gains) is fitted by weighted regression to the teacher's choices
+   (the gains offset from the paper's); the observation normalisation is the demonstrations'.
+   The result is an ordinary model directory: ``evaluate.py``'s ``ppo:<dir>`` runs it, and
+   ``train.py --resume`` can fine-tune it with PPO.
+
+Every simulated control step counts, the teacher's plays included (`Demonstrations.env_steps`),
+so the budget compares with a PPO run's env steps.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from .athena_policy import analytical_policy
+from .gains_lookahead import CycleOutcome, Lookahead, gain_grid
+from .pipeline.envs import EnvSpec
+
+OUTCOME_FIELDS = ("pitch_rate_rms", "roll_rate_rms", "contact_steps")
+
+
+@dataclass
+class Demonstrations:
+    """What the teacher saw and chose, one row per gait cycle."""
+
+    observations: np.ndarray
+    """(n, obs_dim) the observation at the cycle start (as the student gets it, unnormalised)."""
+    outcomes: np.ndarray
+    """(n, k, 3) per candidate: pitch-rate RMS [rad/s], roll-rate RMS [rad/s], contact steps."""
+    candidates: np.ndarray
+    """(k, 3) the candidate gains (k_z, k_α, k_β): the lattice ``levels``³, then `reference`
+    (unless on the lattice)."""
+    levels: np.ndarray
+    """(L,) the gain levels of the candidates' lattice."""
+    reference: np.ndarray
+    """(3,) the analytical controller's gains (the paper's for the terrain): the hybrid's base."""
+    beds: np.ndarray
+    """(n,) the episode seed of each row (a bed of the task distribution)."""
+    env_steps: int
+    """Control steps simulated to collect them: the episodes' and the teacher's plays."""
+
+    def costs(self, contact_cost: float = 1.0) -> np.ndarray:
+        """(n, k) `agents.gains_lookahead.cycle_cost` of every candidate."""
+        o = self.outcomes
+        return o[..., 0] + o[..., 1] + contact_cost * o[..., 2]
+
+    @classmethod
+    def concatenate(cls, parts: Sequence[Demonstrations]) -> Demonstrations:
+        if not parts:
+            raise ValueError("no demonstrations to concatenate")
+        first = parts[0]
+        if any(not np.array_equal(p.candidates, first.candidates) for p in parts):
+            raise ValueError("demonstrations with different candidate sets")
+        return cls(
+            np.concatenate([p.observations for p in parts]),
+            np.concatenate([p.outcomes for p in parts]),
+            first.candidates,
+            first.levels,
+            first.reference,
+            np.concatenate([p.beds for p in parts]),
+            sum(p.env_steps for p in parts),
+        )
+
+    def save(self, path: str | Path) -> None:
+        np.savez_compressed(
+            path,
+            env_steps=self.env_steps,
+            **{
+                f.name: getattr(self, f.name)
+                for f in dataclasses.fields(self)
+                if f.name != "env_steps"
+            },
+        )
+
+    @classmethod
+    def load(cls, path: str | Path) -> Demonstrations:
+        with np.load(path) as data:
+            names = [f.name for f in dataclasses.fields(cls)]
+            missing = [n for n in names if n not in data]
+            if missing:
+                raise ValueError(f"{path} is not a demonstrations file (no {', '.join(missing)})")
+            return cls(**{n: data[n] for n in names[:-1]}, env_steps=int(data["env_steps"]))
+
+
+def demonstrate(
+    spec: EnvSpec, seed: int, levels: Sequence[float], contact_cost: float = 1.0
+) -> Demonstrations:
+    """One episode of `spec`'s env (the gains action mode) on the bed of ``seed``, the teacher
+    (`Lookahead` over the lattice ``levels``³ and the env's reference gains) choosing every
+    cycle; returns its rows. The env is built without `spec`'s learner wrappers (hybrid,
+    per-cycle decisions, reward terms), which do not change the observation."""
+    env = dataclasses.replace(
+        spec, hybrid=None, reward_exclude=[], decision="step", cycle_baseline="none"
+    ).make()
+    base = env.unwrapped
+    if getattr(base, "action_mode", None) != "gains":
+        env.close()
+        raise ValueError(f"demonstrations need action_mode='gains', got {spec.kwargs}")
+    observation, _ = env.reset(seed=seed)
+    reference = analytical_policy(env).gains  # the terrain's, known once it is built
+    teacher = Lookahead((*gain_grid(levels), reference), contact_cost)
+    action = np.asarray(reference, dtype=env.action_space.dtype)
+    observations, outcomes, env_steps = [], [], 0
+    while True:
+        if base.gains_due:
+            played: list[CycleOutcome] = teacher.outcomes(env)
+            observations.append(np.array(observation, dtype=np.float32))
+            outcomes.append([o[:3] for o in played])
+            env_steps += sum(o.steps for o in played)
+            action = np.asarray(teacher.choose(played), dtype=env.action_space.dtype)
+        observation, _, terminated, truncated, _ = env.step(action)
+        env_steps += 1
+        if terminated or truncated:
+            break
+    env.close()
+    return Demonstrations(
+        np.asarray(observations, dtype=np.float32).reshape(len(observations), -1),
+        np.asarray(outcomes, dtype=np.float64).reshape(len(observations), -1, 3),
+        np.asarray(teacher.candidates, dtype=np.float64),
+        np.asarray(levels, dtype=np.float64),
+        np.asarray(reference, dtype=np.float64),
+        np.full(len(observations), seed, dtype=np.int64),
+        env_steps,
+    )
+
+
+def lattice_costs(demos: Demonstrations, contact_cost: float = 1.0) -> np.ndarray:
+    """(n, L, L, L) cost of the lattice candidates, indexed [k_z, k_α, k_β]."""
+    n = len(demos.levels)
+    return demos.costs(contact_cost)[:, : n**3].reshape(-1, n, n, n)
+
+
+def interpolated_cost(lattice, gains, levels: Sequence[float]):
+    """Trilinear interpolation of per-row lattice costs (torch (n, L, L, L)) at per-row gains
+    (torch (n, 3)), constant beyond the lattice's edges; differentiable in the gains. The levels
+    must be evenly spaced."""
+    import torch.nn.functional as F
+
+    levels = np.asarray(levels, dtype=np.float64)
+    if len(levels) < 2 or not np.allclose(np.diff(levels), levels[1] - levels[0]):
+        raise ValueError(f"interpolation needs at least 2 evenly spaced levels, got {levels}")
+    lo, hi = float(levels[0]), float(levels[-1])
+    coords = (gains.to(lattice.dtype) - lo) / (hi - lo) * 2.0 - 1.0
+    # grid_sample's last coordinate indexes the volume's first axis: (k_β, k_α, k_z)
+    grid = coords.flip(-1).reshape(-1, 1, 1, 1, 3)
+    values = F.grid_sample(
+        lattice.unsqueeze(1), grid, mode="bilinear", padding_mode="border", align_corners=True
+    )
+    return values.reshape(-1)
+
+
+@dataclass
+class FitResult:
+    """Mean cycle cost on the validation rows (lattice-interpolated for the student) per epoch,
+    and the references on the same rows."""
+
+    history: list[tuple[int, float, float]]
+    """(epoch, training mean cost, validation mean cost); epoch 0 is the untrained actor."""
+    best_epoch: int
+    reference_cost: float
+    """The reference gains' measured cost (the paper's, a candidate)."""
+    teacher_cost: float
+    """The look-ahead's: the cheapest candidate of every row."""
+    best_constant_cost: float
+    """The lattice point of lowest mean cost over the training rows, on the validation rows."""
+
+    @property
+    def best_cost(self) -> float:
+        return next(v for e, _, v in self.history if e == self.best_epoch)
+
+
+def fit_actor(
+    policy,
+    observations: np.ndarray,
+    demos: Demonstrations,
+    scale: float,
+    validation: np.ndarray,
+    contact_cost: float = 1.0,
+    epochs: int = 300,
+    learning_rate: float = 1e-3,
+    batch_size: int = 128,
+    seed: int = 0,
+) -> FitResult:
+    """Fit the actor (mean action) of an SB3 ActorCriticPolicy so that its gains,
+    clip(demos.reference + scale x clip(a, -1, 1), 0, 1) as the hybrid residual applies them,
+    minimise the teacher-measured cycle cost, interpolated over the lattice, on the training
+    rows (``~validation``). Keeps the epoch of lowest validation cost (early stopping).
+
+    Why the cost and not the teacher's choice: a cycle's outcome under a setting is noisy, so
+    the teacher's argmin jumps between distant settings in similar states; regressing on it
+    averages those settings. Minimising the interpolated cost averages the costs instead: in
+    expectation the student picks the setting cheapest for what it observes.
+
+    `observations` are what the network sees (normalised). The critic is not touched."""
+    import copy
+
+    import torch
+
+    torch.manual_seed(seed)
+    device = policy.device
+    obs = torch.as_tensor(observations, dtype=torch.float32, device=device)
+    levels = demos.levels
+    lattice = torch.as_tensor(lattice_costs(demos, contact_cost), device=device)
+    ref = torch.as_tensor(np.asarray(demos.reference, dtype=np.float32), device=device)
+    validation = np.asarray(validation, dtype=bool)
+    train_rows = np.flatnonzero(~validation)
+    val_rows = torch.as_tensor(np.flatnonzero(validation), device=device)
+    if len(train_rows) == 0 or len(val_rows) == 0:
+        raise ValueError("fit_actor needs both training and validation rows")
+
+    def gains(rows) -> torch.Tensor:
+        mean = policy.get_distribution(obs[rows]).distribution.mean
+        return (ref + scale * mean.clamp(-1.0, 1.0)).clamp(0.0, 1.0)
+
+    def mean_cost(rows) -> float:
+        with torch.no_grad():
+            return float(interpolated_cost(lattice[rows], gains(rows), levels).mean())
+
+    costs = demos.costs(contact_cost)
+    ref_index = int(np.argmin(np.abs(demos.candidates - demos.reference).sum(axis=1)))
+    flat = lattice.reshape(len(lattice), -1).cpu().numpy()
+    best_constant = int(flat[train_rows].mean(axis=0).argmin())
+    vr = val_rows.cpu().numpy()
+    actor = [*policy.mlp_extractor.policy_net.parameters(), *policy.action_net.parameters()]
+    optimizer = torch.optim.Adam(actor, lr=learning_rate)
+    generator = np.random.default_rng(seed)
+    train_t = torch.as_tensor(train_rows, device=device)
+    history = [(0, mean_cost(train_t), mean_cost(val_rows))]
+    best_state, best_epoch = copy.deepcopy(policy.state_dict()), 0
+    for epoch in range(1, epochs + 1):
+        for batch in np.array_split(
+            generator.permutation(train_rows), max(1, len(train_rows) // batch_size)
+        ):
+            rows = torch.as_tensor(batch, device=device)
+            loss = interpolated_cost(lattice[rows], gains(rows), levels).mean()
+            optimizer.zero_grad()
+            loss.backward()
+            optimizer.step()
+        history.append((epoch, mean_cost(train_t), mean_cost(val_rows)))
+        if history[-1][2] < min(v for e, _, v in history[:-1]):
+            best_state, best_epoch = copy.deepcopy(policy.state_dict()), epoch
+    policy.load_state_dict(best_state)
+    return FitResult(
+        history,
+        best_epoch,
+        reference_cost=float(costs[vr, ref_index].mean()),
+        teacher_cost=float(costs[vr].min(axis=1).mean()),
+        best_constant_cost=float(flat[vr, best_constant].mean()),
+    )

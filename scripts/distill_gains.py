@@ -1,0 +1,147 @@
+"""Teach a gains policy with the one-cycle look-ahead (`agents.gains_distill`).
+
+Two steps, so that the expensive one runs once:
+
+    collect   the look-ahead walks training beds of the config's env (its task distribution,
+              seeds --first-seed ...); writes the demonstrations (.npz)
+    fit       fits the actor of the config's PPO model to them; writes a model directory that
+              evaluate.py's ppo:<dir> runs and train.py --resume can fine-tune
+
+Run (CONFIG: configs/irregular_terrain_gains_blocks_scan.yaml):
+    python scripts/distill_gains.py collect --config CONFIG --episodes 56 --workers 2 \
+        --out runs/distill/demos.npz
+    python scripts/distill_gains.py fit --config CONFIG --demos runs/distill/demos.npz \
+        --out runs/distill/model
+"""
+
+from __future__ import annotations
+
+import argparse
+import multiprocessing
+import sys
+import time
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import numpy as np  # noqa: E402
+
+from agents.gains_distill import Demonstrations, demonstrate, fit_actor  # noqa: E402
+from agents.pipeline.artifacts import command_line, save_model_dir  # noqa: E402
+from agents.pipeline.errors import UserError  # noqa: E402
+from agents.pipeline.model_files import NormalizationStats  # noqa: E402
+from agents.pipeline.train_config import load_train_config  # noqa: E402
+from agents.pipeline.training import env_spec, untrained_model  # noqa: E402
+
+
+def collect(args: argparse.Namespace) -> None:
+    spec = env_spec(load_train_config(args.config, args.set))
+    seeds = range(args.first_seed, args.first_seed + args.episodes)
+    start = time.perf_counter()
+    parts = []
+    n = len(seeds)
+    with ProcessPoolExecutor(args.workers, mp_context=multiprocessing.get_context("spawn")) as pool:
+        jobs = pool.map(demonstrate, [spec] * n, seeds, [args.levels] * n, [args.contact_cost] * n)
+        for part in jobs:
+            parts.append(part)
+            steps = sum(p.env_steps for p in parts)
+            print(
+                f"bed {part.beds[0]}: {len(part.beds)} cycles; total {steps} env steps, "
+                f"{time.perf_counter() - start:.0f} s",
+                flush=True,
+            )
+    demos = Demonstrations.concatenate(parts)
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    demos.save(args.out)
+    print(f"wrote {args.out}: {len(demos.beds)} cycles, {demos.env_steps} env steps")
+
+
+def fit(args: argparse.Namespace) -> None:
+    config = load_train_config(args.config, args.set)
+    hybrid = config.hybrid
+    if hybrid is None or hybrid.mode != "residual" or hybrid.safety_filter:
+        raise UserError("fit needs a config whose hybrid section is the plain residual mode")
+    demos = Demonstrations.load(args.demos)
+    beds = np.unique(demos.beds)
+    held_out = beds[len(beds) - max(1, round(args.validation_fraction * len(beds))) :]
+    validation = np.isin(demos.beds, held_out)
+    model = untrained_model(config)
+    vec_normalize = model.get_vec_normalize_env()
+    observations = demos.observations
+    if vec_normalize is not None and vec_normalize.norm_obs:
+        train_obs = observations[~validation].astype(np.float64)
+        vec_normalize.obs_rms.mean = train_obs.mean(axis=0)
+        vec_normalize.obs_rms.var = train_obs.var(axis=0)
+        vec_normalize.obs_rms.count = float(len(train_obs))
+        observations = NormalizationStats.from_vec_normalize(vec_normalize).normalize_obs(
+            observations
+        )
+    result = fit_actor(
+        model.policy,
+        observations,
+        demos,
+        hybrid.scale,
+        validation,
+        contact_cost=args.contact_cost,
+        epochs=args.epochs,
+        learning_rate=args.learning_rate,
+        seed=config.train.seed,
+    )
+    for epoch, train_cost, val_cost in result.history[:: max(1, args.epochs // 20)]:
+        print(
+            f"epoch {epoch:4d}: mean cycle cost train {train_cost:.5f}, validation {val_cost:.5f}"
+        )
+    summary = {
+        "best_epoch": result.best_epoch,
+        "validation_cost": round(result.best_cost, 6),
+        "reference_cost": round(result.reference_cost, 6),
+        "best_constant_cost": round(result.best_constant_cost, 6),
+        "teacher_cost": round(result.teacher_cost, 6),
+    }
+    print(f"validation beds {held_out.tolist()}: {summary}")
+    save_model_dir(
+        args.out,
+        model,
+        vec_normalize,
+        config,
+        command_line(),
+        kind="distilled",
+        extra_meta={
+            "demonstrations": str(args.demos),
+            "demonstration_cycles": len(demos.beds),
+            "env_steps": demos.env_steps,
+            **summary,
+        },
+    )
+    print(f"wrote {args.out}")
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    commands = parser.add_subparsers(dest="command", required=True)
+    c = commands.add_parser("collect", help="the look-ahead's demonstrations on training beds")
+    c.add_argument("--config", type=Path, required=True, help="training config (gains mode)")
+    c.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    c.add_argument("--episodes", type=int, default=60)
+    c.add_argument("--first-seed", type=int, default=0)
+    c.add_argument("--levels", type=float, nargs="+", default=[0.2, 0.5, 0.8])
+    c.add_argument("--contact-cost", type=float, default=1.0)
+    c.add_argument("--workers", type=int, default=1, help="processes (one core each)")
+    c.add_argument("--out", type=Path, required=True)
+    f = commands.add_parser("fit", help="fit the config's actor to demonstrations")
+    f.add_argument("--config", type=Path, required=True, help="training config (gains, hybrid)")
+    f.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+    f.add_argument("--demos", type=Path, required=True)
+    f.add_argument("--contact-cost", type=float, default=1.0)
+    f.add_argument("--epochs", type=int, default=300)
+    f.add_argument("--learning-rate", type=float, default=1e-3)
+    f.add_argument(
+        "--validation-fraction", type=float, default=0.2, help="of the beds, for early stopping"
+    )
+    f.add_argument("--out", type=Path, required=True, help="model directory to write")
+    args = parser.parse_args(argv)
+    {"collect": collect, "fit": fit}[args.command](args)
+
+
+if __name__ == "__main__":
+    main()

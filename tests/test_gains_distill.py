@@ -1,0 +1,173 @@
+"""Teaching a gains policy with the look-ahead (agents/gains_distill, scripts/distill_gains)."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+import torch
+from test_athena_posture_study import _script
+
+import hexapod_envs  # noqa: F401
+from agents.gains_distill import (
+    Demonstrations,
+    demonstrate,
+    fit_actor,
+    interpolated_cost,
+    lattice_costs,
+)
+from agents.gains_lookahead import gain_grid
+from agents.pipeline.envs import EnvSpec
+
+CONFIG = "configs/irregular_terrain_gains_blocks_scan.yaml"
+
+
+def test_interpolation_is_exact_on_the_lattice_linear_between_and_flat_beyond():
+    levels = [0.2, 0.5, 0.8]
+    rng = np.random.default_rng(0)
+    lattice = torch.as_tensor(rng.uniform(size=(1, 3, 3, 3)))
+    for i, g in enumerate(gain_grid(levels)):
+        z, a, b = np.unravel_index(i, (3, 3, 3))
+        value = interpolated_cost(lattice, torch.tensor([g], dtype=torch.float64), levels)
+        assert float(value) == pytest.approx(float(lattice[0, z, a, b]), abs=1e-12)
+    # halfway along k_α between (0.2, 0.2, 0.8) and (0.2, 0.5, 0.8)
+    mid = interpolated_cost(lattice, torch.tensor([[0.2, 0.35, 0.8]], dtype=torch.float64), levels)
+    assert float(mid) == pytest.approx(float(lattice[0, 0, :2, 2].mean()), abs=1e-12)
+    beyond = interpolated_cost(lattice, torch.tensor([[1.0, 0.0, 0.9]]), levels)
+    assert float(beyond) == pytest.approx(float(lattice[0, 2, 0, 2]), abs=1e-12)
+    gains = torch.tensor([[0.3, 0.6, 0.4]], dtype=torch.float64, requires_grad=True)
+    interpolated_cost(lattice, gains, levels).sum().backward()
+    assert torch.all(torch.isfinite(gains.grad)) and torch.any(gains.grad != 0)
+    with pytest.raises(ValueError, match="evenly spaced"):
+        interpolated_cost(lattice, gains, [0.2, 0.3, 0.8])
+
+
+def _synthetic(n: int = 400, seed: int = 0) -> Demonstrations:
+    """Observation feature 0 says which k_z level is cheapest (0.2 when negative, else 0.8)."""
+    rng = np.random.default_rng(seed)
+    levels = np.array([0.2, 0.5, 0.8])
+    grid = np.array(gain_grid(levels))
+    candidates = np.vstack([grid, [0.6, 0.4, 0.4]])
+    obs = rng.normal(size=(n, 4)).astype(np.float32)
+    best_kz = np.where(obs[:, :1] < 0, 0.2, 0.8)
+    pitch = (candidates[None, :, 0] - best_kz) ** 2 + 0.01 * rng.uniform(size=(n, len(candidates)))
+    outcomes = np.stack([pitch, np.full_like(pitch, 0.1), np.zeros_like(pitch)], axis=-1)
+    reference = np.array([0.6, 0.4, 0.4])
+    return Demonstrations(obs, outcomes, candidates, levels, reference, np.arange(n) // 20, n * 50)
+
+
+def test_fit_actor_learns_the_state_dependent_choice_and_keeps_the_best_epoch():
+    from stable_baselines3.common.policies import ActorCriticPolicy
+
+    demos = _synthetic()
+    policy = ActorCriticPolicy(
+        gym.spaces.Box(-np.inf, np.inf, (4,), np.float32),
+        gym.spaces.Box(-1.0, 1.0, (3,), np.float32),
+        lr_schedule=lambda _: 1e-3,
+        net_arch=[32],
+    )
+    validation = demos.beds >= 16
+    result = fit_actor(policy, demos.observations, demos, 1.0, validation, epochs=60)
+    assert result.history[0][0] == 0 and len(result.history) == 61
+    assert result.best_cost == min(v for _, _, v in result.history)
+    # the teacher knows every row's cheapest; a constant cannot follow feature 0; the student can
+    excess = result.best_cost - result.teacher_cost
+    assert 0 < excess < 0.5 * (result.best_constant_cost - result.teacher_cost)
+    assert result.best_cost < result.reference_cost
+    with torch.no_grad():
+        mean = policy.get_distribution(torch.as_tensor(demos.observations)).distribution.mean
+    k_z = np.clip(0.6 + mean[:, 0].clamp(-1, 1).numpy(), 0, 1)
+    sign = demos.observations[:, 0] < 0
+    assert np.median(k_z[sign]) < 0.35 and np.median(k_z[~sign]) > 0.65
+    with pytest.raises(ValueError, match="training and validation"):
+        fit_actor(policy, demos.observations, demos, 1.0, demos.beds >= 0)
+
+
+def test_demonstrations_record_every_candidate_and_the_teachers_budget(tmp_path):
+    spec = EnvSpec(
+        "HexapodIrregularTerrain-v0",
+        {
+            "task_distribution": "train",
+            "terrain": "blocks",
+            "action_mode": "gains",
+            "gait_ground_search": "always",
+            "terrain_scan": True,
+        },
+        max_episode_steps=90,
+    )
+    demos = demonstrate(spec, 3, [0.2, 0.8])
+    n = len(demos.beds)
+    assert n >= 2 and np.all(demos.beds == 3)
+    assert demos.candidates.shape == (9, 3) and tuple(demos.candidates[-1]) == (0.6, 0.4, 0.4)
+    assert demos.observations.shape == (
+        n,
+        gym.make(spec.id, **spec.kwargs).observation_space.shape[0],
+    )
+    assert demos.outcomes.shape == (n, 9, 3) and np.all(demos.outcomes[..., :2] > 0)
+    # every candidate is played for a whole cycle on top of the episode's 90 steps
+    assert demos.env_steps > 90 + 9 * 20 * n
+    assert lattice_costs(demos).shape == (n, 2, 2, 2)
+    demos.save(tmp_path / "d.npz")
+    back = Demonstrations.load(tmp_path / "d.npz")
+    np.testing.assert_array_equal(back.outcomes, demos.outcomes)
+    assert back.env_steps == demos.env_steps
+    both = Demonstrations.concatenate([demos, back])
+    assert len(both.beds) == 2 * n and both.env_steps == 2 * demos.env_steps
+    other = Demonstrations(**{**vars(demos), "candidates": demos.candidates + 0.1})
+    with pytest.raises(ValueError, match="different candidate sets"):
+        Demonstrations.concatenate([demos, other])
+    np.savez(tmp_path / "bad.npz", observations=demos.observations)
+    with pytest.raises(ValueError, match="not a demonstrations file"):
+        Demonstrations.load(tmp_path / "bad.npz")
+
+
+def test_script_collects_fits_and_the_model_runs_in_the_evaluation(tmp_path):
+    from agents.ppo import PPOPolicy
+
+    script = _script("distill_gains")
+    demos = tmp_path / "demos.npz"
+    script.main(
+        [
+            "collect",
+            "--config",
+            CONFIG,
+            "--set",
+            "env.max_episode_steps=70",
+            "--episodes",
+            "2",
+            "--levels",
+            "0.2",
+            "0.8",
+            "--out",
+            str(demos),
+        ]
+    )
+    model_dir = tmp_path / "model"
+    script.main(
+        [
+            "fit",
+            "--config",
+            CONFIG,
+            "--demos",
+            str(demos),
+            "--epochs",
+            "3",
+            "--validation-fraction",
+            "0.5",
+            "--out",
+            str(model_dir),
+        ]
+    )
+    env = gym.make(
+        "HexapodIrregularTerrain-v0",
+        terrain="blocks",
+        action_mode="gains",
+        gait_ground_search="always",
+        terrain_scan=True,
+        task_distribution="test",
+    )
+    policy = PPOPolicy.load(model_dir, env)
+    obs, _ = env.reset(seed=0)
+    policy.reset()
+    action = policy(obs)
+    assert action.shape == (3,) and np.all((action >= 0.0) & (action <= 1.0))
