@@ -199,16 +199,20 @@ def fit_actor(
     learning_rate: float = 1e-3,
     batch_size: int = 128,
     seed: int = 0,
+    edge_weight: float = 10.0,
 ) -> FitResult:
     """Fit the actor (mean action) of an SB3 ActorCriticPolicy so that its gains,
     clip(demos.reference + scale x clip(a, -1, 1), 0, 1) as the hybrid residual applies them,
     minimise the teacher-measured cycle cost, interpolated over the lattice, on the training
     rows (``~validation``). Keeps the epoch of lowest validation cost (early stopping).
 
-    Why the cost and not the teacher's choice: a cycle's outcome under a setting is noisy, so
-    the teacher's argmin jumps between distant settings in similar states; regressing on it
-    averages those settings. Minimising the interpolated cost averages the costs instead: in
-    expectation the student picks the setting cheapest for what it observes.
+    Why the cost and not the teacher's choice: a cycle's outcome depends on details of the
+    state that the observation does not carry, so the teacher's argmin jumps between distant
+    settings in states the student cannot tell apart; regressing on it averages those
+    settings. Minimising the interpolated cost averages the costs instead: the student learns
+    the setting cheapest on average for what it observes. The teacher measured nothing outside
+    the lattice, so gains beyond it cost ``(distance outside)²`` per unit of `edge_weight` (the
+    interpolation is flat there: without it the actor drifts to 0 or 1).
 
     `observations` are what the network sees (normalised). The critic is not touched."""
     import copy
@@ -227,9 +231,18 @@ def fit_actor(
     if len(train_rows) == 0 or len(val_rows) == 0:
         raise ValueError("fit_actor needs both training and validation rows")
 
+    lo, hi = float(levels[0]), float(levels[-1])
+
     def gains(rows) -> torch.Tensor:
         mean = policy.get_distribution(obs[rows]).distribution.mean
         return (ref + scale * mean.clamp(-1.0, 1.0)).clamp(0.0, 1.0)
+
+    def loss(rows) -> torch.Tensor:
+        # unclipped, so that the edge term pulls back an action beyond the action space too
+        raw = ref + scale * policy.get_distribution(obs[rows]).distribution.mean
+        outside = torch.relu(lo - raw) + torch.relu(raw - hi)
+        cost = interpolated_cost(lattice[rows], raw, levels)
+        return (cost + edge_weight * (outside**2).sum(dim=-1)).mean()
 
     def mean_cost(rows) -> float:
         with torch.no_grad():
@@ -251,9 +264,8 @@ def fit_actor(
             generator.permutation(train_rows), max(1, len(train_rows) // batch_size)
         ):
             rows = torch.as_tensor(batch, device=device)
-            loss = interpolated_cost(lattice[rows], gains(rows), levels).mean()
             optimizer.zero_grad()
-            loss.backward()
+            loss(rows).backward()
             optimizer.step()
         history.append((epoch, mean_cost(train_t), mean_cost(val_rows)))
         if history[-1][2] < min(v for e, _, v in history[:-1]):
