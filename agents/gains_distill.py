@@ -80,6 +80,15 @@ class Demonstrations:
             sum(p.env_steps for p in parts),
         )
 
+    def subset(self, rows: np.ndarray) -> Demonstrations:
+        """The given rows (a boolean mask or indices); `env_steps` is kept (what was spent)."""
+        return dataclasses.replace(
+            self,
+            observations=self.observations[rows],
+            outcomes=self.outcomes[rows],
+            beds=self.beds[rows],
+        )
+
     def save(self, path: str | Path) -> None:
         np.savez_compressed(
             path,
@@ -278,3 +287,36 @@ def fit_actor(
         teacher_cost=float(costs[vr].min(axis=1).mean()),
         best_constant_cost=float(flat[vr, best_constant].mean()),
     )
+
+
+def held_out_rows(demos: Demonstrations, fraction: float) -> np.ndarray:
+    """(n,) True for the rows of the last ``fraction`` of the beds (at least one bed)."""
+    beds = np.unique(demos.beds)
+    held_out = beds[len(beds) - max(1, round(fraction * len(beds))) :]
+    return np.isin(demos.beds, held_out)
+
+
+def distill(config, demos: Demonstrations, validation: np.ndarray, **fit_kwargs):
+    """(model, its VecNormalize or None, `FitResult`): a new PPO model of the training config
+    `config` (`agents.pipeline.train_config.TrainConfig`, gains mode, plain hybrid residual)
+    whose observation statistics are those of the training rows and whose actor is fitted by
+    `fit_actor` (``fit_kwargs``)."""
+    from .pipeline.model_files import NormalizationStats
+    from .pipeline.training import untrained_model
+
+    hybrid = config.hybrid
+    if hybrid is None or hybrid.mode != "residual" or hybrid.safety_filter:
+        raise ValueError("distilling needs a config whose hybrid section is the plain residual")
+    model = untrained_model(config)
+    vec_normalize = model.get_vec_normalize_env()
+    observations = demos.observations
+    if vec_normalize is not None and vec_normalize.norm_obs:
+        train_obs = observations[~validation].astype(np.float64)
+        vec_normalize.obs_rms.mean = train_obs.mean(axis=0)
+        vec_normalize.obs_rms.var = train_obs.var(axis=0)
+        vec_normalize.obs_rms.count = float(len(train_obs))
+        stats = NormalizationStats.from_vec_normalize(vec_normalize)
+        observations = stats.normalize_obs(observations)
+    fit_kwargs.setdefault("seed", config.train.seed)
+    result = fit_actor(model.policy, observations, demos, hybrid.scale, validation, **fit_kwargs)
+    return model, vec_normalize, result

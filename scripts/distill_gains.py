@@ -26,12 +26,15 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import numpy as np  # noqa: E402
 
-from agents.gains_distill import Demonstrations, demonstrate, fit_actor  # noqa: E402
+from agents.gains_distill import (  # noqa: E402
+    Demonstrations,
+    demonstrate,
+    distill,
+    held_out_rows,
+)
 from agents.pipeline.artifacts import command_line, save_model_dir  # noqa: E402
-from agents.pipeline.errors import UserError  # noqa: E402
-from agents.pipeline.model_files import NormalizationStats  # noqa: E402
 from agents.pipeline.train_config import load_train_config  # noqa: E402
-from agents.pipeline.training import env_spec, untrained_model  # noqa: E402
+from agents.pipeline.training import env_spec  # noqa: E402
 
 
 def collect(args: argparse.Namespace) -> None:
@@ -58,47 +61,21 @@ def collect(args: argparse.Namespace) -> None:
 
 def fit(args: argparse.Namespace) -> None:
     config = load_train_config(args.config, args.set)
-    hybrid = config.hybrid
-    if hybrid is None or hybrid.mode != "residual" or hybrid.safety_filter:
-        raise UserError("fit needs a config whose hybrid section is the plain residual mode")
     demos = Demonstrations.load(args.demos)
-    beds = np.unique(demos.beds)
-    held_out = beds[len(beds) - max(1, round(args.validation_fraction * len(beds))) :]
-    validation = np.isin(demos.beds, held_out)
-    model = untrained_model(config)
-    vec_normalize = model.get_vec_normalize_env()
-    observations = demos.observations
-    if vec_normalize is not None and vec_normalize.norm_obs:
-        train_obs = observations[~validation].astype(np.float64)
-        vec_normalize.obs_rms.mean = train_obs.mean(axis=0)
-        vec_normalize.obs_rms.var = train_obs.var(axis=0)
-        vec_normalize.obs_rms.count = float(len(train_obs))
-        observations = NormalizationStats.from_vec_normalize(vec_normalize).normalize_obs(
-            observations
-        )
-    result = fit_actor(
-        model.policy,
-        observations,
-        demos,
-        hybrid.scale,
-        validation,
-        contact_cost=args.contact_cost,
-        epochs=args.epochs,
-        learning_rate=args.learning_rate,
-        seed=config.train.seed,
-    )
+    validation = held_out_rows(demos, args.validation_fraction)
+    model, vec_normalize, result = distill(config, demos, validation, **_fit_settings(args))
     for epoch, train_cost, val_cost in result.history[:: max(1, args.epochs // 20)]:
         print(
-            f"epoch {epoch:4d}: mean cycle cost train {train_cost:.5f}, validation {val_cost:.5f}"
+            f"epoch {epoch:4d}: mean cycle cost: training {train_cost:.5f}, held out {val_cost:.5f}"
         )
     summary = {
         "best_epoch": result.best_epoch,
-        "validation_cost": round(result.best_cost, 6),
+        "held_out_cost": round(result.best_cost, 6),
         "reference_cost": round(result.reference_cost, 6),
         "best_constant_cost": round(result.best_constant_cost, 6),
         "teacher_cost": round(result.teacher_cost, 6),
     }
-    print(f"validation beds {held_out.tolist()}: {summary}")
+    print(f"held-out beds {np.unique(demos.beds[validation]).tolist()}: {summary}")
     save_model_dir(
         args.out,
         model,
@@ -116,6 +93,39 @@ def fit(args: argparse.Namespace) -> None:
     print(f"wrote {args.out}")
 
 
+def curve(args: argparse.Namespace) -> None:
+    """Held-out cost against the number of training beds: does more data help?"""
+    demos = Demonstrations.load(args.demos)
+    validation = held_out_rows(demos, args.validation_fraction)
+    pool = np.unique(demos.beds[~validation])
+    for fraction in args.fractions:
+        costs = []
+        for seed in range(args.seeds):
+            config = load_train_config(args.config, [*args.set, f"train.seed={seed}"])
+            chosen = np.random.default_rng(seed).choice(
+                pool, max(1, round(fraction * len(pool))), replace=False
+            )
+            rows = validation | np.isin(demos.beds, chosen)
+            subset = demos.subset(rows)
+            _, _, result = distill(config, subset, validation[rows], **_fit_settings(args))
+            costs.append(result.best_cost)
+        print(
+            f"{len(chosen)} training beds: held-out cost {np.mean(costs):.5f} "
+            f"± {np.std(costs):.5f} over {args.seeds} seeds (reference "
+            f"{result.reference_cost:.5f}, best constant {result.best_constant_cost:.5f}, "
+            f"teacher {result.teacher_cost:.5f})",
+            flush=True,
+        )
+
+
+def _fit_settings(args: argparse.Namespace) -> dict:
+    return {
+        "contact_cost": args.contact_cost,
+        "epochs": args.epochs,
+        "learning_rate": args.learning_rate,
+    }
+
+
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="command", required=True)
@@ -129,18 +139,22 @@ def main(argv: list[str] | None = None) -> None:
     c.add_argument("--workers", type=int, default=1, help="processes (one core each)")
     c.add_argument("--out", type=Path, required=True)
     f = commands.add_parser("fit", help="fit the config's actor to demonstrations")
-    f.add_argument("--config", type=Path, required=True, help="training config (gains, hybrid)")
-    f.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-    f.add_argument("--demos", type=Path, required=True)
-    f.add_argument("--contact-cost", type=float, default=1.0)
-    f.add_argument("--epochs", type=int, default=300)
-    f.add_argument("--learning-rate", type=float, default=1e-3)
-    f.add_argument(
-        "--validation-fraction", type=float, default=0.2, help="of the beds, for early stopping"
-    )
+    r = commands.add_parser("curve", help="held-out cost against the number of training beds")
+    for p in (f, r):
+        p.add_argument("--config", type=Path, required=True, help="training config (gains, hybrid)")
+        p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+        p.add_argument("--demos", type=Path, required=True)
+        p.add_argument("--contact-cost", type=float, default=1.0)
+        p.add_argument("--epochs", type=int, default=300)
+        p.add_argument("--learning-rate", type=float, default=1e-3)
+        p.add_argument(
+            "--validation-fraction", type=float, default=0.2, help="held-out beds (early stopping)"
+        )
     f.add_argument("--out", type=Path, required=True, help="model directory to write")
+    r.add_argument("--fractions", type=float, nargs="+", default=[0.25, 0.5, 1.0])
+    r.add_argument("--seeds", type=int, default=3)
     args = parser.parse_args(argv)
-    {"collect": collect, "fit": fit}[args.command](args)
+    {"collect": collect, "fit": fit, "curve": curve}[args.command](args)
 
 
 if __name__ == "__main__":

@@ -81,7 +81,7 @@ def test_fit_actor_learns_the_state_dependent_choice_and_keeps_the_best_epoch():
     assert np.median(k_z[sign]) < 0.35 and np.median(k_z[~sign]) > 0.65
     # the optimum lies on the lattice's edge; the edge term keeps the actor from drifting beyond
     low, high = np.percentile(k_z, [10, 90])
-    assert 0.15 < low and high < 0.85
+    assert low > 0.15 and high < 0.85
     with pytest.raises(ValueError, match="training and validation"):
         fit_actor(policy, demos.observations, demos, 1.0, demos.beds >= 0)
 
@@ -124,7 +124,7 @@ def test_demonstrations_record_every_candidate_and_the_teachers_budget(tmp_path)
         Demonstrations.load(tmp_path / "bad.npz")
 
 
-def test_script_collects_fits_and_the_model_runs_in_the_evaluation(tmp_path):
+def test_script_collects_fits_and_the_model_runs_in_the_evaluation(tmp_path, capsys):
     from agents.ppo import PPOPolicy
 
     script = _script("distill_gains")
@@ -174,3 +174,21 @@ def test_script_collects_fits_and_the_model_runs_in_the_evaluation(tmp_path):
     policy.reset()
     action = policy(obs)
     assert action.shape == (3,) and np.all((action >= 0.0) & (action <= 1.0))
+    script.main(
+        [
+            "curve",
+            "--config",
+            CONFIG,
+            "--demos",
+            str(demos),
+            "--epochs",
+            "2",
+            "--validation-fraction",
+            "0.5",
+            "--fractions",
+            "1",
+            "--seeds",
+            "1",
+        ]
+    )
+    assert "1 training beds: held-out cost" in capsys.readouterr().out
