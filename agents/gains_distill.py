@@ -32,10 +32,15 @@ from pathlib import Path
 import numpy as np
 
 from .athena_policy import analytical_policy
-from .gains_lookahead import CycleOutcome, Lookahead, gain_grid
+from .gains_lookahead import (
+    DEFAULT_COST,
+    SCORED,
+    CycleCost,
+    CycleOutcome,
+    Lookahead,
+    gain_grid,
+)
 from .pipeline.envs import EnvSpec
-
-OUTCOME_FIELDS = ("pitch_rate_rms", "roll_rate_rms", "contact_steps")
 
 
 @dataclass
@@ -45,7 +50,8 @@ class Demonstrations:
     observations: np.ndarray
     """(n, obs_dim) the observation at the cycle start (as the student gets it, unnormalised)."""
     outcomes: np.ndarray
-    """(n, k, 3) per candidate: pitch-rate RMS [rad/s], roll-rate RMS [rad/s], contact steps."""
+    """(n, k, 4) per candidate, the scored `CycleOutcome` fields: pitch- and roll-rate RMS
+    [rad/s], contact steps, smallest torso footprint clearance [m]."""
     candidates: np.ndarray
     """(k, 3) the candidate gains (k_z, k_α, k_β): the lattice ``levels``³, then `reference`
     (unless on the lattice)."""
@@ -58,10 +64,9 @@ class Demonstrations:
     env_steps: int
     """Control steps simulated to collect them: the episodes' and the teacher's plays."""
 
-    def costs(self, contact_cost: float = 1.0) -> np.ndarray:
-        """(n, k) `agents.gains_lookahead.cycle_cost` of every candidate."""
-        o = self.outcomes
-        return o[..., 0] + o[..., 1] + contact_cost * o[..., 2]
+    def costs(self, cost: CycleCost) -> np.ndarray:
+        """(n, k) cost of every candidate."""
+        return cost.of_rows(self.outcomes)
 
     @classmethod
     def concatenate(cls, parts: Sequence[Demonstrations]) -> Demonstrations:
@@ -111,7 +116,7 @@ class Demonstrations:
 
 
 def demonstrate(
-    spec: EnvSpec, seed: int, levels: Sequence[float], contact_cost: float = 1.0
+    spec: EnvSpec, seed: int, levels: Sequence[float], cost: CycleCost = DEFAULT_COST
 ) -> Demonstrations:
     """One episode of `spec`'s env (the gains action mode) on the bed of ``seed``, the teacher
     (`Lookahead` over the lattice ``levels``³ and the env's reference gains) choosing every
@@ -126,14 +131,14 @@ def demonstrate(
         raise ValueError(f"demonstrations need action_mode='gains', got {spec.kwargs}")
     observation, _ = env.reset(seed=seed)
     reference = analytical_policy(env).gains  # the terrain's, known once it is built
-    teacher = Lookahead((*gain_grid(levels), reference), contact_cost)
+    teacher = Lookahead((*gain_grid(levels), reference), cost)
     action = np.asarray(reference, dtype=env.action_space.dtype)
     observations, outcomes, env_steps = [], [], 0
     while True:
         if base.gains_due:
             played: list[CycleOutcome] = teacher.outcomes(env)
             observations.append(np.array(observation, dtype=np.float32))
-            outcomes.append([o[:3] for o in played])
+            outcomes.append([o[:SCORED] for o in played])
             env_steps += sum(o.steps for o in played)
             action = np.asarray(teacher.choose(played), dtype=env.action_space.dtype)
         observation, _, terminated, truncated, _ = env.step(action)
@@ -143,7 +148,7 @@ def demonstrate(
     env.close()
     return Demonstrations(
         np.asarray(observations, dtype=np.float32).reshape(len(observations), -1),
-        np.asarray(outcomes, dtype=np.float64).reshape(len(observations), -1, 3),
+        np.asarray(outcomes, dtype=np.float64).reshape(len(observations), -1, SCORED),
         np.asarray(teacher.candidates, dtype=np.float64),
         np.asarray(levels, dtype=np.float64),
         np.asarray(reference, dtype=np.float64),
@@ -152,10 +157,10 @@ def demonstrate(
     )
 
 
-def lattice_costs(demos: Demonstrations, contact_cost: float = 1.0) -> np.ndarray:
+def lattice_costs(demos: Demonstrations, cost: CycleCost) -> np.ndarray:
     """(n, L, L, L) cost of the lattice candidates, indexed [k_z, k_α, k_β]."""
     n = len(demos.levels)
-    return demos.costs(contact_cost)[:, : n**3].reshape(-1, n, n, n)
+    return demos.costs(cost)[:, : n**3].reshape(-1, n, n, n)
 
 
 def interpolated_cost(lattice, gains, levels: Sequence[float]):
@@ -203,7 +208,7 @@ def fit_actor(
     demos: Demonstrations,
     scale: float,
     validation: np.ndarray,
-    contact_cost: float = 1.0,
+    cost: CycleCost = DEFAULT_COST,
     epochs: int = 300,
     learning_rate: float = 1e-3,
     batch_size: int = 128,
@@ -232,7 +237,7 @@ def fit_actor(
     device = policy.device
     obs = torch.as_tensor(observations, dtype=torch.float32, device=device)
     levels = demos.levels
-    lattice = torch.as_tensor(lattice_costs(demos, contact_cost), device=device)
+    lattice = torch.as_tensor(lattice_costs(demos, cost), device=device)
     ref = torch.as_tensor(np.asarray(demos.reference, dtype=np.float32), device=device)
     validation = np.asarray(validation, dtype=bool)
     train_rows = np.flatnonzero(~validation)
@@ -257,7 +262,7 @@ def fit_actor(
         with torch.no_grad():
             return float(interpolated_cost(lattice[rows], gains(rows), levels).mean())
 
-    costs = demos.costs(contact_cost)
+    costs = demos.costs(cost)
     ref_index = int(np.argmin(np.abs(demos.candidates - demos.reference).sum(axis=1)))
     flat = lattice.reshape(len(lattice), -1).cpu().numpy()
     best_constant = int(flat[train_rows].mean(axis=0).argmin())

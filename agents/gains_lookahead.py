@@ -8,8 +8,8 @@ achieve on a task distribution:
 - **fixed gains**: every setting of a grid held for whole episodes (a constant policy, which
   PPO can represent);
 - **look-ahead**: at every cycle start the env is copied and each candidate setting is played
-  for one cycle on its own copy; the one with the lowest cycle cost, pitch-rate RMS + roll-rate
-  RMS [rad/s] + ``contact_cost`` x torso-contact steps, is applied. It sees the terrain the
+  for one cycle on its own copy; the one with the lowest `CycleCost` (by default pitch-rate
+  RMS + roll-rate RMS [rad/s] + 1 per torso-contact step) is applied. It sees the terrain the
   cycle will meet (the default observation does not carry it) and the cycle's outcome, so it
   shows what a greedy per-cycle choice can reach; it is not a bound on policies that plan over
   several cycles. A contact step costs 1 rad/s by default, more than any rate difference
@@ -46,6 +46,9 @@ class CycleOutcome(NamedTuple):
     """[rad/s]"""
     contact_steps: int
     """Control steps with torso-terrain contact."""
+    min_clearance: float = float("inf")
+    """Smallest torso footprint clearance of the cycle [m] (the env's
+    ``torso_footprint_clearance``; inf for an env without one)."""
     steps: int = 0
     """Control steps simulated (what the look-ahead spends of an env-step budget)."""
 
@@ -61,25 +64,56 @@ def play_cycle(env: gym.Env, gains: Gains) -> CycleOutcome:
     twin = copy.deepcopy(env)
     base = twin.unwrapped
     action = np.asarray(gains, dtype=twin.action_space.dtype)
+    clearance = getattr(base, "torso_footprint_clearance", lambda: float("inf"))
     pitch_sq = roll_sq = 0.0
     steps = contacts = 0
+    lowest = float("inf")
     while True:
         _, _, terminated, truncated, info = twin.step(action)
         pitch_sq += info["pitch_rate"] ** 2
         roll_sq += info["roll_rate"] ** 2
         contacts += bool(info["torso_contact"])
+        lowest = min(lowest, clearance())
         steps += 1
         if terminated or truncated or base.gains_due:
             break
     twin.close()
-    return CycleOutcome(
-        float(np.sqrt(pitch_sq / steps)), float(np.sqrt(roll_sq / steps)), contacts, steps
-    )
+    pitch, roll = float(np.sqrt(pitch_sq / steps)), float(np.sqrt(roll_sq / steps))
+    return CycleOutcome(pitch, roll, contacts, lowest, steps)
 
 
-def cycle_cost(outcome: CycleOutcome, contact_cost: float = 1.0) -> float:
-    """Pitch-rate RMS + roll-rate RMS [rad/s] + ``contact_cost`` per torso-contact step."""
-    return outcome.pitch_rate_rms + outcome.roll_rate_rms + contact_cost * outcome.contact_steps
+SCORED = 4
+"""The leading `CycleOutcome` fields a `CycleCost` reads."""
+
+
+@dataclass(frozen=True)
+class CycleCost:
+    """What the look-ahead minimises over one cycle [rad/s]: pitch-rate RMS + roll-rate RMS
+    + `contact` per torso-contact step + `clearance` per metre by which the torso's footprint
+    clearance fell below `margin` [m].
+
+    The clearance term (off by default) warns densely where contacts are rare: on training
+    block beds the paper's gains touched in 1 of 1242 cycles, while their footprint clearance
+    fell below 3 cm in 13 of 208 (10 beds); on 6 taller held-out beds every one of 928 contact
+    steps fell in a cycle whose footprint clearance dropped below 1 cm."""
+
+    contact: float = 1.0
+    clearance: float = 0.0
+    """[rad/s per m]"""
+    margin: float = 0.0
+    """[m]"""
+
+    def __call__(self, outcome: CycleOutcome) -> float:
+        return float(self.of_rows(np.asarray(outcome[:SCORED], dtype=np.float64)))
+
+    def of_rows(self, outcomes: np.ndarray) -> np.ndarray:
+        """Costs of outcome rows (..., 4): pitch-, roll-rate RMS, contact steps, clearance."""
+        o = outcomes
+        shortfall = np.maximum(0.0, self.margin - o[..., 3])
+        return o[..., 0] + o[..., 1] + self.contact * o[..., 2] + self.clearance * shortfall
+
+
+DEFAULT_COST = CycleCost()
 
 
 @dataclass(frozen=True)
@@ -97,7 +131,7 @@ class Lookahead:
     """The look-ahead choice (module docstring) over ``candidates`` (the first of equal cost)."""
 
     candidates: tuple[Gains, ...]
-    contact_cost: float = 1.0
+    cost: CycleCost = DEFAULT_COST
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "candidates", tuple(dict.fromkeys(self.candidates)))
@@ -109,7 +143,7 @@ class Lookahead:
         return [play_cycle(env, g) for g in self.candidates]
 
     def choose(self, outcomes: Sequence[CycleOutcome]) -> Gains:
-        costs = [cycle_cost(o, self.contact_cost) for o in outcomes]
+        costs = [self.cost(o) for o in outcomes]
         return self.candidates[costs.index(min(costs))]
 
     def __call__(self, env: gym.Env) -> Gains:

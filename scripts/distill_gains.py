@@ -32,6 +32,7 @@ from agents.gains_distill import (  # noqa: E402
     distill,
     held_out_rows,
 )
+from agents.gains_lookahead import CycleCost  # noqa: E402
 from agents.pipeline.artifacts import command_line, save_model_dir  # noqa: E402
 from agents.pipeline.train_config import load_train_config  # noqa: E402
 from agents.pipeline.training import env_spec  # noqa: E402
@@ -44,7 +45,7 @@ def collect(args: argparse.Namespace) -> None:
     parts = []
     n = len(seeds)
     with ProcessPoolExecutor(args.workers, mp_context=multiprocessing.get_context("spawn")) as pool:
-        jobs = pool.map(demonstrate, [spec] * n, seeds, [args.levels] * n, [args.contact_cost] * n)
+        jobs = pool.map(demonstrate, [spec] * n, seeds, [args.levels] * n, [_cost(args)] * n)
         for part in jobs:
             parts.append(part)
             steps = sum(p.env_steps for p in parts)
@@ -118,9 +119,13 @@ def curve(args: argparse.Namespace) -> None:
         )
 
 
+def _cost(args: argparse.Namespace) -> CycleCost:
+    return CycleCost(args.contact_cost, args.clearance_cost, args.clearance_margin)
+
+
 def _fit_settings(args: argparse.Namespace) -> dict:
     return {
-        "contact_cost": args.contact_cost,
+        "cost": _cost(args),
         "epochs": args.epochs,
         "learning_rate": args.learning_rate,
     }
@@ -130,21 +135,22 @@ def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     commands = parser.add_subparsers(dest="command", required=True)
     c = commands.add_parser("collect", help="the look-ahead's demonstrations on training beds")
-    c.add_argument("--config", type=Path, required=True, help="training config (gains mode)")
-    c.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-    c.add_argument("--episodes", type=int, default=60)
-    c.add_argument("--first-seed", type=int, default=0)
-    c.add_argument("--levels", type=float, nargs="+", default=[0.2, 0.5, 0.8])
-    c.add_argument("--contact-cost", type=float, default=1.0)
-    c.add_argument("--workers", type=int, default=1, help="processes (one core each)")
-    c.add_argument("--out", type=Path, required=True)
     f = commands.add_parser("fit", help="fit the config's actor to demonstrations")
     r = commands.add_parser("curve", help="held-out cost against the number of training beds")
-    for p in (f, r):
-        p.add_argument("--config", type=Path, required=True, help="training config (gains, hybrid)")
+    for p in (c, f, r):
+        p.add_argument("--config", type=Path, required=True, help="training config (gains mode)")
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
+        # the cycle cost (agents.gains_lookahead.CycleCost) the teacher or the student minimises
+        p.add_argument("--contact-cost", type=float, default=1.0, help="rad/s per contact step")
+        p.add_argument("--clearance-cost", type=float, default=0.0, help="rad/s per m short")
+        p.add_argument("--clearance-margin", type=float, default=0.0, help="footprint clearance, m")
+    c.add_argument("--episodes", type=int, default=56)
+    c.add_argument("--first-seed", type=int, default=0)
+    c.add_argument("--levels", type=float, nargs="+", default=[0.2, 0.5, 0.8])
+    c.add_argument("--workers", type=int, default=1, help="processes (one core each)")
+    c.add_argument("--out", type=Path, required=True)
+    for p in (f, r):
         p.add_argument("--demos", type=Path, required=True)
-        p.add_argument("--contact-cost", type=float, default=1.0)
         p.add_argument("--epochs", type=int, default=300)
         p.add_argument("--learning-rate", type=float, default=1e-3)
         p.add_argument(

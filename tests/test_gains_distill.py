@@ -16,7 +16,7 @@ from agents.gains_distill import (
     interpolated_cost,
     lattice_costs,
 )
-from agents.gains_lookahead import gain_grid
+from agents.gains_lookahead import CycleCost, gain_grid
 from agents.pipeline.envs import EnvSpec
 
 CONFIG = "configs/irregular_terrain_gains_blocks_scan.yaml"
@@ -51,7 +51,8 @@ def _synthetic(n: int = 400, seed: int = 0) -> Demonstrations:
     obs = rng.normal(size=(n, 4)).astype(np.float32)
     best_kz = np.where(obs[:, :1] < 0, 0.2, 0.8)
     pitch = np.abs(candidates[None, :, 0] - best_kz) + 0.01 * rng.uniform(size=(n, len(candidates)))
-    outcomes = np.stack([pitch, np.full_like(pitch, 0.1), np.zeros_like(pitch)], axis=-1)
+    zero, inf = np.zeros_like(pitch), np.full_like(pitch, np.inf)
+    outcomes = np.stack([pitch, np.full_like(pitch, 0.1), zero, inf], axis=-1)
     reference = np.array([0.6, 0.4, 0.4])
     return Demonstrations(obs, outcomes, candidates, levels, reference, np.arange(n) // 20, n * 50)
 
@@ -106,10 +107,11 @@ def test_demonstrations_record_every_candidate_and_the_teachers_budget(tmp_path)
         n,
         gym.make(spec.id, **spec.kwargs).observation_space.shape[0],
     )
-    assert demos.outcomes.shape == (n, 9, 3) and np.all(demos.outcomes[..., :2] > 0)
+    assert demos.outcomes.shape == (n, 9, 4) and np.all(demos.outcomes[..., :2] > 0)
+    assert np.all((demos.outcomes[..., 3] > 0.0) & (demos.outcomes[..., 3] < 0.1))  # clearance [m]
     # every candidate is played for a whole cycle on top of the episode's 90 steps
     assert demos.env_steps > 90 + 9 * 20 * n
-    assert lattice_costs(demos).shape == (n, 2, 2, 2)
+    assert lattice_costs(demos, CycleCost()).shape == (n, 2, 2, 2)
     demos.save(tmp_path / "d.npz")
     back = Demonstrations.load(tmp_path / "d.npz")
     np.testing.assert_array_equal(back.outcomes, demos.outcomes)

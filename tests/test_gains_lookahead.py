@@ -10,10 +10,11 @@ from test_athena_posture_study import _script
 import hexapod_envs  # noqa: F401
 from agents.athena_policy import PAPER_GAINS
 from agents.gains_lookahead import (
+    CycleCost,
+    CycleOutcome,
     Fixed,
     Lookahead,
     beats,
-    cycle_cost,
     gain_grid,
     play_cycle,
     run_episode,
@@ -55,9 +56,25 @@ def test_play_cycle_leaves_the_env_as_it_was():
             e.step(action)
     outcome = play_cycle(env, (0.2, 0.2, 0.2))
     assert outcome.contact_steps >= 0 and outcome.pitch_rate_rms > 0.0
+    # the torso stays a few cm above the blocks, below its standing clearance of 7 cm
+    assert 0.0 < outcome.min_clearance < env.unwrapped.torso_footprint_clearance() + 0.03
+    assert outcome.steps > 20
     for _ in range(30):
         a, b = env.step(action), other.step(action)
         np.testing.assert_array_equal(a[0], b[0])
+
+
+def test_cycle_cost_terms():
+    outcome = CycleOutcome(0.1, 0.2, 1, 0.01, steps=50)
+    assert CycleCost()(outcome) == pytest.approx(1.3)
+    assert CycleCost(contact=2.0)(outcome) == pytest.approx(2.3)
+    # 2 cm short of a 3 cm margin at 5 rad/s per m
+    assert CycleCost(clearance=5.0, margin=0.03)(outcome) == pytest.approx(1.4)
+    assert CycleCost(clearance=5.0, margin=0.03)(
+        outcome._replace(min_clearance=0.05)
+    ) == pytest.approx(1.3)
+    rows = np.array([outcome[:4], outcome._replace(contact_steps=0)[:4]])
+    np.testing.assert_allclose(CycleCost(clearance=5.0, margin=0.03).of_rows(rows), [1.4, 0.4])
 
 
 def test_lookahead_applies_the_cheapest_cycle():
@@ -65,10 +82,10 @@ def test_lookahead_applies_the_cheapest_cycle():
     env.reset(seed=1)
     candidates = [*gain_grid([0.2, 0.8]), PAPER]
     choice = Lookahead(tuple(candidates))(env)
-    costs = {g: cycle_cost(play_cycle(env, g)) for g in candidates}
+    costs = {g: CycleCost()(play_cycle(env, g)) for g in candidates}
     assert costs[choice] == min(costs.values())
     # A huge contact cost makes the contact steps decide first.
-    strict = Lookahead(tuple(candidates), contact_cost=1e6)(env)
+    strict = Lookahead(tuple(candidates), CycleCost(contact=1e6))(env)
     assert play_cycle(env, strict).contact_steps == min(
         play_cycle(env, g).contact_steps for g in candidates
     )

@@ -259,6 +259,28 @@ def test_terrain_scan_is_the_torso_height_above_the_terrain_around_it(terrain):
         gym.make(ENV_ID, terrain_scan="yes")
 
 
+@pytest.mark.parametrize("terrain", TERRAINS)
+def test_footprint_clearance_is_the_lowest_point_of_the_torso_bottom_above_the_terrain(terrain):
+    env = gym.make(ENV_ID, terrain=terrain)
+    env.reset(seed=5)
+    base = env.unwrapped
+    half = np.asarray(base.robot.body.size) / 2
+    gaps = []
+    for _ in range(60):
+        env.step(np.zeros(env.action_space.shape))
+        footprint = base.torso_footprint_clearance()
+        # the grid holds the centre of the bottom face: never above the centre clearance
+        gaps.append(base.torso_clearance() - footprint)
+        assert gaps[-1] >= -1e-12
+        if terrain == "flat":  # the lowest corner of a (slightly tilted) box over z = 0
+            pos = base.data.xpos[base.sensors.torso_id]
+            rot = base.data.xmat[base.sensors.torso_id].reshape(3, 3)
+            corners = [rot @ (half * (sx, sy, -1.0)) for sx in (-1, 1) for sy in (-1, 1)]
+            assert footprint == pytest.approx(pos[2] + min(c[2] for c in corners), abs=1e-12)
+    if terrain == "blocks":  # blocks under an edge: well below the centre clearance at times
+        assert max(gaps) > 0.005
+
+
 def test_torso_contact_is_detected_and_penalised():
     """Legs folded up in joint mode: the torso drops onto the ground."""
     env = gym.make(ENV_ID, terrain="flat", action_mode="joint", collision_penalty=2.0)
