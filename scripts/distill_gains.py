@@ -1,4 +1,4 @@
-"""Teach a gains policy with the one-cycle look-ahead (`agents.gains_distill`).
+"""Teach a gains policy with the one-cycle look-ahead (`agents.pipeline.gains_distill`).
 
 Two steps, so that the expensive one runs once:
 
@@ -26,14 +26,14 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import numpy as np  # noqa: E402
 
-from agents.gains_distill import (  # noqa: E402
+from agents.gains_lookahead import CycleCost  # noqa: E402
+from agents.pipeline.artifacts import command_line, save_model_dir  # noqa: E402
+from agents.pipeline.gains_distill import (  # noqa: E402
     Demonstrations,
     demonstrate,
     distill,
     held_out_rows,
 )
-from agents.gains_lookahead import CycleCost  # noqa: E402
-from agents.pipeline.artifacts import command_line, save_model_dir  # noqa: E402
 from agents.pipeline.train_config import load_train_config  # noqa: E402
 from agents.pipeline.training import env_spec  # noqa: E402
 

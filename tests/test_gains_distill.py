@@ -1,4 +1,4 @@
-"""Teaching a gains policy with the look-ahead (agents/gains_distill, scripts/distill_gains)."""
+"""Teaching a gains policy with the look-ahead (agents.pipeline.gains_distill, its script)."""
 
 from __future__ import annotations
 
@@ -9,15 +9,15 @@ import torch
 from test_athena_posture_study import _script
 
 import hexapod_envs  # noqa: F401
-from agents.gains_distill import (
+from agents.gains_lookahead import CycleCost, gain_grid
+from agents.pipeline.envs import EnvSpec
+from agents.pipeline.gains_distill import (
     Demonstrations,
     demonstrate,
     fit_actor,
     interpolated_cost,
     lattice_costs,
 )
-from agents.gains_lookahead import CycleCost, gain_grid
-from agents.pipeline.envs import EnvSpec
 
 CONFIG = "configs/irregular_terrain_gains_blocks_scan.yaml"
 

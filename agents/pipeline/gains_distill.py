@@ -31,8 +31,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .athena_policy import analytical_policy
-from .gains_lookahead import (
+from ..athena_policy import analytical_policy
+from ..gains_lookahead import (
     DEFAULT_COST,
     SCORED,
     CycleCost,
@@ -40,7 +40,7 @@ from .gains_lookahead import (
     Lookahead,
     gain_grid,
 )
-from .pipeline.envs import EnvSpec
+from .envs import EnvSpec
 
 
 @dataclass
@@ -306,8 +306,8 @@ def distill(config, demos: Demonstrations, validation: np.ndarray, **fit_kwargs)
     `config` (`agents.pipeline.train_config.TrainConfig`, gains mode, plain hybrid residual)
     whose observation statistics are those of the training rows and whose actor is fitted by
     `fit_actor` (``fit_kwargs``)."""
-    from .pipeline.model_files import NormalizationStats
-    from .pipeline.training import untrained_model
+    from .model_files import NormalizationStats
+    from .training import untrained_model
 
     hybrid = config.hybrid
     if hybrid is None or hybrid.mode != "residual" or hybrid.safety_filter:
