@@ -19,7 +19,8 @@ it observes):
    ``train.py --resume`` can fine-tune it with PPO.
 
 Every simulated control step counts, the teacher's plays included (`Demonstrations.env_steps`),
-so the budget compares with a PPO run's env steps.
+so the budget compares with a PPO run's env steps. What it achieved on the blocks is in
+``scripts/distill_gains.py``'s docstring.
 """
 
 from __future__ import annotations
