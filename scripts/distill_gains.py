@@ -1,11 +1,12 @@
 """Teach a gains policy with the one-cycle look-ahead (`agents.pipeline.gains_distill`).
 
-Two steps, so that the expensive one runs once:
+Collect once (the expensive step), then fit:
 
     collect   the look-ahead walks training beds of the config's env (its task distribution,
               seeds --first-seed ...); writes the demonstrations (.npz)
     fit       fits the actor of the config's PPO model to them; writes a model directory that
-              evaluate.py's ppo:<dir> runs and train.py --resume can fine-tune
+              evaluate.py's ppo:<dir> runs
+    curve     the held-out cost of fits to growing subsets of the training beds
 
 Measured on the blocks (2026-11-24; CONFIG below; the look-ahead over the 3 x 3 x 3 lattice of
 0.2/0.5/0.8 and the paper's gains on 56 training beds, seeds 0-55: about 1240 cycles and 1.95 M

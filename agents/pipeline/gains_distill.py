@@ -11,12 +11,12 @@ it observes):
 
 1. `demonstrate`: the teacher walks training beds; at every cycle start the student's
    observation is stored with every candidate's outcome (pitch- and roll-rate RMS, contact
-   steps) and the teacher's choice is applied.
-2. `fit_actor`: the actor of an SB3 PPO model (the architecture of the run config, the hybrid
-   residual over the paper's gains) is fitted by weighted regression to the teacher's choices
-   (the gains offset from the paper's); the observation normalisation is the demonstrations'.
-   The result is an ordinary model directory: ``evaluate.py``'s ``ppo:<dir>`` runs it, and
-   ``train.py --resume`` can fine-tune it with PPO.
+   steps, torso footprint clearance) and the teacher's choice is applied.
+2. `distill` / `fit_actor`: the actor of an SB3 PPO model (the architecture of the run config,
+   the hybrid residual over the paper's gains) is fitted so that its gains minimise the
+   outcomes' `CycleCost`, interpolated over the lattice of candidate gains; the observation
+   normalisation is the demonstrations'. The result is an ordinary model directory:
+   ``evaluate.py``'s ``ppo:<dir>`` runs it like a trained gains agent.
 
 Every simulated control step counts, the teacher's plays included (`Demonstrations.env_steps`),
 so the budget compares with a PPO run's env steps. What it achieved on the blocks is in
@@ -120,7 +120,7 @@ def demonstrate(
     spec: EnvSpec, seed: int, levels: Sequence[float], cost: CycleCost = DEFAULT_COST
 ) -> Demonstrations:
     """One episode of `spec`'s env (the gains action mode) on the bed of ``seed``, the teacher
-    (`Lookahead` over the lattice ``levels``³ and the env's reference gains) choosing every
+    (`Lookahead` over the lattice ``levels``³ and the analytical gains) choosing every
     cycle; returns its rows. The env is built without `spec`'s learner wrappers (hybrid,
     per-cycle decisions, reward terms), which do not change the observation."""
     env = dataclasses.replace(

@@ -164,7 +164,7 @@ def new_model(config: TrainConfig, venv: Any) -> Any:
 
 def untrained_model(config: TrainConfig) -> Any:
     """`new_model` on the config's training vec env (VecNormalize on top when configured), for
-    models fitted outside PPO (e.g. `gains_distill`) that PPO can then fine-tune."""
+    models fitted outside PPO's own loop (`gains_distill`)."""
     venv, eval_env = _vec_envs(config, config.train.seed)
     if eval_env is not None:
         eval_env.close()
