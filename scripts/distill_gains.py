@@ -13,8 +13,8 @@ Measured on the blocks (2026-11-24; CONFIG below; the look-ahead over the 3 x 3 
 env steps including the teacher's plays, 18 min on 2 cores; the last 11 beds held out):
 - Mean cycle cost on the held-out beds: the paper's gains 0.1670, the best fixed lattice setting
   0.1646, the student 0.1641, the teacher 0.1423. `curve`: 0.1647, 0.1645 and 0.1646 from 11,
-  22 and 45 training beds. More demonstrations do not help: what the teacher exploits is not in
-  the observation, the terrain scan included.
+  22 and 45 training beds. More demonstrations do not help: the student does not learn the
+  teacher's per-cycle advantage from the observation, the terrain scan included.
 - On the 20 test beds of configs/evaluate_gains_blocks.yaml (the paper's gains: pitch- and
   roll-rate medians 0.11276 / 0.12618 rad/s, 2552 torso-contact steps, 6/20 successes): the
   student 0.11981 / 0.12506, 1915 contact steps, 6/20.
