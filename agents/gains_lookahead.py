@@ -33,8 +33,9 @@ import gymnasium as gym
 import numpy as np
 
 Gains = tuple[float, float, float]
-Chooser = Callable[[gym.Env], Gains]
-"""Returns the gains for the cycle about to start in the given env."""
+Chooser = Callable[[gym.Env, np.ndarray], Gains]
+"""Returns the gains for the cycle about to start in the given env (its last observation
+given)."""
 
 
 class CycleOutcome(NamedTuple):
@@ -122,7 +123,7 @@ class Fixed:
 
     gains: Gains
 
-    def __call__(self, env: gym.Env) -> Gains:
+    def __call__(self, env: gym.Env, observation: np.ndarray | None = None) -> Gains:
         return self.gains
 
 
@@ -146,24 +147,27 @@ class Lookahead:
         costs = [self.cost(o) for o in outcomes]
         return self.candidates[costs.index(min(costs))]
 
-    def __call__(self, env: gym.Env) -> Gains:
+    def __call__(self, env: gym.Env, observation: np.ndarray | None = None) -> Gains:
         return self.choose(self.outcomes(env))
 
 
 def run_episode(env: gym.Env, seed: int, choose: Chooser) -> dict:
     """One episode in the "gains" action mode, ``choose`` asked at every cycle start.
 
-    Returns the per-cycle pitch- and roll-rate RMS lists, torso-contact steps and success."""
+    Returns the per-cycle pitch- and roll-rate RMS lists, torso-contact steps, success and the
+    episode's control steps."""
     base = env.unwrapped
     if getattr(base, "action_mode", None) != "gains":
         raise ValueError("run_episode needs HexapodIrregularTerrain-v0 with action_mode='gains'")
-    env.reset(seed=seed)
+    observation, _ = env.reset(seed=seed)
     pitch, roll = [], []
     action = np.asarray(base.reference_gains, dtype=env.action_space.dtype)
+    steps = 0
     while True:
         if base.gains_due:
-            action = np.asarray(choose(env), dtype=env.action_space.dtype)
-        _, _, terminated, truncated, info = env.step(action)
+            action = np.asarray(choose(env, observation), dtype=env.action_space.dtype)
+        observation, _, terminated, truncated, info = env.step(action)
+        steps += 1
         stats = info["cycle_stats"]
         if stats is not None:
             pitch.append(stats["pitch_rate_rms"])
@@ -175,6 +179,7 @@ def run_episode(env: gym.Env, seed: int, choose: Chooser) -> dict:
         "roll_rate_rms": roll,
         "contact_steps": int(info["torso_collisions"]),
         "success": bool(info["is_success"]),
+        "steps": steps,
     }
 
 

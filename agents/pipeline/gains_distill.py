@@ -40,6 +40,7 @@ from ..gains_lookahead import (
     CycleOutcome,
     Lookahead,
     gain_grid,
+    run_episode,
 )
 from .envs import EnvSpec
 
@@ -96,15 +97,7 @@ class Demonstrations:
         )
 
     def save(self, path: str | Path) -> None:
-        np.savez_compressed(
-            path,
-            env_steps=self.env_steps,
-            **{
-                f.name: getattr(self, f.name)
-                for f in dataclasses.fields(self)
-                if f.name != "env_steps"
-            },
-        )
+        np.savez_compressed(path, **vars(self))
 
     @classmethod
     def load(cls, path: str | Path) -> Demonstrations:
@@ -113,7 +106,8 @@ class Demonstrations:
             missing = [n for n in names if n not in data]
             if missing:
                 raise ValueError(f"{path} is not a demonstrations file (no {', '.join(missing)})")
-            return cls(**{n: data[n] for n in names[:-1]}, env_steps=int(data["env_steps"]))
+            fields = {n: data[n] for n in names}
+        return cls(**{**fields, "env_steps": int(fields["env_steps"])})
 
 
 def demonstrate(
@@ -126,36 +120,43 @@ def demonstrate(
     env = dataclasses.replace(
         spec, hybrid=None, reward_exclude=[], decision="step", cycle_baseline="none"
     ).make()
-    base = env.unwrapped
-    if getattr(base, "action_mode", None) != "gains":
+    try:
+        recorder = _Recorder(levels, cost)
+        episode = run_episode(env, seed, recorder)
+    finally:
         env.close()
-        raise ValueError(f"demonstrations need action_mode='gains', got {spec.kwargs}")
-    observation, _ = env.reset(seed=seed)
-    reference = analytical_policy(env).gains  # the terrain's, known once it is built
-    teacher = Lookahead((*gain_grid(levels), reference), cost)
-    action = np.asarray(reference, dtype=env.action_space.dtype)
-    observations, outcomes, env_steps = [], [], 0
-    while True:
-        if base.gains_due:
-            played: list[CycleOutcome] = teacher.outcomes(env)
-            observations.append(np.array(observation, dtype=np.float32))
-            outcomes.append([o[:SCORED] for o in played])
-            env_steps += sum(o.steps for o in played)
-            action = np.asarray(teacher.choose(played), dtype=env.action_space.dtype)
-        observation, _, terminated, truncated, _ = env.step(action)
-        env_steps += 1
-        if terminated or truncated:
-            break
-    env.close()
+    n = len(recorder.observations)
     return Demonstrations(
-        np.asarray(observations, dtype=np.float32).reshape(len(observations), -1),
-        np.asarray(outcomes, dtype=np.float64).reshape(len(observations), -1, SCORED),
-        np.asarray(teacher.candidates, dtype=np.float64),
+        np.asarray(recorder.observations, dtype=np.float32).reshape(n, -1),
+        np.asarray(recorder.outcomes, dtype=np.float64).reshape(n, -1, SCORED),
+        np.asarray(recorder.teacher.candidates, dtype=np.float64),
         np.asarray(levels, dtype=np.float64),
-        np.asarray(reference, dtype=np.float64),
-        np.full(len(observations), seed, dtype=np.int64),
-        env_steps,
+        np.asarray(recorder.reference, dtype=np.float64),
+        np.full(n, seed, dtype=np.int64),
+        episode["steps"] + recorder.teacher_steps,
     )
+
+
+class _Recorder:
+    """A `run_episode` chooser: the look-ahead's choice, with what it saw and measured kept."""
+
+    def __init__(self, levels: Sequence[float], cost: CycleCost):
+        self.levels, self.cost = levels, cost
+        self.teacher: Lookahead | None = None
+        self.reference: tuple[float, float, float] | None = None
+        self.observations: list[np.ndarray] = []
+        self.outcomes: list[list[tuple]] = []
+        self.teacher_steps = 0
+
+    def __call__(self, env, observation: np.ndarray) -> tuple[float, float, float]:
+        if self.teacher is None:  # the terrain's analytical gains, known once it is built
+            self.reference = analytical_policy(env).gains
+            self.teacher = Lookahead((*gain_grid(self.levels), self.reference), self.cost)
+        played: list[CycleOutcome] = self.teacher.outcomes(env)
+        self.observations.append(np.array(observation, dtype=np.float32))
+        self.outcomes.append([o[:SCORED] for o in played])
+        self.teacher_steps += sum(o.steps for o in played)
+        return self.teacher.choose(played)
 
 
 def lattice_costs(demos: Demonstrations, cost: CycleCost) -> np.ndarray:
@@ -241,10 +242,10 @@ def fit_actor(
     lattice = torch.as_tensor(lattice_costs(demos, cost), device=device)
     ref = torch.as_tensor(np.asarray(demos.reference, dtype=np.float32), device=device)
     validation = np.asarray(validation, dtype=bool)
-    train_rows = np.flatnonzero(~validation)
-    val_rows = torch.as_tensor(np.flatnonzero(validation), device=device)
-    if len(train_rows) == 0 or len(val_rows) == 0:
+    train_rows, held_out = np.flatnonzero(~validation), np.flatnonzero(validation)
+    if len(train_rows) == 0 or len(held_out) == 0:
         raise ValueError("fit_actor needs both training and validation rows")
+    val_rows = torch.as_tensor(held_out, device=device)
 
     lo, hi = float(levels[0]), float(levels[-1])
 
@@ -265,9 +266,8 @@ def fit_actor(
 
     costs = demos.costs(cost)
     ref_index = int(np.argmin(np.abs(demos.candidates - demos.reference).sum(axis=1)))
-    flat = lattice.reshape(len(lattice), -1).cpu().numpy()
-    best_constant = int(flat[train_rows].mean(axis=0).argmin())
-    vr = val_rows.cpu().numpy()
+    on_lattice = costs[:, : len(levels) ** 3]
+    best_constant = int(on_lattice[train_rows].mean(axis=0).argmin())
     actor = [*policy.mlp_extractor.policy_net.parameters(), *policy.action_net.parameters()]
     optimizer = torch.optim.Adam(actor, lr=learning_rate)
     generator = np.random.default_rng(seed)
@@ -289,9 +289,9 @@ def fit_actor(
     return FitResult(
         history,
         best_epoch,
-        reference_cost=float(costs[vr, ref_index].mean()),
-        teacher_cost=float(costs[vr].min(axis=1).mean()),
-        best_constant_cost=float(flat[vr, best_constant].mean()),
+        reference_cost=float(costs[held_out, ref_index].mean()),
+        teacher_cost=float(costs[held_out].min(axis=1).mean()),
+        best_constant_cost=float(on_lattice[held_out, best_constant].mean()),
     )
 
 

@@ -638,9 +638,11 @@ class IrregularTerrainEnv(HexapodEnv):
         pos = self.data.xpos[self.sensors.torso_id]
         rot = self.data.xmat[self.sensors.torso_id].reshape(3, 3)
         points = pos[:, None] + rot @ self._footprint
-        if self.terrain_info is None:
-            return float(points[2].min())
-        return float(np.min(points[2] - self.terrain_info.surface_height(points[0], points[1])))
+        return float(np.min(points[2] - self._ground(points[0], points[1])))
+
+    def _ground(self, x: np.ndarray, y: np.ndarray) -> np.ndarray | float:
+        """True terrain height [m] at world points (0 on flat ground, which has no model)."""
+        return 0.0 if self.terrain_info is None else self.terrain_info.surface_height(x, y)
 
     # --- gait clock and per-cycle statistics ----------------------------------------------
     def _gait_cycle_index(self) -> int:
@@ -734,9 +736,7 @@ class IrregularTerrainEnv(HexapodEnv):
         heading = math.atan2(float(rot[1, 0]), float(rot[0, 0]))
         c, s = math.cos(heading), math.sin(heading)
         ahead, left = self._scan_offsets
-        px, py = x + c * ahead - s * left, y + s * ahead + c * left
-        ground = 0.0 if self.terrain_info is None else self.terrain_info.surface_height(px, py)
-        return z - ground
+        return z - self._ground(x + c * ahead - s * left, y + s * ahead + c * left)
 
     def step_cost_bound(self) -> float:
         """The largest cost one step can carry (the bounded negative parts of every term but
