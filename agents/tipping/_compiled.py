@@ -261,21 +261,8 @@ def body_feet_and_cog(joints, hips, l1, consts, hip_sums):
     HeavyDutyBodyModel.feet_and_cog, which packs ``consts``: k_x, k_z, L2, the moving links'
     mass, the mass weighting the hip distance, the carriage's fixed mass moment, shank mass and
     centre, foot mass and centre, leg mass, total mass)."""
-    k_x, k_z, l2, m_moving, y_mass, z_fixed = (
-        consts[0],
-        consts[1],
-        consts[2],
-        consts[3],
-        consts[4],
-        consts[5],
-    )
-    m_shank, shank_up, m_foot, foot_up, m_leg, total = (
-        consts[6],
-        consts[7],
-        consts[8],
-        consts[9],
-        consts[10],
-        consts[11],
+    k_x, k_z, l2, m_moving, y_mass, z_fixed, m_shank, shank_up, m_foot, foot_up, m_leg, total = (
+        consts
     )
     feet = np.empty((6, 3))
     sum_x = sum_y = sum_z = 0.0
