@@ -309,7 +309,7 @@ class IrregularTerrainEnv(HexapodEnv):
         "torso_clearance": {
             "reduce": "min",
             "better": "higher",
-            "description": "smallest true torso clearance [m]",
+            "description": "smallest true clearance below the torso centre [m]",
         },
         "cycle_height_rms": {
             "reduce": "episode",
