@@ -42,3 +42,23 @@ def test_sweep_speed_rows_have_expected_keys_and_finite_numbers():
         assert r["substeps"] == 15 and math.isclose(r["physics_dt"], 0.05 / 15)
         assert math.isclose(r["sim_s"], 0.2)
         assert r["unstable"] == 0
+
+
+def test_athena_fidelity_includes_the_servo_dependent_reproduction_rows():
+    # The ramp walk alone let a 10 ms timestep through that sags the simple controller 8.6 mm
+    # more; the posture-study rows (quick: 2 ramp seeds, 4 block beds, 400 steps) are there
+    # for that. The block rows carry a bootstrap interval and are judged by it.
+    from benchmarks.physics_settings import DEFAULT, athena_fidelity
+
+    rows = athena_fidelity(DEFAULT, quick=True)
+    (sag,) = [f for f in rows if f.name.startswith("ramp, simple control")]
+    assert 0.03 < sag.value < 0.12  # metres: ATHENA stands about 0.1 m high and sags on the ramp
+    changes = [f for f in rows if "rate change" in f.name]
+    assert len(changes) == 2
+    for f in changes:
+        estimate, low, high = f.value
+        assert low <= estimate <= high and math.isfinite(high - low)
+        assert f.compare(f.value, f.value)
+        assert not f.compare((high + 1.0, low, high), f.value)
+    (touched,) = [f for f in rows if "torso contact" in f.name]
+    assert touched.value in range(5)
