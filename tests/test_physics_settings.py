@@ -46,7 +46,7 @@ def test_sweep_speed_rows_have_expected_keys_and_finite_numbers():
 
 def test_athena_fidelity_includes_the_servo_dependent_reproduction_rows():
     # The ramp walk alone let a 10 ms timestep through that sags the simple controller 8.6 mm
-    # more; the posture-study rows (quick: 2 ramp seeds, 4 block beds, 400 steps) are there
+    # more; the posture-study rows (quick: ramp seed 0, 4 block beds of 400 steps) are there
     # for that. The block rows carry a bootstrap interval and are judged by it.
     from benchmarks.physics_settings import DEFAULT, athena_fidelity
 
