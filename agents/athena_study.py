@@ -131,17 +131,15 @@ def percent_change(before: float, after: float) -> float | None:
     return None if before == 0 else 100.0 * (after / before - 1.0)
 
 
-def change_interval(
-    result: dict, metric: str, confidence: float = 0.95, n_resamples: int = 2000
-) -> tuple[float, float, float]:
+def change_interval(result: dict, metric: str) -> tuple[float, float, float]:
     """The posture-vs-simple change of `metric`'s pooled median (%) in a `compare` result, with
-    its percentile-bootstrap interval over the beds (seeds; both controllers resampled
+    its 95 % percentile-bootstrap interval over the beds (seeds; both controllers resampled
     together, since they walked the same beds): (estimate, low, high).
 
     Why: on the block bed the pooled medians of a few beds swing widely from bed to bed (the
     simple controller's torso rests on some blocks, which stills its rates), so a change
     measured on 4 beds says little without its spread."""
-    from scipy.stats import bootstrap
+    from agents.pipeline.summary import bootstrap_interval
 
     simple = [r.per_cycle(metric) for r in result["simple"]]
     posture = [r.per_cycle(metric) for r in result["posture"]]
@@ -151,17 +149,7 @@ def change_interval(
         after = np.median(np.concatenate([posture[i] for i in beds]))
         return 100.0 * (after / before - 1.0)
 
-    beds = np.arange(len(simple))
-    ci = bootstrap(
-        (beds,),
-        change,
-        vectorized=False,
-        n_resamples=n_resamples,
-        confidence_level=confidence,
-        method="percentile",
-        rng=np.random.default_rng(0),
-    ).confidence_interval
-    return float(change(beds)), float(ci.low), float(ci.high)
+    return (float(change(np.arange(len(simple)))), *bootstrap_interval(change, len(simple)))
 
 
 def compare(terrain: str, seeds, gains=None, steps: int | None = None, **env_kwargs) -> dict:

@@ -14,7 +14,7 @@ from agents.pipeline.episode import EpisodeAccumulator, MetricSpec, metric_specs
 from agents.pipeline.errors import ConfigError, UserError
 from agents.pipeline.eval_config import EvaluationSuite, load_suite
 from agents.pipeline.schedules import Schedule, parse_schedule
-from agents.pipeline.summary import aggregate, compare
+from agents.pipeline.summary import aggregate, compare, paired_difference_interval
 from agents.pipeline.train_config import TrainConfig, load_train_config
 from agents.registry import analytical_factory, analytical_policy
 
@@ -264,6 +264,35 @@ def test_verdicts_use_each_metrics_direction():
     assert verdicts["fasm_min_deg"] == "better" and verdicts["success"] == "better"
     assert verdicts["tipped_over"] == "better" and verdicts["rms"] == "worse"
     assert verdicts["episode_return"] == "better"
+
+
+def test_paired_interval_is_exact_for_a_constant_difference_and_spans_zero_for_mixed_ones():
+    assert paired_difference_interval([3.0, 5.0, 9.0], [2.0, 4.0, 8.0], False) == pytest.approx(
+        (1.0, 1.0)
+    )
+    low, high = paired_difference_interval([1.0, 0.0, 1.0, 0.0], [0.0, 1.0, 0.0, 1.0], False)
+    assert low < 0.0 < high
+    # Unknown values drop their pair; one pair is too few for an interval.
+    assert paired_difference_interval([1.0, None], [0.0, 2.0], False) is None
+    # Pooled per-cycle lists: every episode's cycles shifted by 0.5 -> medians 0.5 apart always.
+    base = [[1.0, 2.0, 3.0], [2.0, 6.0], [4.0]]
+    shifted = [[x + 0.5 for x in cycles] for cycles in base]
+    assert paired_difference_interval(shifted, base, True) == pytest.approx((0.5, 0.5))
+
+
+def test_verdicts_carry_the_paired_interval_only_when_the_episodes_pair_up():
+    records = {
+        "ppo:x": _records([30.0, 32.0, 31.0], [True, True, True]),
+        "analytical": _records([20.0, 20.1, 35.0], [True, False, True]),
+    }
+    aggs = {name: aggregate(recs) for name, recs in records.items()}
+    verdicts = {v.metric: v for v in compare("ppo:x", "analytical", aggs, [], records)}
+    fasm = verdicts["fasm_min_deg"]  # differences +10, +11.9, -4: better on average, unresolved
+    assert fasm.outcome == "better" and fasm.interval[0] < 0.0 < fasm.interval[1]
+    assert not fasm.resolved and fasm.to_json()["resolved"] is False
+    unpaired = {**records, "analytical": records["analytical"][:2]}
+    aggs["analytical"] = aggregate(unpaired["analytical"])
+    assert all(v.interval is None for v in compare("ppo:x", "analytical", aggs, [], unpaired))
 
 
 # --- registry ------------------------------------------------------------------------------

@@ -267,13 +267,15 @@ def verdict_lines(result: EnvResult, aggs: dict[str, dict]) -> tuple[list[str], 
     a policy that tips over more often than its reference is said to, first."""
     lines: list[str] = []
     all_verdicts: list[Verdict] = []
+    # `aggs` is keyed by the policy names as given or as labelled (``{env_id}`` expanded).
+    episodes = {k: run.episodes for n, run in result.runs.items() for k in (n, result.label(n))}
     for reference in REFERENCES:
         if reference not in aggs:
             continue
         for name in aggs:
             if name == reference or (reference == "zero" and name == "analytical"):
                 continue  # analytical vs zero is already said (as zero vs analytical)
-            verdicts = compare(name, reference, aggs, result.specs)
+            verdicts = compare(name, reference, aggs, result.specs, episodes)
             all_verdicts += verdicts
             lines.append(_bullet(name, reference, aggs, verdicts))
     if not lines:
@@ -288,7 +290,11 @@ def _bullet(name: str, reference: str, aggs: dict[str, dict], verdicts: list[Ver
     def fmt(vs: list[Verdict]) -> str:
         return "; ".join(
             f"{v.label} {_num(v.challenger_value)} vs {_num(v.baseline_value)}"
-            + (" (within spread)" if v.within_spread else "")
+            + (
+                f" (not resolved: difference [{_num(v.interval[0])}, {_num(v.interval[1])}])"
+                if v.interval is not None and not v.resolved
+                else ""
+            )
             for v in vs
         )
 
@@ -335,6 +341,10 @@ HOW_TO_READ = [
     "power), so a policy whose episodes end early cannot look better on a total. Every policy is "
     "compared with the analytical controller (`analytical`) and with the env's reference motion "
     "(`zero`: the zero action, the paper's gait without feedback).",
+    "- **Not resolved** marks a difference whose 95 % paired-bootstrap interval includes 0: "
+    "every policy runs the same seeds, hence the same tasks, and the bootstrap resamples the "
+    "tasks with both policies' episodes together, so the interval shows how much of the "
+    "difference the draw of the tasks alone could make.",
 ]
 
 

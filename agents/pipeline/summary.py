@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import Any
 
@@ -36,6 +36,9 @@ STANDARD_METRICS: dict[str, tuple[str, str, str | None]] = {
 
 TIE_TOLERANCE = 0.01
 """Relative difference below which two policies count as equal on a metric (1 %)."""
+
+CONFIDENCE = 0.95
+"""Level of the verdicts' paired-bootstrap intervals (`paired_difference_interval`)."""
 
 
 def summarize(values: Iterable[Any]) -> dict[str, float] | None:
@@ -103,10 +106,74 @@ class Verdict:
     challenger_value: float
     baseline_value: float
     outcome: str  # "better", "worse" or "tie"
-    within_spread: bool
+    interval: tuple[float, float] | None = None
+    """`CONFIDENCE` interval of challenger - baseline over the paired episodes (None: unpaired
+    or fewer than 2 pairs)."""
+
+    @property
+    def resolved(self) -> bool:
+        """The difference's interval excludes 0 (unknown, i.e. False, without an interval)."""
+        return self.interval is not None and not self.interval[0] <= 0.0 <= self.interval[1]
 
     def to_json(self) -> dict[str, Any]:
-        return dict(self.__dict__)
+        return {**self.__dict__, "resolved": self.resolved}
+
+
+def paired_difference_interval(
+    challenger: list[Any], baseline: list[Any], pooled: bool, n_resamples: int = 2000
+) -> tuple[float, float] | None:
+    """Percentile-bootstrap interval (`CONFIDENCE`) of challenger - baseline over paired
+    episodes: the i-th episodes of both ran the same seed, hence the same task, and are resampled
+    together. The statistic is the verdicts' own: the difference of the means of per-episode
+    values, or with `pooled` of the medians of the episodes' pooled per-cycle lists. None with
+    fewer than 2 pairs (scalars: pairs where both values are known).
+
+    Why: the tasks of an evaluation differ (terrain, tilt rate, ...), and with 20 of them a
+    difference of a few per cent is often the draw of the tasks, not the policy."""
+    if pooled:
+        a = [np.asarray([x for x in v or [] if x is not None], float) for v in challenger]
+        b = [np.asarray([x for x in v or [] if x is not None], float) for v in baseline]
+
+        def diff(idx: np.ndarray) -> float:
+            pa, pb = np.concatenate([a[i] for i in idx]), np.concatenate([b[i] for i in idx])
+            return float(np.median(pa) - np.median(pb)) if pa.size and pb.size else math.nan
+
+        n = min(len(a), len(b))
+    else:
+        pairs = [
+            (float(x), float(y))
+            for x, y in zip(challenger, baseline, strict=False)
+            if x is not None and y is not None and not _is_nan(x) and not _is_nan(y)
+        ]
+        d = np.array([x - y for x, y in pairs])
+
+        def diff(idx: np.ndarray) -> float:
+            return float(d[idx].mean())
+
+        n = len(pairs)
+    if n < 2:
+        return None
+    low, high = bootstrap_interval(diff, n, n_resamples)
+    return None if math.isnan(low) or math.isnan(high) else (low, high)
+
+
+def bootstrap_interval(
+    statistic: Callable[[np.ndarray], float], n: int, n_resamples: int = 2000
+) -> tuple[float, float]:
+    """`CONFIDENCE` percentile-bootstrap interval of ``statistic(indices)`` over `n` units
+    (episodes, beds) resampled with replacement; seeded, so a report is reproducible."""
+    from scipy.stats import bootstrap
+
+    ci = bootstrap(
+        (np.arange(n),),
+        statistic,
+        vectorized=False,
+        n_resamples=n_resamples,
+        confidence_level=CONFIDENCE,
+        method="percentile",
+        rng=np.random.default_rng(0),
+    ).confidence_interval
+    return float(ci.low), float(ci.high)
 
 
 def _central(summary: dict[str, Any] | None, use_median: bool) -> float | None:
@@ -120,12 +187,14 @@ def compare(
     baseline: str,
     aggregates: dict[str, dict[str, Any]],
     specs: list[MetricSpec],
+    episodes: dict[str, list[EpisodeRecord]] | None = None,
 ) -> list[Verdict]:
     """Metric-by-metric verdicts of `challenger` against `baseline` (means; medians for pooled
-    per-cycle lists). Differences up to `TIE_TOLERANCE` of the larger magnitude are ties; a
-    difference smaller than the larger of the two standard deviations is flagged
-    ``within_spread``."""
+    per-cycle lists). Differences up to `TIE_TOLERANCE` of the larger magnitude are ties. With
+    `episodes` (per policy, in seed order, the same seeds for both) every verdict carries the
+    paired-bootstrap interval of the difference (`paired_difference_interval`)."""
     a, b = aggregates[challenger], aggregates[baseline]
+    paired = episodes is not None and len(episodes[challenger]) == len(episodes[baseline])
     rows: list[tuple[str, str, str, dict | None, dict | None, bool]] = []
     for key, (label, _, better) in STANDARD_METRICS.items():
         if better is not None:
@@ -148,8 +217,20 @@ def compare(
             outcome = "better"
         else:
             outcome = "worse"
-        spread = max(sa.get("std", 0.0), sb.get("std", 0.0))
+        interval = None
+        if paired:
+            values = {
+                name: [_episode_value(r, key) for r in episodes[name]]
+                for name in (challenger, baseline)
+            }
+            interval = paired_difference_interval(values[challenger], values[baseline], pooled)
         verdicts.append(
-            Verdict(key, label, better, challenger, baseline, va, vb, outcome, abs(diff) < spread)
+            Verdict(key, label, better, challenger, baseline, va, vb, outcome, interval)
         )
     return verdicts
+
+
+def _episode_value(record: EpisodeRecord, key: str) -> Any:
+    """A standard metric or an env-specific one of one episode (None if it has none)."""
+    scalars = record.scalar_metrics()
+    return scalars[key] if key in scalars else record.specifics.get(key)
