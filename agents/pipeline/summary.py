@@ -1,4 +1,5 @@
-"""Aggregates over episodes (mean ± std, median, min/max) and policy-vs-policy verdicts.
+"""Aggregates over episodes (mean ± std, median, min/max) and policy-vs-policy verdicts with
+paired-bootstrap intervals of their differences.
 
 Verdicts compare like with like: rates per episode (success, tip-over), per-episode extremes
 (min FASM), and time-integrated quantities only per second of episode (share of time below ξ,
