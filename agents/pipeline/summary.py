@@ -195,7 +195,12 @@ def compare(
     `episodes` (per policy, in seed order, the same seeds for both) every verdict carries the
     paired-bootstrap interval of the difference (`paired_difference_interval`)."""
     a, b = aggregates[challenger], aggregates[baseline]
-    paired = episodes is not None and len(episodes[challenger]) == len(episodes[baseline])
+    per_episode = None  # name -> every episode's metrics (standard ones over specifics)
+    if episodes is not None and len(episodes[challenger]) == len(episodes[baseline]):
+        per_episode = {
+            name: [{**r.specifics, **r.scalar_metrics()} for r in episodes[name]]
+            for name in (challenger, baseline)
+        }
     rows: list[tuple[str, str, str, dict | None, dict | None, bool]] = []
     for key, (label, _, better) in STANDARD_METRICS.items():
         if better is not None:
@@ -219,19 +224,13 @@ def compare(
         else:
             outcome = "worse"
         interval = None
-        if paired:
-            values = {
-                name: [_episode_value(r, key) for r in episodes[name]]
-                for name in (challenger, baseline)
-            }
-            interval = paired_difference_interval(values[challenger], values[baseline], pooled)
+        if per_episode is not None:
+            interval = paired_difference_interval(
+                [m.get(key) for m in per_episode[challenger]],
+                [m.get(key) for m in per_episode[baseline]],
+                pooled,
+            )
         verdicts.append(
             Verdict(key, label, better, challenger, baseline, va, vb, outcome, interval)
         )
     return verdicts
-
-
-def _episode_value(record: EpisodeRecord, key: str) -> Any:
-    """A standard metric or an env-specific one of one episode (None if it has none)."""
-    scalars = record.scalar_metrics()
-    return scalars[key] if key in scalars else record.specifics.get(key)
