@@ -206,7 +206,7 @@ def athena_rows(
     env_defaults = IrregularTerrainSettings()
     default = (
         f"default env (servo_kp {env_defaults.servo_kp:g} N m/rad, "
-        f"{env_defaults.block_size[0]:g} m blocks)"
+        f"{env_defaults.block_size[0]:g} m blocks, {env_defaults.physics_dt * 1e3:g} ms step)"
     )
     settings = {t: f"HexapodIrregularTerrain-v0 {kwargs[t] or default}, {protocol}" for t in kwargs}
     bs, bp = blocks["summary"]["simple"], blocks["summary"]["posture"]
@@ -511,6 +511,9 @@ ATHENA_PREVIOUS_DEFAULT = {"servo_kp": 8.0}
 ATHENA_PREVIOUS_BLOCKS = {"block_size": (0.1, 0.1)}
 """The ATHENA env defaults before the calibration of 2026-11-24 (rows with these suffixes).
 
+The calibration below was measured at the 2 ms physics step, the default until 2026-11-25 (now
+2.5 ms; the rows of the report are measured at the current default).
+
 Servo stiffness. The env default, 6.8 N m/rad, is the stiffness at which the simple controller's
 median ramp torso height is the paper's 0.068 m (measured 0.0681 m over seeds 0-3; kp 8: 0.089 m,
 kp 6: 0.049 m). With it the ramp height gain is +48 % (kp 8: +14 %) but the ramp roll-rate RMS
@@ -533,8 +536,9 @@ Larger blocks leave fewer edges for the torso to meet, but posture control keeps
 about 3 of 8 episodes; 0.25 m is the smallest size at that level and the one whose rate changes
 are nearest the paper's. With kp 8, 0.25 m blocks give 4 of 8 and rate changes of -42 % / -50 %.
 The rate changes of this table are from 8 beds: on 20 beds of the 0.25 m default they are
-+13.8 % / -10.8 % with 95 % intervals spanning 0 (`athena_block_beds_rows`), so the table ranks
-the sizes by their contacts, not by their rate changes.
++13.8 % / -10.8 % at 2 ms and -8.0 % / -21.7 % at 2.5 ms, with 95 % intervals spanning 0
+(`athena_block_beds_rows`), so the table ranks the sizes by their contacts, not by their rate
+changes.
 """
 
 
@@ -803,23 +807,25 @@ NOTES = (
     "what holds the robot up in our model. With the platform stopping at 25 deg the side cases "
     "stay at lambda 0.5 throughout. The cone's base is centred on the support polygon's "
     "centroid, which lies far from below the CoG once a rear or side leg has landed.",
-    "9 (ramp roll rate, +1.9 % vs -36 %): with the servo model calibrated to the paper's simple-"
-    "control sag (env default servo_kp 6.8 N m/rad; 0.0681 m vs 0.068 m, row 11d) the simple "
+    "9 (ramp roll rate, +5.5 % vs -36 %): with the servo model calibrated to the paper's simple-"
+    "control sag (env default servo_kp 6.8 N m/rad; 0.0676 m vs 0.068 m, row 11d) the simple "
     "control drags its torso on the slope, which damps its roll, and posture control's roll-rate "
-    "RMS ends 2 % above it. With the previous default (kp 8, rows @servo_kp=8.0) rows 9 and 10 "
-    "hold (-16.9 %, -33.8 %) but the height gain is only +14 % (row 8) and the sag 0.089 m: no "
-    "single stiffness reproduces all four ramp rows.",
-    "11 (blocks): on the calibrated bed (0.25 m blocks, env default; the paper gives no size) "
-    "posture control touches in 1 of seeds 0-3 (6 steps) and on 8 of 20 beds (rows @seeds 0-19: "
-    "492 steps against the simple controller's 16205), so it keeps the torso off the blocks on "
-    "most beds, not on all. The pitch/roll-rate rises of seeds 0-3 (+45 % / +34 %; paper +54 % / "
-    "+82 %) are not settled: on 20 beds the changes are +13.8 % and -10.8 % with 95 % intervals "
-    "of [-17.7, +152.1] and [-31.1, +42.6] %. Rows 11b and 11c hold on seeds 0-3 by the draw of "
-    "the beds (the block size was chosen on them), and physics settings that should not matter "
-    "(solver tolerance 1e-6 instead of 1e-8, RK4) turn seeds 0-3's changes negative. On the "
-    "previous 0.1 m blocks with kp 8 posture control touched in 4 of 4 episodes (192 steps) and "
-    "lowered both rates: the simple controller's torso knocked on the many block edges, which "
-    "posture control mostly avoids.",
+    "RMS ends 5.5 % above it (+1.9 % at the former 2 ms step). With the previous default (kp 8, "
+    "rows @servo_kp=8.0) rows 9 and 10 hold (-15.4 %, -34.0 %) but the height gain is only "
+    "+15 % (row 8) and the sag 0.089 m: no single stiffness reproduces all four ramp rows.",
+    "11, 11b, 11c (blocks): on the calibrated bed (0.25 m blocks, env default; the paper gives no "
+    "size) posture control touches in 1 of seeds 0-3 (5 steps) and on 10 of 20 beds (rows "
+    "@seeds 0-19: 673 steps against the simple controller's 15273), so it keeps the torso off "
+    "the blocks on most steps, not on all beds. The paper's pitch/roll-rate rises (+54 % / "
+    "+82 %) are not reproduced: on seeds 0-3 posture control lowers both rates (-36 % / -30 %), "
+    "and on 20 beds the changes are -8.0 % and -21.7 % with 95 % intervals of [-37.1, +51.2] "
+    "and [-33.6, +19.4] %, whose sign is not settled. The block size was chosen on seeds 0-3 at "
+    "the former 2 ms physics step, where their changes were +45 % / +34 % (20 beds: +13.8 % and "
+    "-10.8 %); the timestep, a looser solver tolerance (1e-6 instead of 1e-8) or RK4 each flip "
+    "seeds 0-3's changes, so the 20-bed rows with their intervals are the ones to read. On the "
+    "previous 0.1 m blocks with kp 8 posture control touched in 4 of 4 episodes (83 steps), "
+    "changed the pitch rate by +4 % and lowered the roll rate by 22 %: the simple controller's "
+    "torso knocked on the many block edges, which posture control mostly avoids.",
     "6b (paper's reach model, side cases, default hold posture): the robot tips; the foothold "
     "(0, +-1889, -1946) mm is the paper's kind but 163 mm lower (our hold posture stands "
     "taller). With the hold posture calibrated to the paper's foothold height "

@@ -38,8 +38,8 @@ holds; a setting less than `MIN_SPEEDUP` (10 %) faster than the default does not
 The env defaults are not changed: settings are applied to the envs this script makes.
 
 How a setting is applied (`make_env`): the timestep through the ``physics_dt`` kwarg (the env
-checks that it divides ``control_dt``; ATHENA also needs a multiple of 5 substeps, so its "x2"
-and "x4" are the nearest allowed timesteps, 3.33 and 10 ms; the table prints the timestep
+checks that it divides ``control_dt``; ATHENA also needs a multiple of 5 substeps, so its "x1.25"
+and "x2.5" are the nearest allowed timesteps, 3.33 and 5 ms; the table prints the timestep
 used); the integrator and solver options through the env's ``integrator``, ``solver_iterations``,
 ``solver_ls_iterations`` and ``solver_tolerance`` settings, so that a model rebuilt at reset
 (ATHENA on blocks, a sampled task) gets them too; every reset here is followed by
@@ -285,10 +285,10 @@ def within(tol: float) -> Callable[[object, object], bool]:
 
 
 def within_relative(fraction: float) -> Callable[[object, object], bool]:
-    """|value - reference| <= fraction x |reference|. The rates' tolerance, 5 %, is about the
-    default's own integration error: RK4 at the same 2 ms changes the ramp's roll-rate RMS by
-    -1.7 % (seed 0; -5 % over test tasks 0-3), while the timestep moves it steadily (seed 0:
-    +3.4 % at 2.5 ms, +9.5 % at 3.33 ms, +15 % at 5 ms)."""
+    """|value - reference| <= fraction x |reference|. The rates' tolerance, 5 %, is about
+    ATHENA's own integration error: measured against the former 2 ms default, RK4 at the same
+    2 ms changes the ramp's roll-rate RMS by -1.7 % (seed 0; -5 % over test tasks 0-3), while
+    the timestep moves it steadily (seed 0: +3.4 % at 2.5 ms, +9.5 % at 3.33 ms, +15 % at 5 ms)."""
 
     def cmp(value, reference) -> bool:
         return bool(math.isfinite(value) and abs(value - reference) <= fraction * abs(reference))

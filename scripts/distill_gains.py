@@ -8,9 +8,10 @@ Collect once (the expensive step), then fit:
               evaluate.py's ppo:<dir> runs
     curve     the held-out cost of fits to growing subsets of the training beds
 
-Measured on the blocks (2026-11-24; CONFIG below; the look-ahead over the 3 x 3 x 3 lattice of
-0.2/0.5/0.8 and the paper's gains on 56 training beds, seeds 0-55: about 1240 cycles and 1.95 M
-env steps including the teacher's plays, 18 min on 2 cores; the last 11 beds held out):
+Measured on the blocks (2026-11-24, at the then default 2 ms physics step; CONFIG below; the
+look-ahead over the 3 x 3 x 3 lattice of 0.2/0.5/0.8 and the paper's gains on 56 training beds,
+seeds 0-55: about 1240 cycles and 1.95 M env steps including the teacher's plays, 18 min on 2
+cores; the last 11 beds held out):
 - Mean cycle cost on the held-out beds: the paper's gains 0.1670, the best fixed lattice setting
   0.1646, the student 0.1641, the teacher 0.1423. `curve`: 0.1647, 0.1645 and 0.1646 from 11,
   22 and 45 training beds. More demonstrations do not help: the student does not learn the

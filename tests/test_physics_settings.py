@@ -27,7 +27,7 @@ SPEED_KEYS = {
 def test_sweep_speed_rows_have_expected_keys_and_finite_numbers():
     # ATHENA: its block bed is rebuilt at every reset, so the sweep's check that the model still
     # carries the integrator and tolerance after a reset is exercised too (it raises if not).
-    setting = PhysicsSetting(2.0, "euler", tolerance=1e-6)
+    setting = PhysicsSetting(1.25, "euler", tolerance=1e-6)
     rows = sweep("athena", [setting], seconds=0.2, repeats=1, fidelity=False)
     assert len(rows) == 4  # ramp and blocks, zero and random actions
     assert {(r["env"], r["actions"]) for r in rows} == {
@@ -38,7 +38,7 @@ def test_sweep_speed_rows_have_expected_keys_and_finite_numbers():
         assert r["kind"] == "speed" and r["robot"] == "athena" and r["setting"] == setting
         for key in ("physics_dt", "sim_s", "wall_s", "sim_per_wall"):
             assert math.isfinite(r[key]) and r[key] > 0, key
-        # x2 of 2 ms is not allowed (25 substeps must stay a multiple of 5): 15 substeps
+        # x1.25 of 2.5 ms (16 substeps) is not allowed (a multiple of 5 substeps): 15 substeps
         assert r["substeps"] == 15 and math.isclose(r["physics_dt"], 0.05 / 15)
         assert math.isclose(r["sim_s"], 0.2)
         assert r["unstable"] == 0

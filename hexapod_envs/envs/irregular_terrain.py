@@ -29,8 +29,9 @@ proportional position servos with that torque limit, a stiffness ``servo_kp`` an
 of position error, a hobby servo's proportional band; a stance leg carrying a third to a half of
 the robot's weight sags by a few millimetres. The paper's own simple-control results (median torso
 height 0.068 m on the ramp against 0.104 m standing) show that its simulated servos sagged too
-(6.8 N·m/rad is calibrated to that sag: 0.0681 m over seeds 0-3; 8 N·m/rad, the default before
-2026-11-24, gives 0.089 m):
+(6.8 N·m/rad is calibrated to that sag: 0.0681 m over seeds 0-3 at the 2 ms step of the
+calibration, 0.0676 m at the 2.5 ms default; 8 N·m/rad, the default before 2026-11-24, gives
+0.089 m):
 because every phase starts from the *measured* feet (eq. 12 on the encoders) the sag accumulates
 and the torso slowly sinks unless the height correction k_z δz brings it back. The phase start
 uses the measured heights but the commanded horizontal positions (``gait_start_from=
@@ -239,7 +240,11 @@ class IrregularTerrainSettings(EnvSettings):
 
     reward_class = IrregularTerrainRewardScales
     control_dt: float = number(0.05, strict=True)
-    physics_dt: float = number(0.002, strict=True)
+    physics_dt: float = number(0.0025, strict=True)
+    """MuJoCo timestep [s]: 2.5 ms, the coarsest step at which every ATHENA fidelity row of
+    benchmarks/physics_settings.py holds (the ramp's pitch- and roll-rate RMS within 5 % of
+    2 ms, the simple control's sag, the block-bed rate changes and contacts); about 1.3x the
+    simulated seconds per wall second of ``physics_dt=0.002``, the default before 2026-11-25."""
     contact_threshold: float = number(CONTACT_FORCE_N / (ATHENA.total_mass * 9.81), high=1.0)
     """A foot is loaded above this fraction of the weight (default: 0.5 N)."""
     tipping_threshold_deg: float = number(10.0, high=90.0)

@@ -136,7 +136,7 @@ class AthenaParams:
     """Joint viscous damping, N·m·s/rad: damping ratio ~0.5 on the swinging leg."""
     servo_armature: float = 0.002
     """Reflected rotor inertia of the geared servo, kg·m² (typical for a ~200:1 hobby servo);
-    it also keeps the light tibia joint well conditioned at a 2 ms time step."""
+    it also keeps the light tibia joint well conditioned at the 2-2.5 ms time steps used."""
 
     # ----- derived quantities --------------------------------------------------------------
     @property
