@@ -243,7 +243,7 @@ class IrregularTerrainSettings(EnvSettings):
     physics_dt: float = number(0.0025, strict=True)
     """MuJoCo timestep [s]: 2.5 ms, the coarsest step at which every ATHENA fidelity row of
     benchmarks/physics_settings.py holds (the ramp's pitch- and roll-rate RMS within 5 % of
-    2 ms, the simple control's sag, the block-bed rate changes and contacts); about 1.3x the
+    their 2 ms values, the simple control's sag, the block-bed rate changes and contacts); 1.3x the
     simulated seconds per wall second of ``physics_dt=0.002``, the default before 2026-11-25."""
     contact_threshold: float = number(CONTACT_FORCE_N / (ATHENA.total_mass * 9.81), high=1.0)
     """A foot is loaded above this fraction of the weight (default: 0.5 N)."""
