@@ -507,7 +507,7 @@ def posture_study_fidelity(setting: PhysicsSetting, quick: bool) -> list[Fidelit
                 inside_interval,
             )
         )
-    touched_beds = max(1, len(beds) // 7)  # 2 of 20 (RK4 and 2.5 ms: 10 against 8)
+    touched_beds = max(1, len(beds) // 7)  # 2 of 20 (against 2 ms: RK4 and 2.5 ms 10 vs 8)
     rows.append(
         Fidelity(
             f"{on_beds}: beds with posture-control torso contact",
