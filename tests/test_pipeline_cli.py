@@ -2,6 +2,7 @@
 bad-input paths: clear one-line errors on stderr and a non-zero exit code."""
 
 import json
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -13,6 +14,7 @@ import yaml
 
 from agents.pipeline import callbacks
 from agents.pipeline.cli import evaluate_main, train_main
+from agents.pipeline.env_settings import read_settings, resolved_settings
 from agents.ppo import PPOPolicy
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -64,7 +66,14 @@ def test_run_dir_holds_model_config_command_vecnormalize_and_tensorboard(run):
     run_dir, first = run
     assert first["final_steps"] == 1024 and first["events"]
     for model_dir in (run_dir / "final", run_dir / "best", *(run_dir / "checkpoints").iterdir()):
-        for name in ("model.zip", "vecnormalize.npz", "config.yaml", "command.txt", "meta.json"):
+        for name in (
+            "model.zip",
+            "vecnormalize.npz",
+            "config.yaml",
+            "env_settings.yaml",
+            "command.txt",
+            "meta.json",
+        ):
             assert (model_dir / name).is_file(), model_dir / name
     config = yaml.safe_load((run_dir / "final" / "config.yaml").read_text())
     assert config["env"]["id"] == "HexapodCliffWalk-v0" and config["ppo"]["n_steps"] == 256
@@ -203,6 +212,37 @@ def test_identical_seeds_give_identical_episodes_across_policies(tmp_path):
     for a, z in zip(analytical, zero, strict=True):
         assert a["episode_return"] == pytest.approx(z["episode_return"], rel=1e-4)
         assert a["distance_m"] == pytest.approx(z["distance_m"], abs=1e-4)
+
+
+def test_run_records_every_setting_of_its_training_env(run):
+    """Defaults included: a later change of a default must be visible against the record."""
+    run_dir, _ = run
+    config = yaml.safe_load((run_dir / "config.yaml").read_text())
+    env = gym.make("HexapodCliffWalk-v0", **config["env"]["kwargs"])
+    expected = resolved_settings(env)
+    assert "physics_dt" not in config["env"]["kwargs"] and expected["physics_dt"] == 0.001
+    for directory in (run_dir, run_dir / "final", run_dir / "best"):
+        assert read_settings(directory) == expected
+
+
+def test_evaluation_warns_when_a_setting_differs_from_the_training_env(run, tmp_path):
+    """A default changed since the training (here the physics step) is named in the report;
+    the held-out task distribution is not a mismatch."""
+    model = tmp_path / "model"
+    shutil.copytree(run[0] / "final", model)
+    assert evaluate(tmp_path / "same", f"ppo:{model}") == 0
+    assert "set up otherwise" not in (tmp_path / "same" / "report.md").read_text()
+    settings = read_settings(model)
+    settings["physics_dt"] = 0.002
+    settings["reward"]["forward_weight"] = 3.0
+    (model / "env_settings.yaml").write_text(yaml.safe_dump(settings))
+    assert evaluate(tmp_path / "changed", f"ppo:{model}") == 0
+    md = (tmp_path / "changed" / "report.md").read_text()
+    assert (
+        f"ppo:{model} was trained on an env set up otherwise than evaluated here "
+        "(setting: trained -> evaluated): physics_dt: 0.002 -> 0.001; reward terms (change "
+        "returns only): reward.forward_weight: 3.0 -> 1.0"
+    ) in md
 
 
 def test_missing_model_path_is_a_clear_error(tmp_path, capsys):

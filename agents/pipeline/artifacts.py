@@ -6,12 +6,14 @@ A **model directory** holds everything needed to use or resume one saved model::
     vecnormalize.npz   VecNormalize statistics as plain arrays (absent when normalisation is
                        off; older runs have a pickled vecnormalize.pkl, see `model_files`)
     config.yaml        the resolved training config (env id and kwargs included)
+    env_settings.yaml  every setting of the training env, defaults filled in (`env_settings`)
     command.txt        the command line that produced it
     meta.json          num_timesteps, observation/action shapes, kind, eval reward (if best)
 
 A **run directory** (``runs/{env}__ppo__{seed}__{time}``)::
 
     config.yaml, command.txt    resolved config; every command run on it, one per line
+    env_settings.yaml           the training env's settings, defaults filled in
     tb/                         TensorBoard event files (a resumed run appends here)
     checkpoints/step_<N>/       periodic and Ctrl-C checkpoints (model directories)
     best/                       best model by EvalCallback's mean reward (model directory)
@@ -35,6 +37,7 @@ from pathlib import Path
 from typing import Any
 
 from .configtools import dump_yaml, load_yaml
+from .env_settings import SETTINGS_FILE, write_settings
 from .errors import UserError
 from .model_files import (
     LEGACY_STATS_FILE,
@@ -85,8 +88,10 @@ def save_model_dir(
     command: str,
     kind: str,
     extra_meta: dict[str, Any] | None = None,
+    env_settings: dict[str, Any] | None = None,
 ) -> Path:
-    """Write a model directory (see module docstring): each file atomically, meta.json last."""
+    """Write a model directory (see module docstring): each file atomically, meta.json last.
+    `env_settings`: the training env's resolved settings (`env_settings.resolved_settings`)."""
     path = Path(path)
     path.mkdir(parents=True, exist_ok=True)
     with atomic_path(path / MODEL_FILE) as tmp:
@@ -98,6 +103,9 @@ def save_model_dir(
     if (path / LEGACY_STATS_FILE).exists():  # superseded by the .npz just written
         (path / LEGACY_STATS_FILE).unlink()
     atomic_write_text(path / CONFIG_FILE, dump_yaml(config))
+    write_settings(path, env_settings)
+    if env_settings is None and (path / SETTINGS_FILE).exists():  # not this model's
+        (path / SETTINGS_FILE).unlink()
     atomic_write_text(path / COMMAND_FILE, command + "\n")
     meta = {
         "kind": kind,

@@ -70,16 +70,21 @@ class EpisodeStatsCallback(BaseCallback):
 
 
 class ModelSaver:
-    """Saves model directories of one run (model, VecNormalize stats, config, command, meta)."""
+    """Saves model directories of one run (model, VecNormalize stats, config, env settings,
+    command, meta)."""
 
-    def __init__(self, run_dir: Path, config: Any, command: str):
+    def __init__(
+        self, run_dir: Path, config: Any, command: str, env_settings: dict[str, Any] | None = None
+    ):
         self.run_dir, self.config, self.command = Path(run_dir), config, command
+        self.env_settings = env_settings
 
     def save(self, model: Any, kind: str, path: Path | None = None, **meta: Any) -> Path:
         if path is None:
             path = checkpoint_dir(self.run_dir, model.num_timesteps)
+        vec_normalize = model.get_vec_normalize_env()
         return save_model_dir(
-            path, model, model.get_vec_normalize_env(), self.config, self.command, kind, meta
+            path, model, vec_normalize, self.config, self.command, kind, meta, self.env_settings
         )
 
 

@@ -17,6 +17,7 @@ import gymnasium as gym
 import numpy as np
 
 from ..policy import Policy, RandomPolicy, ZeroPolicy
+from .env_settings import describe, differences, read_settings, resolved_settings
 from .envs import EnvSpec, check_env_id, env_time_step, import_gym_packages
 from .episode import EpisodeAccumulator, EpisodeRecord, MetricSpec, metric_specs
 from .errors import UserError
@@ -278,6 +279,31 @@ def _kwargs_note(
     )
 
 
+def _settings_note(
+    env: gym.Env,
+    suite_env: SuiteEnv,
+    name: str,
+    model_dir: Path | None,
+    policy: Policy,
+    policy_kwargs: dict[str, Any],
+) -> str | None:
+    """A warning when a model was trained on an env set up otherwise than `env`, the one it is
+    evaluated on: every recorded setting of its training env (`env_settings`) against `env`'s,
+    so that a default changed since the training shows; for a model without that record (older
+    runs, envs without typed settings) its config's kwargs against the suite's."""
+    trained, current = read_settings(model_dir), resolved_settings(env)
+    if trained is None or current is None:
+        trained_kwargs = getattr(policy, "train_env_kwargs", None)
+        return _kwargs_note(env, suite_env, name, trained_kwargs, policy_kwargs)
+    found = differences(trained, current)
+    if not found:
+        return None
+    return (
+        f"{suite_env.id}: {name} was trained on an env set up otherwise than evaluated here "
+        f"(setting: trained -> evaluated): {describe(found)}"
+    )
+
+
 def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[str]]:
     """Make every env and policy (all checks happen here). Returns, per suite env, its result
     and ``{policy name: (policy, env)}`` (policies that read actions alike share one env), and
@@ -310,8 +336,7 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[
             run = PolicyRun(name=name, source=source, env_kwargs=extra)
             files = getattr(getattr(policy, "learned", policy), "files", None)
             run.model_dir = getattr(files, "directory", None)
-            trained = getattr(policy, "train_env_kwargs", None)
-            note = _kwargs_note(env, suite_env, name, trained, extra)
+            note = _settings_note(envs[key], suite_env, name, run.model_dir, policy, extra)
             if note:
                 run.notes.append(note)
                 warnings.append(note)

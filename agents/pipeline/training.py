@@ -34,6 +34,7 @@ from .artifacts import (
     saved_model_dirs,
 )
 from .configtools import dump_yaml, load_yaml, parse_override
+from .env_settings import describe, differences, read_settings, resolved_settings, write_settings
 from .envs import EnvSpec, env_time_step, make_vec_env
 from .episode import XI_F_DEG, EpisodeAccumulator, metric_specs
 from .errors import UserError
@@ -84,17 +85,21 @@ def env_spec(config: TrainConfig) -> EnvSpec:
     )
 
 
-def _probe(spec: EnvSpec) -> Callable[[], EpisodeAccumulator]:
+def _probe(
+    spec: EnvSpec,
+) -> tuple[Callable[[], EpisodeAccumulator], dict[str, Any] | None]:
     """Make one env in this process: clear errors early; read its time step, metric specs and
-    the robot's tipping threshold ξ (the time below it is logged); return a factory of episode
-    accumulators for the training and evaluation callbacks."""
+    the robot's tipping threshold ξ (the time below it is logged). Returns a factory of episode
+    accumulators for the training and evaluation callbacks, and the env's resolved settings
+    (recorded with the run, see `env_settings`)."""
     env = spec.make()
     try:
         dt, specs = env_time_step(env), metric_specs(env)
         xi = getattr(env.unwrapped, "tipping_threshold_deg", XI_F_DEG)
+        settings = resolved_settings(env)
     finally:
         env.close()
-    return partial(EpisodeAccumulator, dt, specs, xi_f_deg=xi)
+    return partial(EpisodeAccumulator, dt, specs, xi_f_deg=xi), settings
 
 
 def _vec_envs(config: TrainConfig, seed: int, stats: NormalizationStats | None = None):
@@ -187,19 +192,22 @@ def start_training(
     metrics to Ray Tune.
     """
     spec = env_spec(config)
-    new_accumulator = _probe(spec)
+    new_accumulator, settings = _probe(spec)
     name = name or run_name(config.env.id, config.train.seed)
     run_dir = prepare_new_dir(Path(output_dir) / name, force, "run directory")
     try:
         command = command or command_line()
         atomic_write_text(run_dir / CONFIG_FILE, dump_yaml(config))
+        write_settings(run_dir, settings)
         atomic_write_text(run_dir / COMMAND_FILE, command + "\n")
         venv, eval_env = _vec_envs(config, config.train.seed)
         model = new_model(config, venv)
     except BaseException:
         shutil.rmtree(run_dir, ignore_errors=True)
         raise
-    return _learn(model, config, run_dir, command, eval_env, new_accumulator, False, after_eval)
+    return _learn(
+        model, config, run_dir, command, eval_env, new_accumulator, False, after_eval, settings
+    )
 
 
 def resume_training(
@@ -231,7 +239,8 @@ def resume_training(
     if not candidates:
         raise UserError(f"{run_dir} holds no checkpoint to resume from")
     spec = env_spec(config)
-    new_accumulator = _probe(spec)
+    new_accumulator, settings = _probe(spec)
+    _warn_if_settings_changed(run_dir, settings)
     model = eval_env = None
     problems = []
     for checkpoint in candidates:
@@ -257,7 +266,25 @@ def resume_training(
     with open(run_dir / COMMAND_FILE, "a") as fh:
         fh.write(command + "\n")
     print(f"resuming {run_dir} from {checkpoint.name} at {model.num_timesteps} steps")
-    return _learn(model, config, run_dir, command, eval_env, new_accumulator, True, after_eval)
+    return _learn(
+        model, config, run_dir, command, eval_env, new_accumulator, True, after_eval, settings
+    )
+
+
+def _warn_if_settings_changed(run_dir: Path, settings: dict[str, Any] | None) -> None:
+    """Say so when the env's settings now differ from those the run started with (a default
+    changed in the code since): the resumed part trains on the env as it is now, and the model
+    directories it saves record that env's settings."""
+    recorded = read_settings(run_dir)
+    if recorded is None or settings is None:
+        return
+    found = differences(recorded, settings)
+    if found:
+        print(
+            f"warning: the env's settings differ from those {run_dir} started with "
+            f"(setting: then -> now): {describe(found)}",
+            file=sys.stderr,
+        )
 
 
 def _load_checkpoint(
@@ -303,6 +330,7 @@ def _learn(
     new_accumulator: Callable[[], EpisodeAccumulator],
     resumed: bool,
     after_eval: Any = None,
+    env_settings: dict[str, Any] | None = None,
 ) -> TrainResult:
     import torch
     from stable_baselines3.common.callbacks import CallbackList
@@ -318,7 +346,7 @@ def _learn(
         StatsEvalCallback,
     )
 
-    saver = ModelSaver(run_dir, config, command)
+    saver = ModelSaver(run_dir, config, command, env_settings)
     callbacks = [EpisodeStatsCallback(new_accumulator)]
     if config.checkpoint.freq > 0:
         callbacks.append(CheckpointEvery(config.checkpoint.freq, saver))

@@ -1,0 +1,108 @@
+"""The training env's resolved settings, recorded with every run and model directory, and
+compared with the env a model is later evaluated or resumed on.
+
+Why: a run's ``config.yaml`` holds only the env kwargs it was given; every other setting is a
+default of the code that trained it. When a default changes later (ATHENA's physics step went
+from 2 ms to 2.5 ms), comparing kwargs cannot see it, and an agent is silently evaluated, or
+its training resumed, under other physics than it learned on. So a run writes
+``env_settings.yaml``: every field of ``env.unwrapped.settings`` (the env's typed settings,
+see `hexapod_envs.envs.settings`) with the defaults filled in, into the run directory and into
+every model directory it saves. Envs of other packages have no typed settings: nothing is
+recorded for them and the evaluation falls back to comparing kwargs.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+from typing import Any
+
+import gymnasium as gym
+
+from .configtools import dump_yaml, load_yaml
+from .model_files import atomic_write_text
+
+SETTINGS_FILE = "env_settings.yaml"
+
+NOT_COMPARED = (
+    "task_distribution",
+    "train_ranges",
+    "test_ranges",
+    "render_mode",
+    "width",
+    "height",
+    "camera_name",
+)
+"""Settings whose differences are no mismatch: the task distribution and its ranges are the
+evaluation's own choice (a held-out distribution is its point), rendering changes no physics."""
+
+_HEADER = "# The training env's settings, defaults filled in (agents/pipeline/env_settings.py)\n"
+
+REWARD = "reward"
+"""The nested reward scales: they change returns, not what the agent meets."""
+
+
+def resolved_settings(env: gym.Env) -> dict[str, Any] | None:
+    """Every setting of `env` (defaults filled in) as plain YAML types; None for an env
+    without typed settings."""
+    settings = getattr(env.unwrapped, "settings", None)
+    if settings is None or not dataclasses.is_dataclass(settings):
+        return None
+    return _plain(dataclasses.asdict(settings))
+
+
+def _plain(value: Any) -> Any:
+    """Tuples as lists, recursively: what a YAML round trip gives back."""
+    if isinstance(value, dict):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    return value
+
+
+def write_settings(directory: str | Path, settings: dict[str, Any] | None) -> None:
+    """Write ``env_settings.yaml`` into `directory` (nothing for None)."""
+    if settings is not None:
+        atomic_write_text(Path(directory) / SETTINGS_FILE, _HEADER + dump_yaml(settings))
+
+
+def read_settings(directory: str | Path | None) -> dict[str, Any] | None:
+    """The settings recorded in `directory`; None when it has none (older runs, other envs)."""
+    if directory is None:
+        return None
+    path = Path(directory) / SETTINGS_FILE
+    return load_yaml(path) if path.is_file() else None
+
+
+def differences(trained: dict[str, Any], current: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
+    """``{setting: (trained, current)}`` for every compared setting that differs; reward scales
+    as ``reward.<name>``. A setting that exists on one side only (added or removed since the
+    training) shows as None on the other."""
+    out = {}
+    for key in _keys(trained, current):
+        if key in NOT_COMPARED:
+            continue
+        a, b = trained.get(key), current.get(key)
+        if key == REWARD and isinstance(a, dict) and isinstance(b, dict):
+            out.update({f"{REWARD}.{k}": v for k, v in differences(a, b).items()})
+        elif a != b:
+            out[key] = (a, b)
+    return out
+
+
+def _keys(a: dict[str, Any], b: dict[str, Any]) -> list[str]:
+    return [*a, *(k for k in b if k not in a)]
+
+
+def describe(found: dict[str, tuple[Any, Any]]) -> str:
+    """The differences as ``"physics_dt: 0.002 -> 0.0025; reward terms (returns only):
+    reward.rate_weight: 5.0 -> 0.5"``."""
+    env_part = {k: v for k, v in found.items() if not k.startswith(f"{REWARD}.")}
+    reward = {k: v for k, v in found.items() if k.startswith(f"{REWARD}.")}
+    parts = []
+    if env_part:
+        parts.append(", ".join(f"{k}: {a!r} -> {b!r}" for k, (a, b) in env_part.items()))
+    if reward:
+        terms = ", ".join(f"{k}: {a!r} -> {b!r}" for k, (a, b) in reward.items())
+        parts.append(f"reward terms (change returns only): {terms}")
+    return "; ".join(parts)
