@@ -124,3 +124,35 @@ def test_sampled_tasks_are_broken_down_and_run_dirs_give_learning_curves(tmp_pat
     episodes = json.loads((out / "metrics.json").read_text())["envs"]["HexapodCliffWalk-v0"]
     tasks = [e["task"]["cliff_x"] for e in episodes["policies"]["zero"]["episodes"]]
     assert len(set(tasks)) == 4 and all(3.4 <= x <= 4.0 for x in tasks)
+
+
+def test_named_references_are_compared_in_order_and_each_pair_once():
+    """A suite's `references` add like-for-like comparisons (here learned gains against the
+    paper's gains in the same action mode); labelled names ({env_id} expanded) are found."""
+    result = EnvResult("Env-v0", {}, 100, 0.02, [])
+    ok, tipped = _record(100, 0.5, 1.0, False), _record(10, 0.1, 0.05, True)
+    result.runs = {
+        "analytical": PolicyRun("analytical", "a", [ok] * 3),
+        "ppo:m/{env_id}/paper": PolicyRun("ppo:m/{env_id}/paper", "p", [ok, ok, tipped]),
+        "ppo:m/{env_id}/learned": PolicyRun("ppo:m/{env_id}/learned", "l", [ok] * 3),
+    }
+    aggs = {result.label(n): aggregate(r.episodes) for n, r in result.runs.items()}
+    lines, _ = verdict_lines(result, aggs, ("analytical", "ppo:m/{env_id}/paper"))
+    assert [line.split(": success", 1)[0] for line in lines] == [
+        "- `ppo:m/Env-v0/paper` vs the analytical controller (`analytical`)",
+        "- `ppo:m/Env-v0/learned` vs the analytical controller (`analytical`)",
+        "- `ppo:m/Env-v0/learned` vs `ppo:m/Env-v0/paper`",
+    ]
+    assert "success 3/3 vs 2/3" in lines[2]
+    default, _ = verdict_lines(result, aggs)  # analytical and zero; zero did not run
+    assert len(default) == 2
+
+
+def test_references_must_be_among_the_policies(tmp_path, capsys):
+    argv = ["--envs", "HexapodCliffWalk-v0", "--policies", "analytical", "zero"]
+    argv += ["--episodes", "1", "--output-dir", str(tmp_path / "rep"), "--no-progress"]
+    assert evaluate_main([*argv, "--set", "references=[random]"]) == 2
+    assert "references ['random'] are not among the policies ['analytical', 'zero']" in (
+        capsys.readouterr().err
+    )
+    assert not (tmp_path / "rep").exists()

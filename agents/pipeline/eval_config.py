@@ -57,12 +57,25 @@ def _parse_policies(value: Any, where: str) -> list[str]:
     return names
 
 
+DEFAULT_REFERENCES = ("analytical", "zero")
+"""The policies every other one is compared with when a suite names no ``references``: the
+analytical controller and the reference motion (those of them that ran)."""
+
+
+def _parse_references(value: Any, where: str) -> list[str] | None:
+    return None if value is None else _parse_policies(value, where)
+
+
 @dataclass
 class EvaluationSuite:
     envs: list[SuiteEnv] = field(metadata={"parse": _parse_envs})
     policies: list[str] = field(
         default_factory=lambda: ["analytical"], metadata={"parse": _parse_policies}
     )
+    # the policies every other one is compared with, in this order (paired-bootstrap intervals
+    # per metric); null: analytical and zero. E.g. [analytical, "ppo:models/{env_id}/paper_gains"]
+    # compares learned gains with the paper's gains in the same action mode, like for like.
+    references: list[str] | None = field(default=None, metadata={"parse": _parse_references})
     episodes: int = 5
     seed: int = 0
     max_episode_steps: int | None = None  # set: overrides every env's time limit (smoke runs)
@@ -87,6 +100,14 @@ class EvaluationSuite:
             raise ValueError("frame_count must be >= 1 and frame_size [width, height]")
         if not 0 < self.video_fps <= 100:
             raise ValueError(f"video_fps must be in (0, 100], got {self.video_fps}")
+        unknown = [r for r in self.references or () if r not in self.policies]
+        if unknown:
+            raise ValueError(f"references {unknown} are not among the policies {self.policies}")
+
+    @property
+    def reference_names(self) -> tuple[str, ...]:
+        """The policies compared with, in order (the defaults when none are named)."""
+        return DEFAULT_REFERENCES if self.references is None else tuple(self.references)
 
     @property
     def seeds(self) -> list[int]:

@@ -13,6 +13,7 @@ import html
 import json
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -21,7 +22,7 @@ import numpy as np
 
 from . import figures
 from .episode import POWER_KEY
-from .eval_config import PPO_PREFIX
+from .eval_config import DEFAULT_REFERENCES, PPO_PREFIX
 from .evaluation import EnvResult, SuiteResult
 from .summary import STANDARD_METRICS, Verdict, aggregate, compare
 
@@ -187,9 +188,6 @@ def task_table(result: EnvResult) -> Table | None:
 
 
 # --- verdicts -------------------------------------------------------------------------------
-REFERENCES = ("analytical", "zero")
-"""Every policy is compared with the analytical controller and with the reference motion."""
-
 REFERENCE_WORDS = {"analytical": "the analytical controller", "zero": "the reference motion"}
 
 
@@ -260,8 +258,11 @@ def _median_min_fasm(a: dict) -> float:
     return s["median"] if s else -math.inf
 
 
-def verdict_lines(result: EnvResult, aggs: dict[str, dict]) -> tuple[list[str], list[Verdict]]:
-    """Bullets comparing every policy with the analytical controller and the reference motion.
+def verdict_lines(
+    result: EnvResult, aggs: dict[str, dict], references: Sequence[str] = DEFAULT_REFERENCES
+) -> tuple[list[str], list[Verdict]]:
+    """Bullets comparing every policy with each of the `references` that ran (by default the
+    analytical controller and the reference motion), in order; a pair is compared once.
 
     Rates are per episode and time-integrated metrics per second of episode (see `summary`);
     a policy that tips over more often than its reference is said to, first."""
@@ -269,21 +270,26 @@ def verdict_lines(result: EnvResult, aggs: dict[str, dict]) -> tuple[list[str], 
     all_verdicts: list[Verdict] = []
     # `aggs` is keyed by the policy names as given or as labelled (``{env_id}`` expanded).
     episodes = {k: run.episodes for n, run in result.runs.items() for k in (n, result.label(n))}
-    for reference in REFERENCES:
-        if reference not in aggs:
-            continue
+    keys = [k for k in (_agg_key(r, result, aggs) for r in references) if k is not None]
+    for i, reference in enumerate(keys):
         for name in aggs:
-            if name == reference or (reference == "zero" and name == "analytical"):
-                continue  # analytical vs zero is already said (as zero vs analytical)
+            if name in keys[: i + 1]:
+                continue  # itself, or a pair already compared the other way round
             verdicts = compare(name, reference, aggs, result.specs, episodes)
             all_verdicts += verdicts
             lines.append(_bullet(name, reference, aggs, verdicts))
     if not lines:
-        lines.append(
-            f"- No comparison on {result.env_id}: neither the analytical controller nor the "
-            "reference motion (`zero`) ran here."
-        )
+        names = ", ".join(f"`{r}`" for r in references)
+        lines.append(f"- No comparison on {result.env_id}: none of the references ({names}) ran.")
     return lines, all_verdicts
+
+
+def _agg_key(reference: str, result: EnvResult, aggs: dict[str, dict]) -> str | None:
+    """The key of `reference` in `aggs` (given or labelled name); None when it did not run."""
+    for key in (reference, result.label(reference)):
+        if key in aggs:
+            return key
+    return None
 
 
 def _bullet(name: str, reference: str, aggs: dict[str, dict], verdicts: list[Verdict]) -> str:
@@ -303,8 +309,13 @@ def _bullet(name: str, reference: str, aggs: dict[str, dict], verdicts: list[Ver
     better = [v for v in rest if v.outcome == "better"]
     worse = [v for v in rest if v.outcome == "worse"]
     a, b = aggs[name], aggs[reference]
+    words = (
+        f"{REFERENCE_WORDS[reference]} (`{reference}`)"
+        if reference in REFERENCE_WORDS
+        else f"`{reference}`"
+    )
     text = (
-        f"- `{name}` vs {REFERENCE_WORDS[reference]} (`{reference}`): success "
+        f"- `{name}` vs {words}: success "
         f"{_fraction(_count(a, 'success'))} vs {_fraction(_count(b, 'success'))}, tip-overs "
         f"{_fraction(_count(a, 'tipped_over'))} vs {_fraction(_count(b, 'tipped_over'))}."
     )
@@ -339,8 +350,9 @@ HOW_TO_READ = [
     "- **Comparisons** use rates per episode and, for time-integrated quantities (time below ξ, "
     "distance, energy), values per second of episode (share of time below ξ, speed, mean "
     "power), so a policy whose episodes end early cannot look better on a total. Every policy is "
-    "compared with the analytical controller (`analytical`) and with the env's reference motion "
-    "(`zero`: the zero action, the paper's gait without feedback).",
+    "compared with each of the suite's references (its `references`; by default the analytical "
+    "controller `analytical` and the env's reference motion `zero`: the zero action, the "
+    "paper's gait without feedback).",
     "- **Not resolved** marks a difference whose 95 % paired-bootstrap interval includes 0: "
     "every policy runs the same seeds, hence the same tasks, and the bootstrap resamples the "
     "tasks with both policies' episodes together, so the interval shows how much of the "
@@ -389,7 +401,7 @@ def build_metrics(result: SuiteResult) -> dict[str, Any]:
     envs = {}
     for r in result.envs:
         aggs = {n: aggregate(run.episodes) for n, run in r.runs.items()}
-        _, verdicts = verdict_lines(r, aggs)
+        _, verdicts = verdict_lines(r, aggs, suite.reference_names)
         envs[r.env_id] = {
             "kwargs": r.kwargs,
             "xi_deg": r.xi_deg,
@@ -562,7 +574,7 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
             continue
         table(main_table(aggs))
         heading("Comparisons (like with like)", 3)
-        bullets(verdict_lines(r, aggs)[0])
+        bullets(verdict_lines(r, aggs, result.suite.reference_names)[0])
         if all(a["energy_j"] is None for a in aggs.values()):
             para(f"Energy: n/a, this env reports no `{POWER_KEY}` in info.")
         heading("Spread (median [min, max])", 3)
