@@ -95,7 +95,7 @@ def _keys(a: dict[str, Any], b: dict[str, Any]) -> list[str]:
 
 
 def describe(found: dict[str, tuple[Any, Any]]) -> str:
-    """The differences as ``"physics_dt: 0.002 -> 0.0025; reward terms (returns only):
+    """The differences as ``"physics_dt: 0.002 -> 0.0025; reward terms (change returns only):
     reward.rate_weight: 5.0 -> 0.5"``."""
     env_part = {k: v for k, v in found.items() if not k.startswith(f"{REWARD}.")}
     reward = {k: v for k, v in found.items() if k.startswith(f"{REWARD}.")}
