@@ -4,7 +4,6 @@ difference, how it is worded, and the warning when a run is resumed on a changed
 from pathlib import Path
 
 import gymnasium as gym
-import yaml
 
 from agents.pipeline.env_settings import (
     describe,
@@ -13,7 +12,8 @@ from agents.pipeline.env_settings import (
     resolved_settings,
     write_settings,
 )
-from agents.pipeline.training import _warn_if_settings_changed
+from agents.pipeline.train_config import load_train_config
+from agents.pipeline.training import _warn_if_settings_changed, env_spec
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -57,8 +57,8 @@ def test_a_setting_added_or_removed_since_the_training_shows_against_none():
 
 
 def test_settings_round_trip_through_the_file_exactly(tmp_path):
-    env = gym.make("HexapodIrregularTerrain-v0", terrain="blocks")
-    settings = resolved_settings(env)
+    with gym.make("HexapodIrregularTerrain-v0", terrain="blocks") as env:
+        settings = resolved_settings(env)
     assert settings["terrain"] == "blocks" and settings["reward"]["rate_weight"] > 0
     write_settings(tmp_path, settings)
     assert read_settings(tmp_path) == settings
@@ -67,8 +67,8 @@ def test_settings_round_trip_through_the_file_exactly(tmp_path):
 
 
 def test_envs_without_typed_settings_record_nothing(tmp_path):
-    env = gym.make("CartPole-v1")
-    assert resolved_settings(env) is None
+    with gym.make("CartPole-v1") as env:
+        assert resolved_settings(env) is None
     write_settings(tmp_path, None)
     assert not list(tmp_path.iterdir())
 
@@ -81,6 +81,30 @@ def test_resuming_on_a_changed_env_warns_with_the_differences(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith(f"warning: the env's settings differ from those {tmp_path} started with")
     assert "physics_dt: 0.002 -> 0.0025" in err
+    # unlike an evaluation, a resumed run keeps learning: changed ranges and rewards matter
+    ranges = {**TRAINED, "train_ranges": {"slope_deg": [[1.0, 2.0]]}, "render_mode": "human"}
+    _warn_if_settings_changed(tmp_path, ranges)
+    err = capsys.readouterr().err
+    assert "train_ranges" in err and "render_mode" not in err
+
+
+def test_a_model_saved_without_settings_drops_an_earlier_record(tmp_path):
+    """Overwriting e.g. best/ with a model of an env without typed settings must not leave the
+    previous model's settings behind."""
+    from types import SimpleNamespace
+
+    from agents.pipeline.artifacts import save_model_dir
+
+    class FakeModel(SimpleNamespace):
+        def save(self, path):
+            Path(path).write_bytes(b"weights")
+
+    space = SimpleNamespace(shape=(2,))
+    model = FakeModel(num_timesteps=5, observation_space=space, action_space=space)
+    save_model_dir(tmp_path, model, None, {"env": {}}, "cmd", "best", env_settings=TRAINED)
+    assert read_settings(tmp_path) == TRAINED
+    save_model_dir(tmp_path, model, None, {"env": {}}, "cmd", "best", env_settings=None)
+    assert read_settings(tmp_path) is None and (tmp_path / "meta.json").is_file()
 
 
 def test_every_shipped_agent_records_the_env_it_was_trained_on_and_the_code_still_builds_it():
@@ -91,6 +115,7 @@ def test_every_shipped_agent_records_the_env_it_was_trained_on_and_the_code_stil
     for model_dir in models:
         recorded = read_settings(model_dir)
         assert recorded is not None, f"{model_dir} has no env_settings.yaml"
-        config = yaml.safe_load((model_dir / "config.yaml").read_text())["env"]
-        now = resolved_settings(gym.make(config["id"], **config["kwargs"]))
+        config = load_train_config(model_dir / "config.yaml")
+        with env_spec(config).make() as env:
+            now = resolved_settings(env)
         assert differences(recorded, now) == {}, (model_dir, describe(differences(recorded, now)))

@@ -245,6 +245,21 @@ def test_evaluation_warns_when_a_setting_differs_from_the_training_env(run, tmp_
     ) in md
 
 
+def test_a_model_without_the_settings_record_is_checked_by_its_kwargs(run, tmp_path):
+    """Older runs (and envs of other packages) have no env_settings.yaml: the evaluation then
+    compares the kwargs of the model's config with the suite's."""
+    model = tmp_path / "old"
+    shutil.copytree(run[0] / "final", model)
+    (model / "env_settings.yaml").unlink()
+    config = yaml.safe_load((model / "config.yaml").read_text())
+    config["env"]["kwargs"]["forward_weight"] = 2.0
+    (model / "config.yaml").write_text(yaml.safe_dump(config))
+    assert evaluate(tmp_path / "rep", f"ppo:{model}") == 0
+    md = (tmp_path / "rep" / "report.md").read_text()
+    assert f"ppo:{model} was trained with other env kwargs than evaluated here" in md
+    assert "forward_weight: 2.0 -> None" in md
+
+
 def test_missing_model_path_is_a_clear_error(tmp_path, capsys):
     assert evaluate(tmp_path / "rep", "analytical", f"ppo:{tmp_path / 'nope'}") == 2
     assert f"no PPO model at {tmp_path / 'nope'}" in capsys.readouterr().err

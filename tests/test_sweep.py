@@ -20,6 +20,7 @@ import pytest
 import yaml
 from sweep_helpers import REPO, free_port, is_gone, loopback_cluster, tiny_sweep
 
+from agents.pipeline.cli import evaluate_main
 from agents.pipeline.errors import ConfigError
 from agents.pipeline.sweep_config import load_sweep
 from agents.pipeline.train_config import load_train_config
@@ -148,6 +149,14 @@ def test_evaluate_aggregates_a_sweep_over_its_training_seeds(local_sweep, tmp_pa
     report = (out / "report.md").read_text()
     assert "## Multi-seed studies" in report and "95 % CI" in report
     assert "Multi-seed studies" in (out / "report.html").read_text()
+
+
+def test_a_sweep_directory_cannot_be_a_reference(local_sweep, tmp_path, capsys):
+    argv = ["--envs", "HexapodIrregularTerrain-v0", "--policies", "zero", f"ppo:{local_sweep}"]
+    argv += ["--episodes", "1", "--output-dir", str(tmp_path / "rep"), "--no-progress"]
+    assert evaluate_main([*argv, "--set", f"references=['ppo:{local_sweep}']"]) == 2
+    err = capsys.readouterr().err
+    assert f"references: ppo:{local_sweep} is a sweep directory" in err and "Traceback" not in err
 
 
 def test_optuna_searcher_with_asha_samples_the_ranges(tmp_path):

@@ -103,9 +103,10 @@ def save_model_dir(
     if (path / LEGACY_STATS_FILE).exists():  # superseded by the .npz just written
         (path / LEGACY_STATS_FILE).unlink()
     atomic_write_text(path / CONFIG_FILE, dump_yaml(config))
-    write_settings(path, env_settings)
-    if env_settings is None and (path / SETTINGS_FILE).exists():  # not this model's
-        (path / SETTINGS_FILE).unlink()
+    if env_settings is None:
+        (path / SETTINGS_FILE).unlink(missing_ok=True)  # an earlier model's, not this one's
+    else:
+        write_settings(path, env_settings)
     atomic_write_text(path / COMMAND_FILE, command + "\n")
     meta = {
         "kind": kind,

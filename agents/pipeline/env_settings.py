@@ -9,6 +9,11 @@ its training resumed, under other physics than it learned on. So a run writes
 see `hexapod_envs.envs.settings`) with the defaults filled in, into the run directory and into
 every model directory it saves. Envs of other packages have no typed settings: nothing is
 recorded for them and the evaluation falls back to comparing kwargs.
+
+What the record covers is the settings dataclass: a setting left at None for the env to derive
+at construction (the ditch env's gait timing, ATHENA's per-terrain swing height) is recorded as
+None, and robot constants that are no settings (e.g. the heavy-duty servo stiffness in
+``HeavyDutyParams``) are not recorded; a change of those is not detected.
 """
 
 from __future__ import annotations
@@ -24,17 +29,12 @@ from .model_files import atomic_write_text
 
 SETTINGS_FILE = "env_settings.yaml"
 
-NOT_COMPARED = (
-    "task_distribution",
-    "train_ranges",
-    "test_ranges",
-    "render_mode",
-    "width",
-    "height",
-    "camera_name",
-)
-"""Settings whose differences are no mismatch: the task distribution and its ranges are the
-evaluation's own choice (a held-out distribution is its point), rendering changes no physics."""
+RENDERING = ("render_mode", "width", "height", "camera_name")
+"""Settings that change no physics."""
+
+NOT_COMPARED = ("task_distribution", "train_ranges", "test_ranges", *RENDERING)
+"""Settings whose differences are no mismatch for an evaluation: the task distribution and its
+ranges are the evaluation's own choice (a held-out distribution is its point)."""
 
 _HEADER = "# The training env's settings, defaults filled in (agents/pipeline/env_settings.py)\n"
 
@@ -74,17 +74,19 @@ def read_settings(directory: str | Path | None) -> dict[str, Any] | None:
     return load_yaml(path) if path.is_file() else None
 
 
-def differences(trained: dict[str, Any], current: dict[str, Any]) -> dict[str, tuple[Any, Any]]:
-    """``{setting: (trained, current)}`` for every compared setting that differs; reward scales
-    as ``reward.<name>``. A setting that exists on one side only (added or removed since the
-    training) shows as None on the other."""
+def differences(
+    trained: dict[str, Any], current: dict[str, Any], ignore: tuple[str, ...] = NOT_COMPARED
+) -> dict[str, tuple[Any, Any]]:
+    """``{setting: (trained, current)}`` for every setting not in `ignore` that differs; reward
+    scales as ``reward.<name>``. A setting that exists on one side only (added or removed since
+    the training) shows as None on the other."""
     out = {}
     for key in _keys(trained, current):
-        if key in NOT_COMPARED:
+        if key in ignore:
             continue
         a, b = trained.get(key), current.get(key)
         if key == REWARD and isinstance(a, dict) and isinstance(b, dict):
-            out.update({f"{REWARD}.{k}": v for k, v in differences(a, b).items()})
+            out.update({f"{REWARD}.{k}": v for k, v in differences(a, b, ()).items()})
         elif a != b:
             out[key] = (a, b)
     return out
@@ -94,7 +96,7 @@ def _keys(a: dict[str, Any], b: dict[str, Any]) -> list[str]:
     return [*a, *(k for k in b if k not in a)]
 
 
-def describe(found: dict[str, tuple[Any, Any]]) -> str:
+def describe(found: dict[str, tuple[Any, Any]], reward_note: str = "change returns only") -> str:
     """The differences as ``"physics_dt: 0.002 -> 0.0025; reward terms (change returns only):
     reward.rate_weight: 5.0 -> 0.5"``."""
     env_part = {k: v for k, v in found.items() if not k.startswith(f"{REWARD}.")}
@@ -104,5 +106,5 @@ def describe(found: dict[str, tuple[Any, Any]]) -> str:
         parts.append(", ".join(f"{k}: {a!r} -> {b!r}" for k, (a, b) in env_part.items()))
     if reward:
         terms = ", ".join(f"{k}: {a!r} -> {b!r}" for k, (a, b) in reward.items())
-        parts.append(f"reward terms (change returns only): {terms}")
+        parts.append(f"reward terms ({reward_note}): {terms}")
     return "; ".join(parts)

@@ -102,7 +102,10 @@ class EvaluationSuite:
             raise ValueError(f"video_fps must be in (0, 100], got {self.video_fps}")
         unknown = [r for r in self.references or () if r not in self.policies]
         if unknown:
-            raise ValueError(f"references {unknown} are not among the policies {self.policies}")
+            raise ValueError(
+                f"references {unknown} are not among the policies {self.policies} (name them "
+                "among the policies, or drop the suite's references with --set references=null)"
+            )
 
     @property
     def reference_names(self) -> tuple[str, ...]:

@@ -279,8 +279,11 @@ def verdict_lines(
             all_verdicts += verdicts
             lines.append(_bullet(name, reference, aggs, verdicts))
     if not lines:
-        names = ", ".join(f"`{r}`" for r in references)
-        lines.append(f"- No comparison on {result.env_id}: none of the references ({names}) ran.")
+        names = ", ".join(f"`{result.label(r)}`" for r in references)
+        lines.append(
+            f"- No comparison on {result.env_id}: none of the references ({names}) ran beside "
+            "another policy."
+        )
     return lines, all_verdicts
 
 

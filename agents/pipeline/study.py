@@ -70,6 +70,11 @@ def expand_studies(suite: EvaluationSuite) -> tuple[EvaluationSuite, list[Study]
         if sweep_dir is None:
             policies.append(name)
             continue
+        if name in (suite.references or ()):
+            raise UserError(
+                f"references: {name} is a sweep directory (a study of several runs); name one "
+                "of its trials' run directories as the reference instead"
+            )
         study = Study(name, sweep_dir)
         for trial in trial_dirs(sweep_dir):
             has_model = (trial / "best" / "model.zip").is_file() or latest_model_dir(trial)

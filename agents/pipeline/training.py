@@ -34,7 +34,14 @@ from .artifacts import (
     saved_model_dirs,
 )
 from .configtools import dump_yaml, load_yaml, parse_override
-from .env_settings import describe, differences, read_settings, resolved_settings, write_settings
+from .env_settings import (
+    RENDERING,
+    describe,
+    differences,
+    read_settings,
+    resolved_settings,
+    write_settings,
+)
 from .envs import EnvSpec, env_time_step, make_vec_env
 from .episode import XI_F_DEG, EpisodeAccumulator, metric_specs
 from .errors import UserError
@@ -278,11 +285,11 @@ def _warn_if_settings_changed(run_dir: Path, settings: dict[str, Any] | None) ->
     recorded = read_settings(run_dir)
     if recorded is None or settings is None:
         return
-    found = differences(recorded, settings)
+    found = differences(recorded, settings, ignore=RENDERING)
     if found:
         print(
             f"warning: the env's settings differ from those {run_dir} started with "
-            f"(setting: then -> now): {describe(found)}",
+            f"(setting: then -> now): {describe(found, reward_note='the reward it learns from')}",
             file=sys.stderr,
         )
 
