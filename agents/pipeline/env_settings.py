@@ -24,7 +24,7 @@ from typing import Any
 
 import gymnasium as gym
 
-from .configtools import dump_yaml, load_yaml
+from .configtools import dump_yaml, load_yaml, to_mapping
 from .model_files import atomic_write_text
 
 SETTINGS_FILE = "env_settings.yaml"
@@ -43,21 +43,12 @@ REWARD = "reward"
 
 
 def resolved_settings(env: gym.Env) -> dict[str, Any] | None:
-    """Every setting of `env` (defaults filled in) as plain YAML types; None for an env
-    without typed settings."""
+    """Every setting of `env` (defaults filled in) as plain YAML types (tuples as lists: what a
+    YAML round trip gives back); None for an env without typed settings."""
     settings = getattr(env.unwrapped, "settings", None)
     if settings is None or not dataclasses.is_dataclass(settings):
         return None
-    return _plain(dataclasses.asdict(settings))
-
-
-def _plain(value: Any) -> Any:
-    """Tuples as lists, recursively: what a YAML round trip gives back."""
-    if isinstance(value, dict):
-        return {k: _plain(v) for k, v in value.items()}
-    if isinstance(value, list | tuple):
-        return [_plain(v) for v in value]
-    return value
+    return to_mapping(settings)
 
 
 def write_settings(directory: str | Path, settings: dict[str, Any] | None) -> None:
@@ -77,16 +68,17 @@ def read_settings(directory: str | Path | None) -> dict[str, Any] | None:
 def differences(
     trained: dict[str, Any], current: dict[str, Any], ignore: tuple[str, ...] = NOT_COMPARED
 ) -> dict[str, tuple[Any, Any]]:
-    """``{setting: (trained, current)}`` for every setting not in `ignore` that differs; reward
-    scales as ``reward.<name>``. A setting that exists on one side only (added or removed since
-    the training) shows as None on the other."""
+    """``{setting: (trained, current)}`` for every setting not in `ignore` that differs; the
+    fields of a nested mapping as ``<setting>.<field>`` (e.g. ``reward.rate_weight``). A setting
+    that exists on one side only (added or removed since the training) shows as None on the
+    other."""
     out = {}
     for key in _keys(trained, current):
         if key in ignore:
             continue
         a, b = trained.get(key), current.get(key)
-        if key == REWARD and isinstance(a, dict) and isinstance(b, dict):
-            out.update({f"{REWARD}.{k}": v for k, v in differences(a, b, ()).items()})
+        if isinstance(a, dict) and isinstance(b, dict):
+            out.update({f"{key}.{k}": v for k, v in differences(a, b, ()).items()})
         elif a != b:
             out[key] = (a, b)
     return out
