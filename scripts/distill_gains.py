@@ -83,7 +83,9 @@ def fit(args: argparse.Namespace) -> None:
     config = load_train_config(args.config, args.set)
     demos = Demonstrations.load(args.demos)
     validation = held_out_rows(demos, args.validation_fraction)
-    model, vec_normalize, result = distill(config, demos, validation, **_fit_settings(args))
+    model, vec_normalize, result, settings = distill(
+        config, demos, validation, **_fit_settings(args)
+    )
     for epoch, train_cost, val_cost in result.history[:: max(1, args.epochs // 20)]:
         print(
             f"epoch {epoch:4d}: mean cycle cost: training {train_cost:.5f}, held out {val_cost:.5f}"
@@ -109,6 +111,7 @@ def fit(args: argparse.Namespace) -> None:
             "env_steps": demos.env_steps,
             **summary,
         },
+        env_settings=settings,
     )
     print(f"wrote {args.out}")
 
@@ -127,7 +130,7 @@ def curve(args: argparse.Namespace) -> None:
             )
             rows = validation | np.isin(demos.beds, chosen)
             subset = demos.subset(rows)
-            _, _, result = distill(config, subset, validation[rows], **_fit_settings(args))
+            _, _, result, _ = distill(config, subset, validation[rows], **_fit_settings(args))
             costs.append(result.best_cost)
         print(
             f"{len(chosen)} training beds: held-out cost {np.mean(costs):.5f} "

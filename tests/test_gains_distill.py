@@ -10,6 +10,7 @@ from test_athena_posture_study import _script
 
 import hexapod_envs  # noqa: F401
 from agents.gains_lookahead import CycleCost, gain_grid
+from agents.pipeline.env_settings import read_settings
 from agents.pipeline.envs import EnvSpec
 from agents.pipeline.gains_distill import (
     Demonstrations,
@@ -163,6 +164,8 @@ def test_script_collects_fits_and_the_model_runs_in_the_evaluation(tmp_path, cap
             str(model_dir),
         ]
     )
+    recorded = read_settings(model_dir)  # the evaluation compares it with the env it runs on
+    assert recorded["terrain"] == "blocks" and recorded["terrain_scan"] is True
     env = gym.make(
         "HexapodIrregularTerrain-v0",
         terrain="blocks",

@@ -196,6 +196,7 @@ def test_evaluate_smoke_writes_json_markdown_and_html_rows(run, tmp_path, capsys
     assert f"- `{ppo}` vs the analytical controller (`analytical`): success" in md
     assert "data:image/png;base64," in page and "<img" in page
     assert metrics["envs"]["HexapodCliffWalk-v0"]["comparisons"]
+    assert metrics["references"] == ["analytical", "zero"]  # the defaults: the suite names none
 
 
 def test_identical_seeds_give_identical_episodes_across_policies(tmp_path):

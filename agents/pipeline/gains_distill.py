@@ -303,17 +303,17 @@ def held_out_rows(demos: Demonstrations, fraction: float) -> np.ndarray:
 
 
 def distill(config, demos: Demonstrations, validation: np.ndarray, **fit_kwargs):
-    """(model, its VecNormalize or None, `FitResult`): a new PPO model of the training config
-    `config` (`agents.pipeline.train_config.TrainConfig`, gains mode, plain hybrid residual)
-    whose observation statistics are those of the training rows and whose actor is fitted by
-    `fit_actor` (``fit_kwargs``)."""
+    """(model, its VecNormalize or None, `FitResult`, the env's resolved settings): a new PPO
+    model of the training config `config` (`agents.pipeline.train_config.TrainConfig`, gains
+    mode, plain hybrid residual) whose observation statistics are those of the training rows and
+    whose actor is fitted by `fit_actor` (``fit_kwargs``)."""
     from .model_files import NormalizationStats
     from .training import untrained_model
 
     hybrid = config.hybrid
     if hybrid is None or hybrid.mode != "residual" or hybrid.safety_filter:
         raise ValueError("distilling needs a config whose hybrid section is the plain residual")
-    model = untrained_model(config)
+    model, settings = untrained_model(config)
     vec_normalize = model.get_vec_normalize_env()
     observations = demos.observations
     if vec_normalize is not None and vec_normalize.norm_obs:
@@ -325,4 +325,4 @@ def distill(config, demos: Demonstrations, validation: np.ndarray, **fit_kwargs)
         observations = stats.normalize_obs(observations)
     fit_kwargs.setdefault("seed", config.train.seed)
     result = fit_actor(model.policy, observations, demos, hybrid.scale, validation, **fit_kwargs)
-    return model, vec_normalize, result
+    return model, vec_normalize, result, settings

@@ -435,6 +435,7 @@ def build_metrics(result: SuiteResult) -> dict[str, Any]:
         "seeds": suite.seeds,
         "xi_f_deg": suite.xi_f_deg,
         "policies": suite.policies,
+        "references": list(suite.reference_names),  # what the comparisons are against
         "warnings": result.warnings,
         "envs": envs,
     }
