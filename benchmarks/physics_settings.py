@@ -45,7 +45,12 @@ used); the integrator and solver options through the env's ``integrator``, ``sol
 (ATHENA on blocks, a sampled task) gets them too; every reset here is followed by
 `check_options`, which raises if the model does not carry the setting.
 
-Run: python benchmarks/physics_settings.py [--quick] [--robot heavy-duty|athena|3-upu]
+Convergence (``--finer``): the default against half and a quarter of its timestep, on the same
+rows. A finer step is the better-resolved physics, so a row that it moves beyond the tolerance is
+one the default itself does not resolve: its value is partly a discretization effect (see
+benchmarks/README.md for the rows that are).
+
+Run: python benchmarks/physics_settings.py [--quick] [--finer] [--robot heavy-duty|athena|3-upu]
 (about 17 minutes on one core, 15 of them ATHENA's; ``--quick``: 4 settings, shorter runs,
 about 1 minute).
 """
@@ -106,8 +111,15 @@ class PhysicsSetting:
 DEFAULT = PhysicsSetting()
 
 
-def candidate_settings(quick: bool) -> list[PhysicsSetting]:
-    """The sweep; the default comes first (every comparison is against it)."""
+FINER = (PhysicsSetting(0.5), PhysicsSetting(0.25))
+"""The convergence check (`--finer`): half and a quarter of the default timestep."""
+
+
+def candidate_settings(quick: bool, finer: bool = False) -> list[PhysicsSetting]:
+    """The sweep; the default comes first (every comparison is against it). `finer`: only the
+    default and `FINER`, the question being whether the default is converged, not faster."""
+    if finer:
+        return [DEFAULT, *FINER]
     if quick:
         return [DEFAULT, PhysicsSetting(2.0), PhysicsSetting(4.0), PhysicsSetting(1.0, "euler")]
     return [
@@ -133,7 +145,9 @@ _DT_CACHE: dict[tuple[str, float], float] = {}
 
 def physics_dt_for(env_id: str, factor: float) -> float:
     """The allowed ``physics_dt`` nearest to `factor` x the env's default on a log scale (ties
-    to the smaller timestep): ``control_dt`` / n for a whole n that the env accepts."""
+    to the smaller timestep): ``control_dt`` / n for a whole n that the env accepts, from one
+    substep per control period down to 1/8 of the default timestep (`factor` < 1: a finer
+    step, the convergence check of `--finer`)."""
     key = (env_id, factor)
     if key in _DT_CACHE:
         return _DT_CACHE[key]
@@ -144,7 +158,8 @@ def physics_dt_for(env_id: str, factor: float) -> float:
     if factor != 1.0:
         target = control_dt / (default_dt * factor)  # substeps wanted (may be fractional)
         n_default = round(control_dt / default_dt)
-        order = sorted(range(1, n_default + 1), key=lambda n: (abs(math.log(n / target)), -n))
+        candidates = range(1, 8 * n_default + 1)
+        order = sorted(candidates, key=lambda n: (abs(math.log(n / target)), -n))
         for n in order:
             try:
                 gym.make(env_id, physics_dt=control_dt / n).close()
@@ -672,6 +687,10 @@ def report(rows: list[dict], robot: str, settings: list[PhysicsSetting]) -> dict
     fid = [r for r in rows if r["kind"] == "fidelity" and r["robot"] == robot]
     if not fid:
         return {"robot": robot}
+    for s in (s for s in settings if s.factor < 1.0):
+        changed = [r["row"] for r in fid if r["setting"] == s and not r["holds"]]
+        verdict = "; ".join(changed) if changed else "none: the default is converged in every row"
+        print(f"convergence ({s.label}): rows whose value moves beyond tolerance: {verdict}")
     print(f"\n--- {robot}: fidelity (compared with the default setting in this run)")
     for name in dict.fromkeys(r["row"] for r in fid):
         mine = [r for r in fid if r["row"] == name]
@@ -709,11 +728,16 @@ def report(rows: list[dict], robot: str, settings: list[PhysicsSetting]) -> dict
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="4 settings, shorter runs")
+    parser.add_argument(
+        "--finer",
+        action="store_true",
+        help="convergence check: the default against 1/2 and 1/4 of its timestep",
+    )
     parser.add_argument("--robot", choices=sorted(ROBOTS), action="append", help="repeatable")
     parser.add_argument("--seconds", type=float, help="simulated s per speed figure")
     parser.add_argument("--repeats", type=int, help="repeats per speed figure (best is kept)")
     args = parser.parse_args()
-    settings = candidate_settings(args.quick)
+    settings = candidate_settings(args.quick, args.finer)
     seconds = args.seconds or (2.0 if args.quick else 8.0)
     repeats = args.repeats or (2 if args.quick else 3)
     start = time.perf_counter()

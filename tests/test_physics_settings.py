@@ -62,3 +62,16 @@ def test_athena_fidelity_includes_the_servo_dependent_reproduction_rows():
         assert not f.compare((high + 1.0, low, high), f.value)
     (touched,) = [f for f in rows if "torso contact" in f.name]
     assert touched.value in range(5)
+
+
+def test_finer_timesteps_for_the_convergence_check():
+    # --finer compares the default with 1/2 and 1/4 of its timestep; each must be an allowed
+    # one (a whole number of substeps per control period, ATHENA's a multiple of 5).
+    from benchmarks.physics_settings import DEFAULT, FINER, candidate_settings, physics_dt_for
+
+    assert candidate_settings(quick=False, finer=True) == [DEFAULT, *FINER]
+    assert [s.factor for s in FINER] == [0.5, 0.25]
+    assert math.isclose(physics_dt_for("HexapodDitchCrossing-v0", 0.25), 0.0005)
+    assert math.isclose(physics_dt_for("HexapodIrregularTerrain-v0", 0.5), 0.05 / 40)
+    assert math.isclose(physics_dt_for("HexapodIrregularTerrain-v0", 0.25), 0.05 / 80)
+    assert math.isclose(physics_dt_for("HexapodCliffWalk-v0", 0.25), 0.00025)

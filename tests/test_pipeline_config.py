@@ -52,6 +52,20 @@ def test_default_suite_names_all_four_envs_and_shipped_models():
     assert suite.output_dir == "reports/default" and suite.missing_models == "skip"
 
 
+@pytest.mark.parametrize("path", sorted(CONFIGS.glob("evaluate_*.yaml")), ids=lambda p: p.name)
+def test_every_shipped_evaluation_suite_loads_and_names_existing_models(path):
+    # The suites behind the committed reports must stay runnable as the README quotes them.
+    suite = load_suite(path)
+    root = CONFIGS.parent
+    for env in suite.envs:
+        for name in suite.policies:
+            if name.startswith("ppo:"):
+                model_dir = root / name[len("ppo:") :].replace("{env_id}", env.id)
+                assert (model_dir / "model.zip").is_file() or suite.missing_models == "skip", (
+                    f"{path.name}: {name} has no model for {env.id}"
+                )
+
+
 @pytest.mark.parametrize(
     ("override", "path", "valid"),
     [
