@@ -328,10 +328,14 @@ DITCHES = (  # (id, width m, depth m, action mode, seed): the paper's and two ot
 )
 
 
-def ditch_rows() -> list[dict]:
+def ditch_rows(env_kwargs: dict | None = None) -> list[dict]:
     """Rows 13-14 (Li et al. 2018 §5-7): flat-walk static margin; the paper's 350 x 140 mm ditch
-    and two other sizes crossed with a positive margin at every control step."""
-    flat = ditch_episode(seed=2, terrain="flat", action_mode="joint")
+    and two other sizes crossed with a positive margin at every control step. With
+    `env_kwargs` (e.g. UPU_FINER_STEP) the row ids get the suffix "@" + the kwargs."""
+    extra = dict(env_kwargs or {})
+    tag = _tag(extra)
+    shown = f" {extra}" if extra else ""
+    flat = ditch_episode(seed=2, terrain="flat", action_mode="joint", **extra)
     rows = [
         _row(
             "13",
@@ -342,14 +346,16 @@ def ditch_rows() -> list[dict]:
             "mm",
             "> 0",
             flat["success"] and flat["min_margin_m"] > 0,
-            "HexapodDitchCrossing-v0 terrain=flat, joint mode, UpuGaitPolicy, seed 2",
+            f"HexapodDitchCrossing-v0 terrain=flat{shown}, joint mode, UpuGaitPolicy, seed 2",
         ),
     ]
     for id_, width, depth, mode, seed in DITCHES:
-        r = ditch_episode(seed=seed, action_mode=mode, ditch_width=width, ditch_depth=depth)
+        r = ditch_episode(
+            seed=seed, action_mode=mode, ditch_width=width, ditch_depth=depth, **extra
+        )
         rows.append(
             _row(
-                id_,
+                id_ + tag,
                 "003",
                 f"{width * 1e3:.0f} mm wide x {depth * 1e3:.0f} mm deep ditch "
                 "crossed (min static margin)",
@@ -358,11 +364,30 @@ def ditch_rows() -> list[dict]:
                 "mm",
                 "crossed, margin > 0 at every step",
                 r["success"] and r["min_margin_m"] > 0,
-                f"HexapodDitchCrossing-v0 {mode} mode, UpuGaitPolicy, seed {seed}; "
+                f"HexapodDitchCrossing-v0{shown} {mode} mode, UpuGaitPolicy, seed {seed}; "
                 f"planner status {r['status']}",
             )
         )
+    rows[0]["id"] += tag
     return rows
+
+
+UPU_FINER_STEP = {"physics_dt": 0.0005}
+ATHENA_FINER_STEP = {"physics_dt": 0.000625}
+"""A quarter of the 3-UPU's and ATHENA's default physics steps (2 ms, 2.5 ms): rows with these
+suffixes show which results are the default step's discretization (`python
+benchmarks/physics_settings.py --finer`). The heavy-duty robot's rows are converged at its 1 ms
+step (its 0.25 ms step changes none of the env's outcomes), so it has no such rows."""
+
+
+def ditch_finer_step_rows() -> list[dict]:
+    """Rows 13-14 again at a quarter of the 3-UPU's default step."""
+    return ditch_rows(env_kwargs=UPU_FINER_STEP)
+
+
+def athena_finer_step_rows() -> list[dict]:
+    """Rows 8-11d again at a quarter of ATHENA's default step."""
+    return athena_rows(env_kwargs=ATHENA_FINER_STEP)
 
 
 @functools.cache
@@ -766,8 +791,13 @@ FULL = {
         stewart_stop_rows,
         stewart_eq15_rows,
     ),
-    "002": (athena_rows, athena_block_beds_rows, athena_previous_default_rows),
-    "003": (upu_kinematics_rows, ditch_rows),
+    "002": (
+        athena_rows,
+        athena_block_beds_rows,
+        athena_previous_default_rows,
+        athena_finer_step_rows,
+    ),
+    "003": (upu_kinematics_rows, ditch_rows, ditch_finer_step_rows),
 }
 
 
@@ -812,7 +842,11 @@ NOTES = (
     "control drags its torso on the slope, which damps its roll, and posture control's roll-rate "
     "RMS ends 5.5 % above it (+1.9 % at the former 2 ms step). With the previous default (kp 8, "
     "rows @servo_kp=8.0) rows 9 and 10 hold (-15.4 %, -34.0 %) but the height gain is only "
-    "+15 % (row 8) and the sag 0.089 m: no single stiffness reproduces all four ramp rows.",
+    "+15 % (row 8) and the sag 0.089 m: no single stiffness reproduces all four ramp rows. The "
+    "row is also the physics step's: posture control's ramp roll-rate RMS falls as the step "
+    "shrinks (0.0445 rad/s at 2.5 ms, 0.0391 at 0.625 ms), and at a quarter of the default step "
+    "(rows @physics_dt=0.000625) row 9 holds; the change is -2.5 % at 1.25 ms and -8.4 % at "
+    "0.3125 ms (benchmarks/README.md, convergence of the default timesteps).",
     "11, 11b, 11c (blocks): on the calibrated bed (0.25 m blocks, env default; the paper gives no "
     "size) posture control touches in 1 of seeds 0-3 (5 steps) and on 10 of 20 beds (rows "
     "@seeds 0-19: 673 steps against the simple controller's 15273), so it keeps the torso off "
@@ -833,6 +867,14 @@ NOTES = (
     "cases recover, with a "
     "margin of 15.2 deg 0.5 s after landing (paper 21.5). The env default stays 1.95 m with "
     "the kinematic reach model, on which the shipped agents were trained.",
+    "14, 14c @physics_dt=0.0005 (3-UPU, a quarter of the default 2 ms step): the reference gait "
+    "tips on the paper's ditch at 97.8 s and on the 450 x 150 mm ditch; it crosses at every "
+    "step from 0.8 to 2.5 ms. When the lower platform lifts its legs the robot stands on the "
+    "upper platform's feet with the CoG 14 mm inside their triangle; at the finer step the legs "
+    "U2 and U3 give under the shifted load, the platform sinks onto L1 (on the ditch floor) and "
+    "rolls over. The default step's numerical damping of the servos holds that thin margin; on "
+    "the 20 test tasks of the shipped report the planner succeeds on 5 instead of 16 at 0.5 ms "
+    "(reports/ditch_finer_physics), the learned agents on 19 and 18.",
     "4 (cliff): our gait starts walking at 3 s and meets the cliff earlier than the paper's, so "
     "the absolute times differ; the order (judgment before the tip-over) holds.",
 )
