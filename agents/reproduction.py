@@ -874,7 +874,7 @@ NOTES = (
     "U2 and U3 give under the shifted load, the platform sinks onto L1 (on the ditch floor) and "
     "rolls over. The default step's numerical damping of the servos holds that thin margin; on "
     "the 20 test tasks of the shipped report the planner succeeds on 5 instead of 16 at 0.5 ms "
-    "(reports/ditch_finer_physics), the learned agents on 19 and 18.",
+    "(reports/finer_physics), the learned agents on 19 and 18.",
     "4 (cliff): our gait starts walking at 3 s and meets the cliff earlier than the paper's, so "
     "the absolute times differ; the order (judgment before the tip-over) holds.",
 )

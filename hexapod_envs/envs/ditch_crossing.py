@@ -170,6 +170,10 @@ class DitchCrossingSettings(EnvSettings):
     reward_class = DitchCrossingRewardScales
     control_dt: float = number(0.1, strict=True)
     physics_dt: float = number(0.002, strict=True)
+    """MuJoCo timestep [s]. The reference gait crosses the paper's ditch at every step from
+    2.5 down to 0.8 ms (4 ms tips early) and tips at 0.667 ms and finer
+    (benchmarks/physics_settings.py ``--finer``): its 14 mm margin while the lower platform
+    lifts is held by this step's numerical damping of the servos."""
     contact_threshold: float = number(0.005, strict=True, high=1.0)
     """A foot's pressure switch reads loaded above this fraction of the weight."""
     tipping_threshold_deg: float = number(0.0, high=90.0)

@@ -244,7 +244,9 @@ class IrregularTerrainSettings(EnvSettings):
     """MuJoCo timestep [s]: 2.5 ms, the coarsest step at which every ATHENA fidelity row of
     benchmarks/physics_settings.py holds (the ramp's pitch- and roll-rate RMS within 5 % of
     their 2 ms values, the simple control's sag, the block-bed rate changes and contacts); 1.3x the
-    simulated seconds per wall second of ``physics_dt=0.002``, the default before 2026-11-25."""
+    simulated seconds per wall second of ``physics_dt=0.002``, the default before 2026-11-25.
+    Not converged in one row: posture control's ramp roll-rate RMS is 12 % lower at 0.625 ms
+    (0.0391 against 0.0445 rad/s; `physics_settings.py --finer`)."""
     contact_threshold: float = number(CONTACT_FORCE_N / (ATHENA.total_mass * 9.81), high=1.0)
     """A foot is loaded above this fraction of the weight (default: 0.5 N)."""
     tipping_threshold_deg: float = number(10.0, high=90.0)
