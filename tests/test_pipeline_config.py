@@ -120,6 +120,15 @@ def test_bad_values_are_named(override, match):
         load_train_config(CONFIGS / "cliff_walk_ppo.yaml", [override])
 
 
+def test_unquoted_braces_in_an_override_get_a_quoting_hint():
+    with pytest.raises(ConfigError, match=r"quote strings that contain \{ or \}"):
+        load_suite(CONFIGS / "evaluate_default.yaml", ["policies=[ppo:models/{env_id}/ppo, zero]"])
+    quoted = load_suite(
+        CONFIGS / "evaluate_default.yaml", ['policies=["ppo:models/{env_id}/ppo", zero]']
+    )
+    assert quoted.policies == ["ppo:models/{env_id}/ppo", "zero"]
+
+
 def test_missing_required_key_is_named():
     with pytest.raises(ConfigError, match="missing required key 'env.id'"):
         from_mapping(TrainConfig, {"env": {}})

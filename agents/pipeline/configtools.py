@@ -209,7 +209,13 @@ def parse_override(text: str) -> tuple[list[str], Any]:
     try:
         value = yaml.safe_load(raw) if raw.strip() else None
     except yaml.YAMLError as exc:
-        raise ConfigError(f"override {text!r}: value is not valid YAML: {exc}") from None
+        hint = ""
+        if any(c in raw for c in "{}"):  # e.g. policies=[ppo:models/{env_id}/ppo]
+            hint = (
+                "; quote strings that contain { or } (YAML reads them as mappings), e.g. "
+                "--set 'policies=[\"ppo:models/{env_id}/ppo\", zero]'"
+            )
+        raise ConfigError(f"override {text!r}: value is not valid YAML{hint}: {exc}") from None
     return key.split("."), value
 
 
