@@ -305,3 +305,17 @@ def test_body_model_float_code_is_bit_identical_to_array_expressions():
         assert new_cog.tobytes() == cog.tobytes() == body.cog(joints).tobytes()
         new_change = body.target_change_for_force(joints, delta_force, legs=legs)
         assert new_change.tobytes() == change.tobytes()
+
+
+def test_null_space_solve_is_numpys_to_the_bit_and_refuses_a_singular_matrix():
+    # The supported phase projects the force error with the gesv gufunc behind np.linalg.solve
+    # (its wrapper cost ~10 µs per step); the numbers must be np.linalg.solve's exactly.
+    from agents.tipping.controller import _solve
+
+    rng = np.random.default_rng(3)
+    for _ in range(200):
+        a_mat = rng.normal(size=(6, 3 * int(rng.integers(3, 7))))
+        m, v = a_mat @ a_mat.T, a_mat @ rng.normal(size=a_mat.shape[1])
+        assert np.array_equal(_solve(m, v), np.linalg.solve(m, v))
+    with pytest.warns(RuntimeWarning), pytest.raises(np.linalg.LinAlgError, match="Singular"):
+        _solve(np.zeros((6, 6)), np.ones(6))

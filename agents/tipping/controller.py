@@ -102,6 +102,28 @@ contact; landed and distributing forces; holding the posture without a landed ad
 _LEG_INDEX = {leg: i for i, leg in enumerate(LEG_NAMES)}
 _RETRY_NARROWER = 25  # QP solves between attempts at a narrower stability cone
 
+try:  # the LAPACK gesv gufunc behind np.linalg.solve: the same numbers, minus its Python wrapper
+    from numpy.linalg._umath_linalg import solve1 as _gesv
+except ImportError:  # pragma: no cover - a numpy without it
+    _gesv = None
+
+
+def _solve(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """np.linalg.solve(a, b) for a square float64 `a` and a vector `b`, bit for bit.
+
+    Why: in the recovery's supported phase np.linalg.solve's wrapper (type and shape checks, an
+    errstate context) cost about 10 µs of the median 190 µs controller step
+    (benchmarks/bench_recovery_controller.py); the gufunc is the same LAPACK call. A singular
+    `a` makes it return non-finite values (with numpy's RuntimeWarning) where the wrapper raises
+    LinAlgError; the error is raised here too.
+    """
+    if _gesv is None:  # pragma: no cover
+        return np.linalg.solve(a, b)
+    x = _gesv(a, b, signature="dd->d")
+    if not math.isfinite(x.sum()):
+        raise np.linalg.LinAlgError("Singular matrix")
+    return x
+
 
 @dataclass(frozen=True)
 class RecoveryConfig:
@@ -595,7 +617,7 @@ class TippingRecoveryController:
                 # Internal part: error - Aᵀ (A Aᵀ)⁻¹ A error (A has full row rank, k >= 3).
                 a_mat = self._last_qp_a
                 error = (result.forces - measured).reshape(-1)
-                internal = error - a_mat.T @ np.linalg.solve(a_mat @ a_mat.T, a_mat @ error)
+                internal = error - a_mat.T @ _solve(a_mat @ a_mat.T, a_mat @ error)
                 change = self.body.target_change_for_force(
                     joints, internal.reshape(-1, 3), legs=support
                 )
