@@ -338,7 +338,7 @@ def ditch_rows(env_kwargs: dict | None = None) -> list[dict]:
     flat = ditch_episode(seed=2, terrain="flat", action_mode="joint", **extra)
     rows = [
         _row(
-            "13",
+            "13" + tag,
             "003",
             "flat walk minimum static margin",
             "> 0",
@@ -368,16 +368,15 @@ def ditch_rows(env_kwargs: dict | None = None) -> list[dict]:
                 f"planner status {r['status']}",
             )
         )
-    rows[0]["id"] += tag
     return rows
 
 
+# A quarter of the 3-UPU's and ATHENA's default physics steps (2 ms, 2.5 ms): rows with these
+# suffixes show which results are the default step's discretization (`python
+# benchmarks/physics_settings.py --finer`). The heavy-duty robot's rows are converged at its 1 ms
+# step (its 0.25 ms step changes none of the env's outcomes), so it has no such rows.
 UPU_FINER_STEP = {"physics_dt": 0.0005}
 ATHENA_FINER_STEP = {"physics_dt": 0.000625}
-"""A quarter of the 3-UPU's and ATHENA's default physics steps (2 ms, 2.5 ms): rows with these
-suffixes show which results are the default step's discretization (`python
-benchmarks/physics_settings.py --finer`). The heavy-duty robot's rows are converged at its 1 ms
-step (its 0.25 ms step changes none of the env's outcomes), so it has no such rows."""
 
 
 def ditch_finer_step_rows() -> list[dict]:
@@ -874,7 +873,7 @@ NOTES = (
     "U2 and U3 give under the shifted load, the platform sinks onto L1 (on the ditch floor) and "
     "rolls over. The default step's numerical damping of the servos holds that thin margin; on "
     "the 20 test tasks of the shipped report the planner succeeds on 5 instead of 16 at 0.5 ms "
-    "(reports/finer_physics), the learned agents on 19 and 18.",
+    "(reports/finer_physics), the hybrid agent on 19 and PPO on 18.",
     "4 (cliff): our gait starts walking at 3 s and meets the cliff earlier than the paper's, so "
     "the absolute times differ; the order (judgment before the tip-over) holds.",
 )

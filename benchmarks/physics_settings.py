@@ -52,7 +52,8 @@ benchmarks/README.md for the rows that are).
 
 Run: python benchmarks/physics_settings.py [--quick] [--finer] [--robot heavy-duty|athena|3-upu]
 (about 17 minutes on one core, 15 of them ATHENA's; ``--quick``: 4 settings, shorter runs,
-about 1 minute).
+about 1 minute; ``--finer --seconds 2 --repeats 1``: heavy-duty and 3-UPU about 1 minute,
+ATHENA about 5). Under ``--finer`` no recommendation is printed.
 """
 
 from __future__ import annotations
@@ -663,6 +664,20 @@ def _fmt(value) -> str:
     return str(value)
 
 
+def convergence(fid: list[dict], settings: list[PhysicsSetting]) -> None:
+    """Print, per finer-than-default setting, the rows its better-resolved physics moves beyond
+    tolerance (the default does not resolve them) and, apart, the rows whose finer run failed
+    (unstable, or the episode ended early): those say nothing about convergence."""
+    for s in (s for s in settings if s.factor < 1.0):
+        mine = [r for r in fid if r["setting"] == s and not r["holds"]]
+        failed = [r["row"] for r in mine if r["fidelity"].failed]
+        moved = [r["row"] for r in mine if not r["fidelity"].failed]
+        verdict = "; ".join(moved) if moved else "none: the default is converged in every row"
+        print(f"convergence ({s.label}): rows whose value moves beyond tolerance: {verdict}")
+        if failed:
+            print(f"convergence ({s.label}): runs that failed (no verdict): {'; '.join(failed)}")
+
+
 def report(rows: list[dict], robot: str, settings: list[PhysicsSetting]) -> dict:
     """Print the robot's speed and fidelity tables; return its recommendation."""
     speed = [r for r in rows if r["kind"] == "speed" and r["robot"] == robot]
@@ -687,10 +702,6 @@ def report(rows: list[dict], robot: str, settings: list[PhysicsSetting]) -> dict
     fid = [r for r in rows if r["kind"] == "fidelity" and r["robot"] == robot]
     if not fid:
         return {"robot": robot}
-    for s in (s for s in settings if s.factor < 1.0):
-        changed = [r["row"] for r in fid if r["setting"] == s and not r["holds"]]
-        verdict = "; ".join(changed) if changed else "none: the default is converged in every row"
-        print(f"convergence ({s.label}): rows whose value moves beyond tolerance: {verdict}")
     print(f"\n--- {robot}: fidelity (compared with the default setting in this run)")
     for name in dict.fromkeys(r["row"] for r in fid):
         mine = [r for r in fid if r["row"] == name]
@@ -700,6 +711,7 @@ def report(rows: list[dict], robot: str, settings: list[PhysicsSetting]) -> dict
             note = f"  {f.note}" if f.note else ""
             flag = "holds" if r["holds"] else "FAILS"
             print(f"    {r['setting'].label:36s} {_fmt(r['value']):>22s}  {flag}{note}")
+    convergence(fid, settings)
     holding = [
         s
         for s in scores
@@ -723,6 +735,25 @@ def report(rows: list[dict], robot: str, settings: list[PhysicsSetting]) -> dict
         "rows": sum(r["setting"] == best for r in fid),
         "note": note,
     }
+
+
+def print_recommendations(recommendations: list[dict]) -> None:
+    """The per-robot recommendations of `report` as one table."""
+    print("\n=== recommendation: the fastest setting at which every fidelity row holds")
+    print(f"(the default unless another is at least x{MIN_SPEEDUP:g} as fast)")
+    print(
+        f"{'robot':11s} {'setting':36s} {'dt ms':>6s} {'of default':>10s} {'sim s/wall s':>12s} "
+        f"{'x':>5s}  rows"
+    )
+    for b in recommendations:
+        if "setting" not in b:
+            print(f"{b['robot']:11s} none (no setting holds every row)")
+            continue
+        print(
+            f"{b['robot']:11s} {b['setting'].label:36s} {b['physics_dt'] * 1e3:6.3g} "
+            f"{'x%.3g' % (b['physics_dt'] / b['default_dt']):>10s} "
+            f"{b['score']:12.1f} {b['x']:5.2f}  all {b['rows']} hold{b['note']}"
+        )
 
 
 def main() -> None:
@@ -754,21 +785,8 @@ def main() -> None:
         judge(rows)
         recommendations.append(report(rows, robot, settings))
         print(f"({robot}: {time.perf_counter() - t0:.0f} s wall)")
-    print("\n=== recommendation: the fastest setting at which every fidelity row holds")
-    print(f"(the default unless another is at least x{MIN_SPEEDUP:g} as fast)")
-    print(
-        f"{'robot':11s} {'setting':36s} {'dt ms':>6s} {'of default':>10s} {'sim s/wall s':>12s} "
-        f"{'x':>5s}  rows"
-    )
-    for b in recommendations:
-        if "setting" not in b:
-            print(f"{b['robot']:11s} none (no setting holds every row)")
-            continue
-        print(
-            f"{b['robot']:11s} {b['setting'].label:36s} {b['physics_dt'] * 1e3:6.3g} "
-            f"{'x%.3g' % (b['physics_dt'] / b['default_dt']):>10s} "
-            f"{b['score']:12.1f} {b['x']:5.2f}  all {b['rows']} hold{b['note']}"
-        )
+    if not args.finer:  # finer steps are slower: the question there is convergence, not speed
+        print_recommendations(recommendations)
     print(f"\n{len(warnings)} MuJoCo instability warnings (not printed); ", end="")
     print(f"total {time.perf_counter() - start:.0f} s wall")
 

@@ -212,8 +212,8 @@ def parse_override(text: str) -> tuple[list[str], Any]:
         hint = ""
         if any(c in raw for c in "{}"):  # e.g. policies=[ppo:models/{env_id}/ppo]
             hint = (
-                "; quote strings that contain { or } (YAML reads them as mappings), e.g. "
-                "--set 'policies=[\"ppo:models/{env_id}/ppo\", zero]'"
+                "; if the { } are meant as text, quote the string (YAML reads { } as a "
+                "mapping), e.g. --set 'policies=[\"ppo:models/{env_id}/ppo\", zero]'"
             )
         raise ConfigError(f"override {text!r}: value is not valid YAML{hint}: {exc}") from None
     return key.split("."), value

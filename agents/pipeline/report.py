@@ -435,7 +435,8 @@ def build_metrics(result: SuiteResult) -> dict[str, Any]:
         "seeds": suite.seeds,
         "xi_f_deg": suite.xi_f_deg,
         "policies": suite.policies,
-        "references": list(suite.reference_names),  # what the comparisons are against
+        # the policies the comparisons are against (those of the suite's references that ran)
+        "references": [r for r in suite.reference_names if r in suite.policies],
         "warnings": result.warnings,
         "envs": envs,
     }
