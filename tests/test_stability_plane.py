@@ -86,3 +86,17 @@ def test_point_lies_on_the_plane_and_plane_is_frozen():
 def test_fit_plane_errors(points, message):
     with pytest.raises(ValueError, match=message):
         fit_plane(points)
+
+
+def test_plane_normal_is_fit_planes_normal_or_none_where_it_raises():
+    from hexapod_envs.stability import plane_normal
+
+    rng = np.random.default_rng(5)
+    for k in (3, 4, 6):
+        pts = rng.normal(size=(k, 3))
+        assert np.array_equal(plane_normal(pts), fit_plane(pts).normal)
+    collinear = np.array([[0.0, 0.0, 0.0], [1.0, 1.0, 0.2], [2.0, 2.0, 0.1]])
+    with pytest.raises(ValueError):
+        fit_plane(collinear)
+    assert plane_normal(collinear) is None
+    assert plane_normal(np.array([[0.0, 0.0, np.nan], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])) is None

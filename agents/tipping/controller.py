@@ -50,6 +50,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field, replace
+from itertools import compress
 from typing import Any
 
 import gymnasium as gym
@@ -69,7 +70,6 @@ from agents.tipping.foothold import (
     RHO,
     FootholdChoice,
     select_foothold,
-    terrain_plane,
 )
 from agents.tipping.force_distribution import (
     SOLVERS,
@@ -92,7 +92,7 @@ from hexapod_envs.checks import check_number
 from hexapod_envs.envs.base import JointActionMap
 from hexapod_envs.robots.heavy_duty.kinematics import joints_for_foot
 from hexapod_envs.robots.heavy_duty.params import LEG_NAMES, HeavyDutyParams
-from hexapod_envs.stability import fasm_from_feet
+from hexapod_envs.stability import fasm_from_feet, plane_normal
 
 PHASES: tuple[str, ...] = ("monitor", "swing", "touchdown", "supported", "holding")
 """Controller phases: watching the margin; adjustment leg on its quintic; descending until
@@ -346,13 +346,6 @@ class TippingRecoveryController:
             self._accel_f += alpha * (accel - self._accel_f)
             self._gyro_f += alpha * (gyro - self._gyro_f)
 
-    def _margin(self, feet, forces, cog, loaded) -> tuple[float, tuple[int, int] | None]:
-        """FASM [deg] over the loaded feet (body frame); (0, None) without a support polygon.
-
-        f_r and n_r are minus the measured support wrench about the CoG (Zhang et al. 2024 eq. 4).
-        """
-        return fasm_from_feet(feet, forces, cog, loaded)
-
     # --- main step -------------------------------------------------------------------------
     def step(self, reading: SensorReading, nominal: np.ndarray, time: float) -> np.ndarray:
         """(6, 3) joint targets for this control period."""
@@ -363,15 +356,15 @@ class TippingRecoveryController:
         feet, cog = self.body.feet_and_cog(joints)
         forces = forces_to_body(reading.foot_forces, rot)
         loaded = np.add.reduce(forces * forces, axis=1) > self._contact_sq  # .sum(axis=1)
-        margin, edge = self._margin(feet, forces, cog, loaded)
+        # FASM [deg] over the loaded feet (body frame), (0, None) without a support polygon; f_r
+        # and n_r are minus the measured support wrench about the CoG (Zhang et al. 2024 eq. 4).
+        margin, edge = fasm_from_feet(feet, forces, cog, loaded)
         self.history.add(time, margin)
         d = self.diagnostics
         self._previous_margin = d["fasm_deg"]
         d["fasm_deg"] = margin
         d["fasm_edge"] = None if edge is None else (LEG_NAMES[edge[0]], LEG_NAMES[edge[1]])
-        d["stance_legs"] = tuple(
-            leg for leg, on in zip(LEG_NAMES, loaded.tolist(), strict=True) if on
-        )
+        d["stance_legs"] = tuple(compress(LEG_NAMES, loaded.tolist()))
 
         if self.phase == "monitor":
             if margin < cfg.threshold_deg and time >= cfg.arm_after and loaded.sum() >= 3:
@@ -596,10 +589,8 @@ class TippingRecoveryController:
                 omega=self._gyro_f,
                 omega_dot=(self._gyro_f - self._gyro_prev) / self.control_dt,
             )
-            try:
-                normal = terrain_plane(feet_k).normal
-            except ValueError:  # the loaded feet lie on a line in (x, y): no plane to fit
-                normal = None
+            # None when the loaded feet lie on a line in (x, y): no plane to fit
+            normal = plane_normal(feet_k)
             result, cone_ratio = (
                 (None, None) if normal is None else self._solve_qp(feet_k, cog, wrench, normal)
             )

@@ -10,12 +10,13 @@ control step:
 - :func:`zmp`, :func:`zmp_margin` - force-weighted ZMP and its margin (Coelho et al. 2024 eqs.
 32-33).
 - :func:`nesm` - Hirose's normalised energy stability margin, metres.
-- :func:`fit_plane` - least-squares ground plane z = a x + b y + c (Zhang et al. 2024 §4.2).
+- :func:`fit_plane` - least-squares ground plane z = a x + b y + c (Zhang et al. 2024 §4.2);
+  :func:`plane_normal` - only its unit normal, for per-step callers.
 """
 
 from hexapod_envs.stability.fasm import FasmResult, fasm, fasm_from_feet
 from hexapod_envs.stability.nesm import nesm, nesm_per_edge
-from hexapod_envs.stability.plane_fit import Plane, fit_plane
+from hexapod_envs.stability.plane_fit import Plane, fit_plane, plane_normal
 from hexapod_envs.stability.static_margin import static_stability_margin
 from hexapod_envs.stability.support_polygon import support_polygon
 from hexapod_envs.stability.zmp import zmp, zmp_margin
@@ -28,6 +29,7 @@ __all__ = [
     "fit_plane",
     "nesm",
     "nesm_per_edge",
+    "plane_normal",
     "static_stability_margin",
     "support_polygon",
     "zmp",

@@ -86,3 +86,15 @@ def fit_plane(points) -> Plane:
         )
     a, b, c = coefficients.tolist()
     return Plane(a=a, b=b, c=c, normal=normal, point=point)
+
+
+def plane_normal(points: np.ndarray) -> np.ndarray | None:
+    """The unit normal of `fit_plane` for a float64 (k, 3) array with k >= 3, or None where
+    `fit_plane` raises (collinear, coincident or non-finite points).
+
+    For callers that fit a plane every control period and need only its normal (the tipping
+    recovery's force distribution): the same kernel and numbers, without the input checks and
+    the `Plane` object, which in that loop cost more than the fit.
+    """
+    status, _, normal, _ = _compiled.fit_plane(points)
+    return normal if status == _compiled.OK else None
