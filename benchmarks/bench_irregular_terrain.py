@@ -116,8 +116,14 @@ def main() -> None:
         print(f"{'Ant-v5':8s} {'(gym)':9s} {raw:14.0f} {env_rate:12.0f} {env_rate / raw:8.2f}")
     except Exception as exc:  # pragma: no cover - Ant needs gymnasium's mujoco extras
         print(f"Ant-v5 not measured: {exc}")
-    physics_us = 25 / env_vs_raw(ENV_ID, steps=1200, terrain="ramp", action_mode="joint")[0] * 1e6
-    print(f"\nphysics per 50 ms control step (25 x 2 ms mj_step, ramp): {physics_us:6.0f} us")
+    probe = gym.make(ENV_ID).unwrapped  # the default step (it was 2 ms, 25 substeps, until 11-25)
+    n, dt_ms, control_ms = probe.n_substeps, probe.physics_dt * 1e3, probe.control_dt * 1e3
+    probe.close()
+    physics_us = n / env_vs_raw(ENV_ID, steps=1200, terrain="ramp", action_mode="joint")[0] * 1e6
+    print(
+        f"\nphysics per {control_ms:g} ms control step ({n} x {dt_ms:g} ms mj_step, ramp): "
+        f"{physics_us:6.0f} us"
+    )
     print_posture_step()
     for name, us in env_piece_costs().items():
         print(f"env per step, {name:34s} {us:6.1f} us")
