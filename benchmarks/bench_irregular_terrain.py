@@ -116,7 +116,7 @@ def main() -> None:
         print(f"{'Ant-v5':8s} {'(gym)':9s} {raw:14.0f} {env_rate:12.0f} {env_rate / raw:8.2f}")
     except Exception as exc:  # pragma: no cover - Ant needs gymnasium's mujoco extras
         print(f"Ant-v5 not measured: {exc}")
-    probe = gym.make(ENV_ID).unwrapped  # the default step (it was 2 ms, 25 substeps, until 11-25)
+    probe = gym.make(ENV_ID).unwrapped  # the default step and substeps
     n, dt_ms, control_ms = probe.n_substeps, probe.physics_dt * 1e3, probe.control_dt * 1e3
     probe.close()
     physics_us = n / env_vs_raw(ENV_ID, steps=1200, terrain="ramp", action_mode="joint")[0] * 1e6

@@ -12,7 +12,7 @@ import hexapod_envs  # noqa: F401
 from agents.pipeline.configtools import apply_overrides, dump_yaml, from_mapping
 from agents.pipeline.episode import EpisodeAccumulator, MetricSpec, metric_specs
 from agents.pipeline.errors import ConfigError, UserError
-from agents.pipeline.eval_config import EvaluationSuite, load_suite
+from agents.pipeline.eval_config import PPO_PREFIX, EvaluationSuite, load_suite
 from agents.pipeline.schedules import Schedule, parse_schedule
 from agents.pipeline.summary import aggregate, compare, paired_difference_interval
 from agents.pipeline.train_config import TrainConfig, load_train_config
@@ -57,13 +57,13 @@ def test_every_shipped_evaluation_suite_loads_and_names_existing_models(path):
     # The suites behind the committed reports must stay runnable as the README quotes them.
     # A suite that skips missing models may name an env-specific agent (the gains agents exist
     # for the irregular terrain only), but every agent it names must exist for one of its envs.
+    from agents.pipeline.evaluation import _ppo_path
+
     suite = load_suite(path)
     root = CONFIGS.parent
-    for name in (n for n in suite.policies if n.startswith("ppo:")):
+    for name in (n for n in suite.policies if n.startswith(PPO_PREFIX)):
         found = [
-            env.id
-            for env in suite.envs
-            if (root / name[len("ppo:") :].replace("{env_id}", env.id) / "model.zip").is_file()
+            env.id for env in suite.envs if (root / _ppo_path(name, env.id) / "model.zip").is_file()
         ]
         assert found, f"{path.name}: {name} has no model for any of its envs"
         if suite.missing_models == "error":
