@@ -310,6 +310,7 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[
     warning lines."""
     _check_env_ids(suite)
     warnings: list[str] = []
+    skipped: dict[str, list[tuple[str, str]]] = {}  # policy -> [(env id, why)]
     prepared = []
     for suite_env in suite.envs:
         env = _env_spec(suite, suite_env).make()
@@ -326,7 +327,7 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[
         for name in suite.policies:
             missing = _missing_reason(name, suite_env.id)
             if missing and suite.missing_models == "skip":
-                warnings.append(f"{suite_env.id}: skipped {name} - {missing}")
+                skipped.setdefault(name, []).append((suite_env.id, missing))
                 continue
             extra = policy_env_kwargs(name, suite_env.id, suite_env.kwargs)
             key = tuple(sorted(extra.items()))
@@ -346,7 +347,23 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[
         for unused in (e for e in envs.values() if id(e) not in used):
             unused.close()
         prepared.append((result, policies))
-    return prepared, warnings
+    return prepared, warnings + _skip_lines(skipped, [r for r, _ in prepared])
+
+
+def _skip_lines(skipped: dict[str, list[tuple[str, str]]], results: list[EnvResult]) -> list[str]:
+    """Warning lines for the skipped policies: one per env, except for a per-env model path
+    that exists for some envs only (e.g. ``ppo:models/{env_id}/gains``), which gets one line."""
+    lines = []
+    for name, misses in skipped.items():
+        ran = [r.env_id for r in results if name in r.runs]
+        if "{env_id}" in name and ran:
+            lines.append(
+                f"{name} runs on {', '.join(ran)} only: no model at "
+                f"{name[len(PPO_PREFIX) :]} for {', '.join(env for env, _ in misses)}"
+            )
+        else:
+            lines.extend(f"{env}: skipped {name} - {why}" for env, why in misses)
+    return lines
 
 
 def run_suite(
