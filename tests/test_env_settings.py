@@ -105,6 +105,52 @@ def test_task_ranges_are_settings_a_user_can_widen():
         CliffTaskRanges(cliff_x=(3.0, 4.0), edge_y=(-1.0, -0.8), drop=(2.0, 1.0), friction=(1, 1))
 
 
+def test_task_ranges_take_a_mapping_as_a_yaml_config_gives_them():
+    # the named ranges replace the default's (lists as tuples), the others stay
+    env = gym.make(
+        "HexapodIrregularTerrain-v0",
+        task_distribution="train",
+        train_ranges={"friction": [0.3, 0.4], "slope_deg": [[2.0, 3.0], [16.0, 17.0]]},
+    )
+    ranges = env.unwrapped.settings.train_ranges
+    assert ranges == dataclasses.replace(
+        TERRAIN_TRAIN, friction=(0.3, 0.4), slope_deg=((2.0, 3.0), (16.0, 17.0))
+    )
+    tasks = [env.reset(seed=k)[1]["task"] for k in range(6)]
+    assert all(0.3 <= t["friction"] <= 0.4 for t in tasks)
+    assert all(2.0 <= t["slope_deg"] <= 3.0 or 16.0 <= t["slope_deg"] <= 17.0 for t in tasks)
+    one = gym.make("HexapodIrregularTerrain-v0", train_ranges={"slope_deg": [4.0, 5.0]})
+    assert one.unwrapped.settings.train_ranges.slope_deg == ((4.0, 5.0),)  # one interval
+
+
+@pytest.mark.parametrize(
+    "ranges, error, words",
+    [
+        ({"frction": [0.3, 0.4]}, TypeError, ["frction", "valid", "friction"]),
+        ({"friction": 0.5}, ValueError, ["train_ranges.friction", "(low, high) pair"]),
+        ({"sides": [1.0, 2.0]}, ValueError, ["train_ranges.sides", "list of names"]),
+        ({"drop": [3.0, 1.0]}, ValueError, ["drop", "low <= high"]),
+    ],
+)
+def test_bad_task_ranges_are_named(ranges, error, words):
+    with pytest.raises(error) as caught:
+        gym.make("HexapodCliffWalk-v0", train_ranges=ranges)
+    assert all(w in str(caught.value) for w in words), str(caught.value)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_a_recorded_settings_file_rebuilds_the_same_settings(env_id):
+    import yaml
+
+    from agents.pipeline.configtools import dump_yaml
+    from agents.pipeline.env_settings import resolved_settings
+
+    env = gym.make(env_id, task_distribution="train")
+    record = yaml.safe_load(dump_yaml(resolved_settings(env)))  # env_settings.yaml's content
+    assert isinstance(record["train_ranges"], dict)
+    assert gym.make(env_id, **record).unwrapped.settings == env.unwrapped.settings
+
+
 @pytest.mark.parametrize(
     "env_id, kwargs",
     [

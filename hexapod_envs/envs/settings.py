@@ -97,7 +97,8 @@ def numbers(
     optional: bool = False,
 ) -> Any:
     """A tuple of numbers (or of (low, high) pairs): each real, finite and in [`low`, `high`]
-    (``low=None``: any sign); `size` entries; `ordered`: each pair has low <= high."""
+    (``low=None``: any sign); `size` entries; `ordered`: each pair has low <= high. Lists (a
+    YAML config's) are stored as tuples."""
 
     def check(name: str, value: Any) -> None:
         if value is None and optional:
@@ -117,7 +118,7 @@ def numbers(
         if ordered and any(len(p) != 2 or p[0] > p[1] for p in pairs):
             raise ValueError(f"{name} must be (low, high) with low <= high, got {value!r}")
 
-    return dataclasses.field(default=default, metadata=_numeric(check, low))
+    return dataclasses.field(default=default, metadata={**_numeric(check, low), "tuples": True})
 
 
 def choice(default: Any, choices: tuple, *, optional: bool = False) -> Any:
@@ -152,11 +153,35 @@ class _Checked:
             check: Callable | None = f.metadata.get("check")
             if check is not None:
                 check(f.name, getattr(self, f.name))
+            if f.metadata.get("tuples"):
+                object.__setattr__(self, f.name, _as_tuples(getattr(self, f.name)))
 
 
 class TaskRanges:
     """Base of the envs' task-range dataclasses: every (low, high) pair (or tuple of pairs) must
-    be finite with low <= high, every number finite; checked on construction."""
+    be finite with low <= high, every number finite; checked on construction.
+
+    The envs' ``train_ranges`` / ``test_ranges`` settings also take a mapping, e.g. from a YAML
+    config: it replaces the named ranges of the default and keeps the others (`updated`).
+    """
+
+    def updated(self, where: str, changes: Mapping[str, Any]) -> TaskRanges:
+        """A copy with the ranges in `changes` replaced (lists as tuples, as YAML gives them);
+        TypeError naming unknown keys."""
+        valid = [f.name for f in dataclasses.fields(self)]
+        unknown = sorted(set(changes) - set(valid))
+        if unknown:
+            raise TypeError(f"{where}: unknown range(s) {unknown}; valid: {valid}")
+        new = {k: _as_tuples(v) for k, v in changes.items()}
+        for key, value in new.items():
+            old = getattr(self, key)
+            if _shape(old) == "a list of (low, high) pairs" and _shape(value) == _PAIR:
+                value = new[key] = (value,)  # one interval
+            if _shape(value) != _shape(old):
+                raise ValueError(
+                    f"{where}.{key} must be {_shape(old)} like the default {old!r}, got {value!r}"
+                )
+        return dataclasses.replace(self, **new)
 
     def __post_init__(self) -> None:
         for f in dataclasses.fields(self):
@@ -176,6 +201,29 @@ class TaskRanges:
                         f"{type(self).__name__}.{f.name} must be finite (low, high) pairs with "
                         f"low <= high, got {value!r}"
                     )
+
+
+def _shape(value: Any) -> str:
+    """What kind of range `value` is: a number, a (low, high) pair, a tuple of pairs or of
+    names."""
+    if isinstance(value, _numbers.Real) and not isinstance(value, bool):
+        return "a number"
+    if isinstance(value, tuple) and value:
+        if all(isinstance(v, str) for v in value):
+            return "a list of names"
+        if len(value) == 2 and all(_shape(v) == "a number" for v in value):
+            return _PAIR
+        if all(isinstance(v, tuple) and _shape(v) == _PAIR for v in value):
+            return "a list of (low, high) pairs"
+    return f"a {type(value).__name__}"
+
+
+_PAIR = "a (low, high) pair"
+
+
+def _as_tuples(value: Any) -> Any:
+    """Lists (nested too) as tuples: a YAML sequence as the ranges' (low, high) pairs."""
+    return tuple(_as_tuples(v) for v in value) if isinstance(value, (list, tuple)) else value
 
 
 @dataclasses.dataclass(frozen=True)
@@ -256,6 +304,9 @@ class EnvSettings(_Checked):
                 f"{sorted((own - {'reward'}) | scales)}, or reward={{...}} with the "
                 "reward scales"
             )
+        for f in dataclasses.fields(cls):
+            if isinstance(f.default, TaskRanges) and isinstance(kwargs.get(f.name), Mapping):
+                kwargs[f.name] = f.default.updated(f"{owner}: {f.name}", kwargs[f.name])
         flat = {k: kwargs.pop(k) for k in list(kwargs) if k in scales and k not in own}
         reward = kwargs.pop("reward", None)
         if isinstance(reward, Mapping):
