@@ -240,10 +240,18 @@ def test_evaluation_warns_when_a_setting_differs_from_the_training_env(run, tmp_
     assert evaluate(tmp_path / "changed", f"ppo:{model}") == 0
     md = (tmp_path / "changed" / "report.md").read_text()
     assert (
-        f"ppo:{model} was trained on an env set up otherwise than evaluated here "
-        "(setting: trained -> evaluated): physics_dt: 0.002 -> 0.001; reward terms (change "
-        "returns only): reward.forward_weight: 3.0 -> 1.0"
+        f"- **warning:** HexapodCliffWalk-v0: ppo:{model} was trained on an env set up otherwise "
+        "than evaluated here (setting: trained -> evaluated): physics_dt: 0.002 -> 0.001; reward "
+        "terms (change returns only): reward.forward_weight: 3.0 -> 1.0"
     ) in md
+    # other reward scales alone change no action (every policy is scored with the evaluated
+    # env's reward): a note of the report, not a warning
+    settings["physics_dt"] = 0.001
+    (model / "env_settings.yaml").write_text(yaml.safe_dump(settings))
+    assert evaluate(tmp_path / "reward", f"ppo:{model}") == 0
+    md = (tmp_path / "reward" / "report.md").read_text()
+    assert "## Warnings" not in md and "## Notes" in md
+    assert f"- **note:** HexapodCliffWalk-v0: ppo:{model} was trained on an env" in md
 
 
 def test_a_model_without_the_settings_record_is_checked_by_its_kwargs(run, tmp_path):

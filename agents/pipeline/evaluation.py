@@ -17,7 +17,7 @@ import gymnasium as gym
 import numpy as np
 
 from ..policy import Policy, RandomPolicy, ZeroPolicy
-from .env_settings import describe, differences, read_settings, resolved_settings
+from .env_settings import REWARD, describe, differences, read_settings, resolved_settings
 from .envs import EnvSpec, check_env_id, env_time_step, import_gym_packages
 from .episode import EpisodeAccumulator, EpisodeRecord, MetricSpec, metric_specs
 from .errors import UserError
@@ -286,22 +286,27 @@ def _settings_note(
     model_dir: Path | None,
     policy: Policy,
     policy_kwargs: dict[str, Any],
-) -> str | None:
-    """A warning when a model was trained on an env set up otherwise than `env`, the one it is
-    evaluated on: every recorded setting of its training env (`env_settings`) against `env`'s,
-    so that a default changed since the training shows; for a model without that record (older
-    runs, envs without typed settings) its config's kwargs against the suite's."""
+) -> tuple[str | None, bool]:
+    """(note, harmless) when a model was trained on an env set up otherwise than `env`, the
+    one it is evaluated on: every recorded setting of its training env (`env_settings`) against
+    `env`'s, so that a default changed since the training shows; for a model without that
+    record (older runs, envs without typed settings) its config's kwargs against the suite's.
+
+    Harmless: only reward scales differ. The agent acts the same under any reward, and the
+    evaluation scores every policy with the evaluated env's reward, so that is a note of the
+    report, not a warning."""
     trained, current = read_settings(model_dir), resolved_settings(env)
     if trained is None or current is None:
         trained_kwargs = getattr(policy, "train_env_kwargs", None)
-        return _kwargs_note(env, suite_env, name, trained_kwargs, policy_kwargs)
+        return _kwargs_note(env, suite_env, name, trained_kwargs, policy_kwargs), False
     found = differences(trained, current)
     if not found:
-        return None
-    return (
+        return None, False
+    note = (
         f"{suite_env.id}: {name} was trained on an env set up otherwise than evaluated here "
         f"(setting: trained -> evaluated): {describe(found)}"
     )
+    return note, all(key.startswith(f"{REWARD}.") for key in found)
 
 
 def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[str]]:
@@ -337,10 +342,13 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[
             run = PolicyRun(name=name, source=source, env_kwargs=extra)
             files = getattr(getattr(policy, "learned", policy), "files", None)
             run.model_dir = getattr(files, "directory", None)
-            note = _settings_note(envs[key], suite_env, name, run.model_dir, policy, extra)
+            note, harmless = _settings_note(
+                envs[key], suite_env, name, run.model_dir, policy, extra
+            )
             if note:
                 run.notes.append(note)
-                warnings.append(note)
+                if not harmless:
+                    warnings.append(note)
             result.runs[name] = run
             policies[name] = (policy, envs[key])
         used = {id(e) for _, e in policies.values()}

@@ -547,6 +547,11 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
             + "".join(f"<li><b>warning:</b> {html.escape(w)}</li>" for w in result.warnings)
             + "</ul></div>"
         )
+    notes = [n for r in result.envs for run in r.runs.values() for n in run.notes]
+    notes = [n for n in dict.fromkeys(notes) if n not in result.warnings]
+    if notes:  # e.g. an agent trained with other reward scales: it acts the same
+        heading("Notes", 2)
+        bullets([f"- **note:** {n}" for n in notes])
 
     heading("Verdicts", 2)
     for r in result.envs:
