@@ -301,7 +301,7 @@ def test_missing_shipped_model_is_skipped_with_a_warning_in_the_report(tmp_path)
     assert "| analytical |" in md
 
 
-def test_a_per_env_model_that_exists_for_some_envs_gets_one_line():
+def test_a_per_env_model_that_exists_for_some_envs_is_one_note():
     from types import SimpleNamespace
 
     from agents.pipeline.evaluation import _skip_lines
@@ -313,12 +313,12 @@ def test_a_per_env_model_that_exists_for_some_envs_gets_one_line():
         SimpleNamespace(env_id="C-v0", runs={"zero": 0}),
     ]
     skipped = {name: [("A-v0", why), ("C-v0", why)]}
-    assert _skip_lines(skipped, results) == [
-        f"{name} runs on B-v0 only: no model at models/{{env_id}}/gains for A-v0, C-v0"
-    ]
-    results[1].runs.pop(name)  # found nowhere: one line per env, with the reason
+    note = f"{name} runs on B-v0 only: no model at models/{{env_id}}/gains for A-v0, C-v0"
+    assert _skip_lines(skipped, results) == ([], [note])  # expected: a note
+    results[1].runs.pop(name)  # found nowhere: a warning per env, with the reason
     skipped[name].insert(1, ("B-v0", why))
-    assert _skip_lines(skipped, results) == [f"{e}-v0: skipped {name} - {why}" for e in "ABC"]
+    warnings = [f"{e}-v0: skipped {name} - {why}" for e in "ABC"]
+    assert _skip_lines(skipped, results) == (warnings, [])
 
 
 def test_unknown_env_id_and_existing_report_dir(tmp_path, capsys):

@@ -82,7 +82,8 @@ class EvaluationSuite:
     output_dir: str = "reports/evaluation"
     missing_models: Literal["error", "skip"] = "error"
     # skip: a ppo:<path> that does not exist, or an env without an analytical controller in
-    # agents/registry.py, is left out with a warning line in the report (error: exit with it)
+    # agents/registry.py, is left out with a warning line in the report (error: exit with it);
+    # a ppo:...{env_id}... path found for some envs only is one note instead
     deterministic: bool = True  # PPO actions: the mean (true) or sampled
     trust_pickle: bool = False  # load pickled model files of older runs (runs code from them)
     frames: bool = False  # frame strip per policy (rendered with MUJOCO_GL=egl)

@@ -82,6 +82,7 @@ class SuiteResult:
     envs: list[EnvResult]
     warnings: list[str]
     seconds: float
+    notes: list[str] = field(default_factory=list)  # expected gaps, e.g. a per-env model
 
 
 def run_episode(
@@ -309,10 +310,12 @@ def _settings_note(
     return note, all(key.startswith(f"{REWARD}.") for key in found)
 
 
-def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[str]]:
+def prepare(
+    suite: EvaluationSuite,
+) -> tuple[list[tuple[EnvResult, dict]], list[str], list[str]]:
     """Make every env and policy (all checks happen here). Returns, per suite env, its result
-    and ``{policy name: (policy, env)}`` (policies that read actions alike share one env), and
-    warning lines."""
+    and ``{policy name: (policy, env)}`` (policies that read actions alike share one env), then
+    warning lines and note lines."""
     _check_env_ids(suite)
     warnings: list[str] = []
     skipped: dict[str, list[tuple[str, str]]] = {}  # policy -> [(env id, why)]
@@ -355,23 +358,27 @@ def prepare(suite: EvaluationSuite) -> tuple[list[tuple[EnvResult, dict]], list[
         for unused in (e for e in envs.values() if id(e) not in used):
             unused.close()
         prepared.append((result, policies))
-    return prepared, warnings + _skip_lines(skipped, [r for r, _ in prepared])
+    skip_warnings, notes = _skip_lines(skipped, [r for r, _ in prepared])
+    return prepared, warnings + skip_warnings, notes
 
 
-def _skip_lines(skipped: dict[str, list[tuple[str, str]]], results: list[EnvResult]) -> list[str]:
-    """Warning lines for the skipped policies: one per env, except for a per-env model path
-    that exists for some envs only (e.g. ``ppo:models/{env_id}/gains``), which gets one line."""
-    lines = []
+def _skip_lines(
+    skipped: dict[str, list[tuple[str, str]]], results: list[EnvResult]
+) -> tuple[list[str], list[str]]:
+    """(warnings, notes) for the skipped policies: a warning per env, except for a per-env
+    model path that exists for some envs only (e.g. ``ppo:models/{env_id}/gains``, a model for
+    one env), which is one note."""
+    warnings, notes = [], []
     for name, misses in skipped.items():
         ran = [r.env_id for r in results if name in r.runs]
         if "{env_id}" in name and ran:
-            lines.append(
+            notes.append(
                 f"{name} runs on {', '.join(ran)} only: no model at "
                 f"{name[len(PPO_PREFIX) :]} for {', '.join(env for env, _ in misses)}"
             )
         else:
-            lines.extend(f"{env}: skipped {name} - {why}" for env, why in misses)
-    return lines
+            warnings.extend(f"{env}: skipped {name} - {why}" for env, why in misses)
+    return warnings, notes
 
 
 def run_suite(
@@ -381,7 +388,7 @@ def run_suite(
     from tqdm.auto import tqdm
 
     start = time.perf_counter()
-    prepared, warnings = prepare(suite)
+    prepared, warnings, notes = prepare(suite)
     for result, policies in prepared:
         for name, (policy, env) in policies.items():
             run = result.runs[name]
@@ -403,7 +410,9 @@ def run_suite(
             env.close()
         if suite.frames or video_dir is not None:
             warnings.extend(_render(suite, result, policies, video_dir))
-    return SuiteResult(suite, [r for r, _ in prepared], warnings, time.perf_counter() - start)
+    return SuiteResult(
+        suite, [r for r, _ in prepared], warnings, time.perf_counter() - start, notes
+    )
 
 
 CAMERA = "track"

@@ -438,6 +438,7 @@ def build_metrics(result: SuiteResult) -> dict[str, Any]:
         # the policies the comparisons are against (those of the suite's references that ran)
         "references": [r for r in suite.reference_names if r in suite.policies],
         "warnings": result.warnings,
+        "notes": result.notes,
         "envs": envs,
     }
 
@@ -547,9 +548,9 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
             + "".join(f"<li><b>warning:</b> {html.escape(w)}</li>" for w in result.warnings)
             + "</ul></div>"
         )
-    notes = [n for r in result.envs for run in r.runs.values() for n in run.notes]
+    notes = result.notes + [n for r in result.envs for run in r.runs.values() for n in run.notes]
     notes = [n for n in dict.fromkeys(notes) if n not in result.warnings]
-    if notes:  # e.g. an agent trained with other reward scales: it acts the same
+    if notes:  # e.g. a per-env model, an agent trained with other reward scales (acts the same)
         heading("Notes", 2)
         bullets([f"- **note:** {n}" for n in notes])
 
