@@ -175,7 +175,7 @@ class TaskRanges:
         new = {k: _as_tuples(v) for k, v in changes.items()}
         for key, value in new.items():
             old = getattr(self, key)
-            if _shape(old) == "a list of (low, high) pairs" and _shape(value) == _PAIR:
+            if _shape(old) == _PAIRS and _shape(value) == _PAIR:
                 value = new[key] = (value,)  # one interval
             if _shape(value) != _shape(old):
                 raise ValueError(
@@ -214,11 +214,11 @@ def _shape(value: Any) -> str:
         if len(value) == 2 and all(_shape(v) == "a number" for v in value):
             return _PAIR
         if all(isinstance(v, tuple) and _shape(v) == _PAIR for v in value):
-            return "a list of (low, high) pairs"
+            return _PAIRS
     return f"a {type(value).__name__}"
 
 
-_PAIR = "a (low, high) pair"
+_PAIR, _PAIRS = "a (low, high) pair", "a list of (low, high) pairs"
 
 
 def _as_tuples(value: Any) -> Any:
