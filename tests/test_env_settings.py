@@ -129,7 +129,8 @@ def test_task_ranges_take_a_mapping_as_a_yaml_config_gives_them():
         ({"frction": [0.3, 0.4]}, TypeError, ["frction", "valid", "friction"]),
         ({"friction": 0.5}, ValueError, ["train_ranges.friction", "(low, high) pair"]),
         ({"sides": [1.0, 2.0]}, ValueError, ["train_ranges.sides", "list of names"]),
-        ({"drop": [3.0, 1.0]}, ValueError, ["drop", "low <= high"]),
+        ({"sides": ["lft"]}, ValueError, ["train_ranges.sides", "'right', 'left'"]),
+        ({"drop": [3.0, 1.0]}, ValueError, ["train_ranges", "drop", "low <= high"]),
     ],
 )
 def test_bad_task_ranges_are_named(ranges, error, words):

@@ -251,7 +251,28 @@ def test_evaluation_warns_when_a_setting_differs_from_the_training_env(run, tmp_
     assert evaluate(tmp_path / "reward", f"ppo:{model}") == 0
     md = (tmp_path / "reward" / "report.md").read_text()
     assert "## Warnings" not in md and "## Notes" in md
-    assert f"- **note:** HexapodCliffWalk-v0: ppo:{model} was trained on an env" in md
+    note = f"HexapodCliffWalk-v0: ppo:{model} was trained on an env"
+    assert f"- **note:** {note}" in md
+    metrics = json.loads((tmp_path / "reward" / "metrics.json").read_text())
+    assert not metrics["warnings"] and metrics["notes"][0].startswith(note)
+
+
+def test_a_model_template_found_for_one_env_of_two_is_a_note(run, tmp_path, capsys):
+    models = tmp_path / "models"
+    shutil.copytree(run[0] / "final", models / "HexapodCliffWalk-v0")
+    argv = ["--episodes", "1", "--max-episode-steps", "5", "--no-progress"]
+    argv += ["--output-dir", str(tmp_path / "rep"), "--set", "missing_models=skip"]
+    argv += ["--set", "envs=[HexapodCliffWalk-v0, HexapodStewartTilt-v0]"]
+    argv += ["--set", f"policies=[zero, 'ppo:{models}/{{env_id}}']"]
+    assert evaluate_main(argv) == 0
+    note = (
+        f"ppo:{models}/{{env_id}} runs on HexapodCliffWalk-v0 only: no model at "
+        f"{models}/{{env_id}} for HexapodStewartTilt-v0"
+    )
+    metrics = json.loads((tmp_path / "rep" / "metrics.json").read_text())
+    assert metrics["notes"] == [note] and not metrics["warnings"]
+    assert f"- **note:** {note}" in (tmp_path / "rep" / "report.md").read_text()
+    assert f"note: {note}" in capsys.readouterr().err
 
 
 def test_a_model_without_the_settings_record_is_checked_by_its_kwargs(run, tmp_path):

@@ -225,6 +225,8 @@ def evaluate_main(argv: Sequence[str] | None = None) -> int:
         paths += write_study_section(result, studies, out)  # nothing without sweep dirs
         for line in result.warnings:
             print(f"warning: {line}", file=sys.stderr)
+        for line in result.notes:
+            print(f"note: {line}", file=sys.stderr)
         print("wrote " + ", ".join(str(p) for p in paths))
         return 0
 

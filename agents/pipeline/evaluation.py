@@ -82,7 +82,9 @@ class SuiteResult:
     envs: list[EnvResult]
     warnings: list[str]
     seconds: float
-    notes: list[str] = field(default_factory=list)  # expected gaps, e.g. a per-env model
+    # lines that are no mismatch: a per-env model found for some envs only, an agent trained
+    # with other reward scales only
+    notes: list[str] = field(default_factory=list)
 
 
 def run_episode(
@@ -293,9 +295,10 @@ def _settings_note(
     `env`'s, so that a default changed since the training shows; for a model without that
     record (older runs, envs without typed settings) its config's kwargs against the suite's.
 
-    Harmless: only reward scales differ. The agent acts the same under any reward, and the
-    evaluation scores every policy with the evaluated env's reward, so that is a note of the
-    report, not a warning."""
+    Harmless: only reward scales differ (told apart for models with the settings record only;
+    the kwargs comparison of older models is always a warning). The agent acts the same under
+    any reward, and the evaluation scores every policy with the evaluated env's reward, so that
+    is a note of the report, not a warning."""
     trained, current = read_settings(model_dir), resolved_settings(env)
     if trained is None or current is None:
         trained_kwargs = getattr(policy, "train_env_kwargs", None)
@@ -318,6 +321,7 @@ def prepare(
     warning lines and note lines."""
     _check_env_ids(suite)
     warnings: list[str] = []
+    notes: list[str] = []
     skipped: dict[str, list[tuple[str, str]]] = {}  # policy -> [(env id, why)]
     prepared = []
     for suite_env in suite.envs:
@@ -350,16 +354,15 @@ def prepare(
             )
             if note:
                 run.notes.append(note)
-                if not harmless:
-                    warnings.append(note)
+                (notes if harmless else warnings).append(note)
             result.runs[name] = run
             policies[name] = (policy, envs[key])
         used = {id(e) for _, e in policies.values()}
         for unused in (e for e in envs.values() if id(e) not in used):
             unused.close()
         prepared.append((result, policies))
-    skip_warnings, notes = _skip_lines(skipped, [r for r, _ in prepared])
-    return prepared, warnings + skip_warnings, notes
+    skip_warnings, skip_notes = _skip_lines(skipped, [r for r, _ in prepared])
+    return prepared, warnings + skip_warnings, skip_notes + notes
 
 
 def _skip_lines(

@@ -548,11 +548,9 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
             + "".join(f"<li><b>warning:</b> {html.escape(w)}</li>" for w in result.warnings)
             + "</ul></div>"
         )
-    notes = result.notes + [n for r in result.envs for run in r.runs.values() for n in run.notes]
-    notes = [n for n in dict.fromkeys(notes) if n not in result.warnings]
-    if notes:  # e.g. a per-env model, an agent trained with other reward scales (acts the same)
+    if result.notes:  # e.g. a per-env model, an agent trained with other reward scales
         heading("Notes", 2)
-        bullets([f"- **note:** {n}" for n in notes])
+        bullets([f"- **note:** {n}" for n in result.notes])
 
     heading("Verdicts", 2)
     for r in result.envs:

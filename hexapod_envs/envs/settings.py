@@ -166,8 +166,10 @@ class TaskRanges:
     """
 
     def updated(self, where: str, changes: Mapping[str, Any]) -> TaskRanges:
-        """A copy with the ranges in `changes` replaced (lists as tuples, as YAML gives them);
-        TypeError naming unknown keys."""
+        """A copy with the ranges in `changes` replaced (lists as tuples, as YAML gives them).
+        TypeError naming unknown keys; ValueError naming a range of the wrong kind (a number,
+        a (low, high) pair, a list of pairs or of names, like the default's), names outside the
+        default's, or a pair with low > high."""
         valid = [f.name for f in dataclasses.fields(self)]
         unknown = sorted(set(changes) - set(valid))
         if unknown:
@@ -181,9 +183,16 @@ class TaskRanges:
                 raise ValueError(
                     f"{where}.{key} must be {_shape(old)} like the default {old!r}, got {value!r}"
                 )
-        return dataclasses.replace(self, **new)
+            if _shape(old) == _NAMES and not set(value) <= set(old):
+                raise ValueError(f"{where}.{key} takes names among {old}, got {value!r}")
+        try:
+            return dataclasses.replace(self, **new)
+        except ValueError as error:
+            raise ValueError(f"{where}: {error}") from None
 
     def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):  # lists (e.g. from YAML) as tuples
+            object.__setattr__(self, f.name, _as_tuples(getattr(self, f.name)))
         for f in dataclasses.fields(self):
             value = getattr(self, f.name)
             if isinstance(value, _numbers.Real) and not isinstance(value, bool):
@@ -210,7 +219,7 @@ def _shape(value: Any) -> str:
         return "a number"
     if isinstance(value, tuple) and value:
         if all(isinstance(v, str) for v in value):
-            return "a list of names"
+            return _NAMES
         if len(value) == 2 and all(_shape(v) == "a number" for v in value):
             return _PAIR
         if all(isinstance(v, tuple) and _shape(v) == _PAIR for v in value):
@@ -218,7 +227,7 @@ def _shape(value: Any) -> str:
     return f"a {type(value).__name__}"
 
 
-_PAIR, _PAIRS = "a (low, high) pair", "a list of (low, high) pairs"
+_PAIR, _PAIRS, _NAMES = "a (low, high) pair", "a list of (low, high) pairs", "a list of names"
 
 
 def _as_tuples(value: Any) -> Any:
