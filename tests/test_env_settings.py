@@ -139,6 +139,11 @@ def test_bad_task_ranges_are_named(ranges, error, words):
     assert all(w in str(caught.value) for w in words), str(caught.value)
 
 
+def test_a_probability_range_outside_0_1_is_named():
+    with pytest.raises(ValueError, match=r"case_probability must be in \[0, 1\]"):
+        gym.make("HexapodStewartTilt-v0", train_ranges={"case_probability": 1.5})
+
+
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_a_recorded_settings_file_rebuilds_the_same_settings(env_id):
     import yaml

@@ -89,6 +89,13 @@ class TiltTaskRanges(TaskRanges):
     friction: tuple[float, float]
     case_probability: float = 0.5
 
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if not 0.0 <= self.case_probability <= 1.0:
+            raise ValueError(
+                f"TiltTaskRanges.case_probability must be in [0, 1], got {self.case_probability!r}"
+            )
+
 
 TILT_TRAIN = TiltTaskRanges(rates_deg_s=((1.0, 4.0), (8.0, 12.0)), friction=(1.2, 1.8))
 TILT_TEST = TiltTaskRanges(rates_deg_s=((4.0, 8.0), (12.0, 20.0)), friction=(0.9, 1.2))
