@@ -88,11 +88,21 @@ def _keys(a: dict[str, Any], b: dict[str, Any]) -> list[str]:
     return [*a, *(k for k in b if k not in a)]
 
 
+def _is_reward(key: str) -> bool:
+    return key.startswith(f"{REWARD}.")
+
+
+def reward_only(found: dict[str, tuple[Any, Any]]) -> bool:
+    """Whether every difference of `differences` is a reward scale: those change the returns,
+    not what the agent meets or does."""
+    return all(_is_reward(key) for key in found)
+
+
 def describe(found: dict[str, tuple[Any, Any]], reward_note: str = "change returns only") -> str:
     """The differences as ``"physics_dt: 0.002 -> 0.0025; reward terms (change returns only):
     reward.rate_weight: 5.0 -> 0.5"``."""
-    env_part = {k: v for k, v in found.items() if not k.startswith(f"{REWARD}.")}
-    reward = {k: v for k, v in found.items() if k.startswith(f"{REWARD}.")}
+    env_part = {k: v for k, v in found.items() if not _is_reward(k)}
+    reward = {k: v for k, v in found.items() if _is_reward(k)}
     parts = []
     if env_part:
         parts.append(", ".join(f"{k}: {a!r} -> {b!r}" for k, (a, b) in env_part.items()))

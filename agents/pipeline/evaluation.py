@@ -17,7 +17,7 @@ import gymnasium as gym
 import numpy as np
 
 from ..policy import Policy, RandomPolicy, ZeroPolicy
-from .env_settings import REWARD, describe, differences, read_settings, resolved_settings
+from .env_settings import describe, differences, read_settings, resolved_settings, reward_only
 from .envs import EnvSpec, check_env_id, env_time_step, import_gym_packages
 from .episode import EpisodeAccumulator, EpisodeRecord, MetricSpec, metric_specs
 from .errors import UserError
@@ -310,7 +310,7 @@ def _settings_note(
         f"{suite_env.id}: {name} was trained on an env set up otherwise than evaluated here "
         f"(setting: trained -> evaluated): {describe(found)}"
     )
-    return note, all(key.startswith(f"{REWARD}.") for key in found)
+    return note, reward_only(found)
 
 
 def prepare(

@@ -191,11 +191,10 @@ class TaskRanges:
             raise ValueError(f"{where}: {error}") from None
 
     def __post_init__(self) -> None:
-        for f in dataclasses.fields(self):  # lists (e.g. from YAML) as tuples
-            object.__setattr__(self, f.name, _as_tuples(getattr(self, f.name)))
         for f in dataclasses.fields(self):
-            value = getattr(self, f.name)
-            if isinstance(value, _numbers.Real) and not isinstance(value, bool):
+            value = _as_tuples(getattr(self, f.name))  # lists (e.g. from YAML) as tuples
+            object.__setattr__(self, f.name, value)
+            if _shape(value) == _NUMBER:
                 _check_real(f.name, value, value)
                 continue
             if not isinstance(value, tuple) or not value or isinstance(value[0], str):
@@ -216,18 +215,19 @@ def _shape(value: Any) -> str:
     """What kind of range `value` is: a number, a (low, high) pair, a tuple of pairs or of
     names."""
     if isinstance(value, _numbers.Real) and not isinstance(value, bool):
-        return "a number"
+        return _NUMBER
     if isinstance(value, tuple) and value:
         if all(isinstance(v, str) for v in value):
             return _NAMES
-        if len(value) == 2 and all(_shape(v) == "a number" for v in value):
+        if len(value) == 2 and all(_shape(v) == _NUMBER for v in value):
             return _PAIR
         if all(isinstance(v, tuple) and _shape(v) == _PAIR for v in value):
             return _PAIRS
     return f"a {type(value).__name__}"
 
 
-_PAIR, _PAIRS, _NAMES = "a (low, high) pair", "a list of (low, high) pairs", "a list of names"
+_NUMBER, _PAIR, _PAIRS = "a number", "a (low, high) pair", "a list of (low, high) pairs"
+_NAMES = "a list of names"
 
 
 def _as_tuples(value: Any) -> Any:
