@@ -17,6 +17,15 @@ achieve on a task distribution:
   candidates with no more contact steps than the reference in the same cycle, instead, let the
   choices of one cycle cause contacts in the next ones.)
 
+**Foresight or hindsight?** The simulator is deterministic, so the exact look-ahead picks the
+setting whose *realised* cycle was cheapest. If the cycles' costs hung on details of the state
+no sensor resolves, that pick would exploit the chaos of the contacts rather than foresee the
+terrain, and no policy could learn it. ``Lookahead(state_noise=σ, samples=K)`` tells the two
+apart: it plays every candidate on K copies whose joint and body velocities carry an error
+drawn from N(0, σ²) (the same K errors for every candidate) and picks the lowest mean cost,
+while the real env goes on from the exact state. What it keeps of the exact look-ahead's
+advantage is foresight that a state known to σ supports.
+
 The figures are those the evaluation reports for gains (the pooled medians of the per-cycle
 pitch- and roll-rate RMS, ``info["cycle_stats"]``; torso-contact steps, successes).
 """
@@ -59,11 +68,15 @@ def gain_grid(levels: Sequence[float]) -> list[Gains]:
     return [tuple(float(v) for v in g) for g in itertools.product(levels, repeat=3)]
 
 
-def play_cycle(env: gym.Env, gains: Gains) -> CycleOutcome:
+def play_cycle(
+    env: gym.Env, gains: Gains, velocity_error: np.ndarray | None = None
+) -> CycleOutcome:
     """Play one gait cycle with ``gains`` on a copy of ``env`` (at a cycle start; ``env`` is
-    left as it was)."""
+    left as it was); ``velocity_error`` (nv,) is added to the copy's ``qvel`` first."""
     twin = copy.deepcopy(env)
     base = twin.unwrapped
+    if velocity_error is not None:
+        base.data.qvel += velocity_error
     action = np.asarray(gains, dtype=twin.action_space.dtype)
     clearance = getattr(base, "torso_footprint_clearance", lambda: float("inf"))
     pitch_sq = roll_sq = 0.0
@@ -133,22 +146,47 @@ class Lookahead:
 
     candidates: tuple[Gains, ...]
     cost: CycleCost = DEFAULT_COST
+    state_noise: float = 0.0
+    """σ of the copies' velocity error [m/s, rad/s] (0: the exact look-ahead)."""
+    samples: int = 1
+    """Copies per candidate whose mean cost is compared (with ``state_noise`` > 0)."""
+    seed: int = 0
+    """Seed of the velocity errors (drawn per cycle from the seed and the env's clock)."""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "candidates", tuple(dict.fromkeys(self.candidates)))
         if not self.candidates:
             raise ValueError("Lookahead needs at least one candidate setting")
+        if not (self.state_noise >= 0.0 and self.samples >= 1):
+            raise ValueError(
+                f"need state_noise >= 0 and samples >= 1, got {self.state_noise}, {self.samples}"
+            )
+
+    def velocity_errors(self, env: gym.Env) -> list[np.ndarray | None]:
+        """The cycle's velocity errors, one per copy ([None]: the exact look-ahead)."""
+        if self.state_noise == 0.0:
+            return [None]
+        base = env.unwrapped
+        tick = round(base.data.time * 1e6)  # [µs]: a different draw every cycle
+        rng = np.random.default_rng([self.seed, tick])
+        return list(rng.normal(0.0, self.state_noise, (self.samples, base.model.nv)))
 
     def outcomes(self, env: gym.Env) -> list[CycleOutcome]:
-        """Every candidate's coming cycle, in `candidates` order."""
-        return [play_cycle(env, g) for g in self.candidates]
+        """Every candidate's coming cycle, in `candidates` order (with state noise: the first
+        copy's)."""
+        return [play_cycle(env, g, self.velocity_errors(env)[0]) for g in self.candidates]
 
     def choose(self, outcomes: Sequence[CycleOutcome]) -> Gains:
         costs = [self.cost(o) for o in outcomes]
         return self.candidates[costs.index(min(costs))]
 
     def __call__(self, env: gym.Env, observation: np.ndarray | None = None) -> Gains:
-        return self.choose(self.outcomes(env))
+        errors = self.velocity_errors(env)
+        costs = [
+            float(np.mean([self.cost(play_cycle(env, g, e)) for e in errors]))
+            for g in self.candidates
+        ]
+        return self.candidates[costs.index(min(costs))]
 
 
 def run_episode(env: gym.Env, seed: int, choose: Chooser) -> dict:

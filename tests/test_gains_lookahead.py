@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import copy
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -94,6 +96,35 @@ def test_lookahead_applies_the_cheapest_cycle():
         Lookahead(())
 
 
+def test_lookahead_from_noisy_copies():
+    """σ = 0 is the exact look-ahead; the copies' velocity errors are drawn per cycle and
+    shared by the candidates; the errors change the copies' cycles, not the env."""
+    env = _env()
+    env.reset(seed=1)
+    candidates = (*gain_grid([0.2, 0.8]), PAPER)
+    exact = Lookahead(candidates)
+    assert exact.velocity_errors(env) == [None]
+    assert Lookahead(candidates, state_noise=0.0, samples=3)(env) == exact(env)
+    noisy = Lookahead(candidates, state_noise=1e-2, samples=2, seed=5)
+    errors = noisy.velocity_errors(env)
+    assert len(errors) == 2 and errors[0].shape == (env.unwrapped.model.nv,)
+    assert 1e-3 < float(np.std(errors[0])) < 1e-1
+    np.testing.assert_array_equal(errors[1], noisy.velocity_errors(env)[1])  # deterministic
+    later = copy.deepcopy(env)
+    later.step(np.asarray(PAPER, dtype=np.float32))
+    assert not np.array_equal(errors[0], noisy.velocity_errors(later)[0])  # a new draw
+    qvel = env.unwrapped.data.qvel.copy()
+    assert play_cycle(env, PAPER, errors[0]) != play_cycle(env, PAPER)
+    np.testing.assert_array_equal(env.unwrapped.data.qvel, qvel)
+    # the choice minimises the mean cost over the copies
+    means = {g: np.mean([CycleCost()(play_cycle(env, g, e)) for e in errors]) for g in candidates}
+    assert means[noisy(env)] == min(means.values())
+    with pytest.raises(ValueError, match="state_noise"):
+        Lookahead(candidates, state_noise=-1.0)
+    with pytest.raises(ValueError, match="samples"):
+        Lookahead(candidates, samples=0)
+
+
 def test_run_episode_collects_every_finished_cycle():
     env = _env()
     episode = run_episode(env, 0, Fixed(PAPER))
@@ -117,3 +148,14 @@ def test_script_writes_the_table(tmp_path, monkeypatch):
         and "| look-ahead over the grid and the paper's |" in text
     )
     assert (tmp_path / "gains_ceiling_blocks.json").exists()
+    script.main(
+        ["--episodes", "1", "--levels", "0.5", "--no-grid", "--no-lookahead"]
+        + ["--state-noise", "0.01", "--samples", "1", "--out-dir", str(tmp_path)]
+    )
+    text = (tmp_path / "gains_foresight_blocks.md").read_text()
+    assert "--no-grid --state-noise 0.01 --samples 1`" in text
+    rows = [line for line in text.splitlines() if line.startswith("| ") and "|---" not in line]
+    assert [r.split(" |")[0] for r in rows[1:]] == [
+        "| paper (0.6, 0.4, 0.4)",
+        "| look-ahead from copies with velocity error σ = 0.01 (mean of 1)",
+    ]
