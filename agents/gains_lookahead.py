@@ -24,7 +24,9 @@ terrain, and no policy could learn it. ``Lookahead(state_noise=σ, samples=K)`` 
 apart: it plays every candidate on K copies whose joint and body velocities carry an error
 drawn from N(0, σ²) (the same K errors for every candidate) and picks the lowest mean cost,
 while the real env goes on from the exact state. What it keeps of the exact look-ahead's
-advantage is foresight that a state known to σ supports.
+advantage is foresight that a state known to σ supports. ``position_noise=σ_p`` also shifts
+each copy's robot horizontally by an error drawn from N(0, σ_p²) per axis, which is the same
+as knowing where the terrain lies only to σ_p.
 
 The figures are those the evaluation reports for gains (the pooled medians of the per-cycle
 pitch- and roll-rate RMS, ``info["cycle_stats"]``; torso-contact steps, successes).
@@ -45,6 +47,15 @@ Gains = tuple[float, float, float]
 Chooser = Callable[[gym.Env, np.ndarray], Gains]
 """Returns the gains for the cycle about to start in the given env (its last observation
 given)."""
+
+
+class StateError(NamedTuple):
+    """An error put into a look-ahead copy's state."""
+
+    velocity: np.ndarray
+    """(nv,) added to ``qvel`` [m/s, rad/s]."""
+    position: np.ndarray
+    """(2,) added to the robot's horizontal position [m]."""
 
 
 class CycleOutcome(NamedTuple):
@@ -68,15 +79,15 @@ def gain_grid(levels: Sequence[float]) -> list[Gains]:
     return [tuple(float(v) for v in g) for g in itertools.product(levels, repeat=3)]
 
 
-def play_cycle(
-    env: gym.Env, gains: Gains, velocity_error: np.ndarray | None = None
-) -> CycleOutcome:
+def play_cycle(env: gym.Env, gains: Gains, error: StateError | None = None) -> CycleOutcome:
     """Play one gait cycle with ``gains`` on a copy of ``env`` (at a cycle start; ``env`` is
-    left as it was); ``velocity_error`` (nv,) is added to the copy's ``qvel`` first."""
+    left as it was), from the copy's state plus ``error``."""
     twin = copy.deepcopy(env)
     base = twin.unwrapped
-    if velocity_error is not None:
-        base.data.qvel += velocity_error
+    if error is not None:
+        base.data.qvel += error.velocity
+        root = base.model.jnt_qposadr[base.model.joint("root").id]  # the free joint's x, y
+        base.data.qpos[root : root + 2] += error.position
     action = np.asarray(gains, dtype=twin.action_space.dtype)
     clearance = getattr(base, "torso_footprint_clearance", lambda: float("inf"))
     pitch_sq = roll_sq = 0.0
@@ -147,41 +158,47 @@ class Lookahead:
     candidates: tuple[Gains, ...]
     cost: CycleCost = DEFAULT_COST
     state_noise: float = 0.0
-    """σ of the copies' velocity error [m/s, rad/s] (0: the exact look-ahead)."""
+    """σ of the copies' velocity error [m/s, rad/s]."""
+    position_noise: float = 0.0
+    """σ of the copies' horizontal position error per axis [m] (both 0: the exact
+    look-ahead)."""
     samples: int = 1
-    """Copies per candidate whose mean cost is compared (with ``state_noise`` > 0)."""
+    """Copies per candidate whose mean cost is compared (with noise)."""
     seed: int = 0
-    """Seed of the velocity errors (drawn per cycle from the seed and the env's clock)."""
+    """Seed of the errors (drawn per cycle from the seed and the env's clock)."""
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "candidates", tuple(dict.fromkeys(self.candidates)))
         if not self.candidates:
             raise ValueError("Lookahead needs at least one candidate setting")
-        if not (self.state_noise >= 0.0 and self.samples >= 1):
+        if not (self.state_noise >= 0.0 and self.position_noise >= 0.0 and self.samples >= 1):
             raise ValueError(
-                f"need state_noise >= 0 and samples >= 1, got {self.state_noise}, {self.samples}"
+                "need state_noise >= 0, position_noise >= 0 and samples >= 1, got "
+                f"{self.state_noise}, {self.position_noise}, {self.samples}"
             )
 
-    def velocity_errors(self, env: gym.Env) -> list[np.ndarray | None]:
-        """The cycle's velocity errors, one per copy ([None]: the exact look-ahead)."""
-        if self.state_noise == 0.0:
+    def state_errors(self, env: gym.Env) -> list[StateError | None]:
+        """The cycle's state errors, one per copy ([None]: the exact look-ahead)."""
+        if self.state_noise == 0.0 and self.position_noise == 0.0:
             return [None]
         base = env.unwrapped
         tick = round(base.data.time * 1e6)  # [µs]: a different draw every cycle
         rng = np.random.default_rng([self.seed, tick])
-        return list(rng.normal(0.0, self.state_noise, (self.samples, base.model.nv)))
+        velocity = rng.normal(0.0, self.state_noise, (self.samples, base.model.nv))
+        position = rng.normal(0.0, self.position_noise, (self.samples, 2))
+        return [StateError(v, p) for v, p in zip(velocity, position, strict=True)]
 
     def outcomes(self, env: gym.Env) -> list[CycleOutcome]:
-        """Every candidate's coming cycle, in `candidates` order (with state noise: the first
+        """Every candidate's coming cycle, in `candidates` order (with noise: the first
         copy's)."""
-        return [play_cycle(env, g, self.velocity_errors(env)[0]) for g in self.candidates]
+        return [play_cycle(env, g, self.state_errors(env)[0]) for g in self.candidates]
 
     def choose(self, outcomes: Sequence[CycleOutcome]) -> Gains:
         costs = [self.cost(o) for o in outcomes]
         return self.candidates[costs.index(min(costs))]
 
     def __call__(self, env: gym.Env, observation: np.ndarray | None = None) -> Gains:
-        errors = self.velocity_errors(env)
+        errors = self.state_errors(env)
         costs = [
             float(np.mean([self.cost(play_cycle(env, g, e)) for e in errors]))
             for g in self.candidates

@@ -16,6 +16,7 @@ from agents.gains_lookahead import (
     CycleOutcome,
     Fixed,
     Lookahead,
+    StateError,
     beats,
     gain_grid,
     play_cycle,
@@ -97,32 +98,39 @@ def test_lookahead_applies_the_cheapest_cycle():
 
 
 def test_lookahead_from_noisy_copies():
-    """σ = 0 is the exact look-ahead; the copies' velocity errors are drawn per cycle and
-    shared by the candidates; the errors change the copies' cycles, not the env."""
+    """Without noise it is the exact look-ahead; the copies' state errors are drawn per cycle
+    and shared by the candidates; they change the copies' cycles, not the env."""
     env = _env()
     env.reset(seed=1)
     candidates = (*gain_grid([0.2, 0.8]), PAPER)
     exact = Lookahead(candidates)
-    assert exact.velocity_errors(env) == [None]
-    assert Lookahead(candidates, state_noise=0.0, samples=3)(env) == exact(env)
-    noisy = Lookahead(candidates, state_noise=1e-2, samples=2, seed=5)
-    errors = noisy.velocity_errors(env)
-    assert len(errors) == 2 and errors[0].shape == (env.unwrapped.model.nv,)
-    assert 1e-3 < float(np.std(errors[0])) < 1e-1
-    np.testing.assert_array_equal(errors[1], noisy.velocity_errors(env)[1])  # deterministic
+    assert exact.state_errors(env) == [None]
+    assert Lookahead(candidates, samples=3)(env) == exact(env)
+    noisy = Lookahead(candidates, state_noise=1e-2, position_noise=0.005, samples=2, seed=5)
+    errors = noisy.state_errors(env)
+    assert len(errors) == 2 and errors[0].velocity.shape == (env.unwrapped.model.nv,)
+    assert 1e-3 < float(np.std(errors[0].velocity)) < 1e-1
+    assert errors[0].position.shape == (2,) and 0.0 < np.abs(errors[0].position).max() < 0.05
+    np.testing.assert_array_equal(errors[1].velocity, noisy.state_errors(env)[1].velocity)
     later = copy.deepcopy(env)
     later.step(np.asarray(PAPER, dtype=np.float32))
-    assert not np.array_equal(errors[0], noisy.velocity_errors(later)[0])  # a new draw
-    qvel = env.unwrapped.data.qvel.copy()
+    assert not np.array_equal(errors[0].position, noisy.state_errors(later)[0].position)
+    base = env.unwrapped
+    qpos, qvel = base.data.qpos.copy(), base.data.qvel.copy()
     assert play_cycle(env, PAPER, errors[0]) != play_cycle(env, PAPER)
-    np.testing.assert_array_equal(env.unwrapped.data.qvel, qvel)
+    np.testing.assert_array_equal(base.data.qpos, qpos)
+    np.testing.assert_array_equal(base.data.qvel, qvel)
+    # a position error alone (no velocity error) changes the cycle too
+    shift = StateError(np.zeros(base.model.nv), np.array([0.01, -0.02]))
+    shifted = Lookahead(candidates, position_noise=0.01)
+    assert shifted.state_errors(env)[0].velocity.tolist() == [0.0] * base.model.nv
+    assert play_cycle(env, PAPER, shift) != play_cycle(env, PAPER)
     # the choice minimises the mean cost over the copies
     means = {g: np.mean([CycleCost()(play_cycle(env, g, e)) for e in errors]) for g in candidates}
     assert means[noisy(env)] == min(means.values())
-    with pytest.raises(ValueError, match="state_noise"):
-        Lookahead(candidates, state_noise=-1.0)
-    with pytest.raises(ValueError, match="samples"):
-        Lookahead(candidates, samples=0)
+    for bad in ({"state_noise": -1.0}, {"position_noise": -1.0}, {"samples": 0}):
+        with pytest.raises(ValueError, match="position_noise >= 0 and samples >= 1"):
+            Lookahead(candidates, **bad)
 
 
 def test_run_episode_collects_every_finished_cycle():
@@ -149,13 +157,18 @@ def test_script_writes_the_table(tmp_path, monkeypatch):
     )
     assert (tmp_path / "gains_ceiling_blocks.json").exists()
     script.main(
-        ["--episodes", "1", "--levels", "0.5", "--no-grid", "--no-lookahead"]
-        + ["--state-noise", "0.01", "--samples", "1", "--out-dir", str(tmp_path)]
+        ["--episodes", "1", "--levels", "0.5", "--no-grid", "--state-noise", "0.01"]
+        + ["--position-noise", "0.02", "--samples", "1", "--out-dir", str(tmp_path)]
     )
     text = (tmp_path / "gains_foresight_blocks.md").read_text()
-    assert "--no-grid --state-noise 0.01 --samples 1`" in text
+    assert "--no-grid --state-noise 0.01 --position-noise 0.02 --samples 1`" in text
     rows = [line for line in text.splitlines() if line.startswith("| ") and "|---" not in line]
     assert [r.split(" |")[0] for r in rows[1:]] == [
         "| paper (0.6, 0.4, 0.4)",
+        "| look-ahead over the grid and the paper's",
         "| look-ahead from copies with velocity error σ = 0.01 (mean of 1)",
+        "| look-ahead from copies with position error σ = 0.02 m (mean of 1)",
     ]
+    # the kept column: every row but the paper's; the exact look-ahead keeps all of its lead
+    assert rows[0].endswith("| kept |") and rows[2].endswith("| 100% / 100% |")
+    assert all(row.count("|") == rows[0].count("|") for row in rows)
