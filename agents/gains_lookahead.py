@@ -25,8 +25,10 @@ apart: it plays every candidate on K copies whose joint and body velocities carr
 drawn from N(0, σ²) (the same K errors for every candidate) and picks the lowest mean cost,
 while the real env goes on from the exact state. What it keeps of the exact look-ahead's
 advantage is foresight that a state known to σ supports. ``position_noise=σ_p`` also shifts
-each copy's robot horizontally by an error drawn from N(0, σ_p²) per axis, which is the same
-as knowing where the terrain lies only to σ_p.
+each copy's robot horizontally by an error drawn from N(0, σ_p²) per axis: where it stands
+relative to the blocks known only to σ_p. The stance feet move with it, so a shift can start a
+copy with a foot pressed into a block's face or off its edge: such a copy measures how much
+the cycle hangs on the exact footing, not only an error of the terrain map.
 
 The figures are those the evaluation reports for gains (the pooled medians of the per-cycle
 pitch- and roll-rate RMS, ``info["cycle_stats"]``; torso-contact steps, successes).
@@ -188,22 +190,19 @@ class Lookahead:
         position = rng.normal(0.0, self.position_noise, (self.samples, 2))
         return [StateError(v, p) for v, p in zip(velocity, position, strict=True)]
 
-    def outcomes(self, env: gym.Env) -> list[CycleOutcome]:
-        """Every candidate's coming cycle, in `candidates` order (with noise: the first
-        copy's)."""
-        return [play_cycle(env, g, self.state_errors(env)[0]) for g in self.candidates]
+    def outcomes(self, env: gym.Env) -> list[list[CycleOutcome]]:
+        """Every candidate's coming cycle on each copy: [candidate][copy], in `candidates`
+        order (one copy, the exact one, without noise)."""
+        errors = self.state_errors(env)
+        return [[play_cycle(env, g, e) for e in errors] for g in self.candidates]
 
-    def choose(self, outcomes: Sequence[CycleOutcome]) -> Gains:
-        costs = [self.cost(o) for o in outcomes]
+    def choose(self, outcomes: Sequence[Sequence[CycleOutcome]]) -> Gains:
+        """The candidate of lowest mean cost over its copies (the first of equal cost)."""
+        costs = [float(np.mean([self.cost(o) for o in copies])) for copies in outcomes]
         return self.candidates[costs.index(min(costs))]
 
     def __call__(self, env: gym.Env, observation: np.ndarray | None = None) -> Gains:
-        errors = self.state_errors(env)
-        costs = [
-            float(np.mean([self.cost(play_cycle(env, g, e)) for e in errors]))
-            for g in self.candidates
-        ]
-        return self.candidates[costs.index(min(costs))]
+        return self.choose(self.outcomes(env))
 
 
 def run_episode(env: gym.Env, seed: int, choose: Chooser) -> dict:

@@ -101,8 +101,9 @@ def measure(
     if workers == 1:
         rows = {label: _row(terrain, episodes, c) for label, c in choosers.items()}
     else:
-        # The look-ahead (the longest row) first, so that the other rows fill the other workers.
-        first = sorted(choosers, key=lambda label: not isinstance(choosers[label], Lookahead))
+        # The longest rows first (a look-ahead from noisy copies, then the exact one), so that
+        # the shorter rows fill the other workers.
+        first = sorted(choosers, key=lambda label: -_row_cost(choosers[label]))
         with ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("spawn")) as pool:
             futures = {
                 label: pool.submit(_row, terrain, episodes, choosers[label]) for label in first
@@ -164,6 +165,14 @@ def report(rows: dict, terrain: str, args: argparse.Namespace) -> str:
             line += "  |" if r is reference else f" {shares[0]} / {shares[1]} |"
         lines.append(line)
     return "\n".join(lines) + "\n"
+
+
+def _row_cost(choose) -> int:
+    """Cycles played per episode cycle, roughly: the sort key of the rows' scheduling."""
+    if not isinstance(choose, Lookahead):
+        return 1
+    noisy = choose.state_noise > 0.0 or choose.position_noise > 0.0
+    return len(choose.candidates) * (choose.samples if noisy else 1)
 
 
 def _share(part: float, whole: float) -> str:

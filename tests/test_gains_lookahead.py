@@ -97,7 +97,7 @@ def test_lookahead_applies_the_cheapest_cycle():
         Lookahead(())
 
 
-def test_lookahead_from_noisy_copies():
+def test_lookahead_from_noisy_copies(monkeypatch):
     """Without noise it is the exact look-ahead; the copies' state errors are drawn per cycle
     and shared by the candidates; they change the copies' cycles, not the env."""
     env = _env()
@@ -120,14 +120,31 @@ def test_lookahead_from_noisy_copies():
     assert play_cycle(env, PAPER, errors[0]) != play_cycle(env, PAPER)
     np.testing.assert_array_equal(base.data.qpos, qpos)
     np.testing.assert_array_equal(base.data.qvel, qvel)
-    # a position error alone (no velocity error) changes the cycle too
+    # a position error alone (no velocity error) shifts the torso by it, nothing else
     shift = StateError(np.zeros(base.model.nv), np.array([0.01, -0.02]))
     shifted = Lookahead(candidates, position_noise=0.01)
     assert shifted.state_errors(env)[0].velocity.tolist() == [0.0] * base.model.nv
+    seen = {}
+
+    def record(twin, action):
+        seen["qpos"] = twin.unwrapped.data.qpos.copy()
+        raise StopIteration
+
+    with monkeypatch.context() as patch:
+        patch.setattr(type(env), "step", record)
+        with pytest.raises(StopIteration):
+            play_cycle(env, PAPER, shift)
+    moved = seen["qpos"] - qpos
+    np.testing.assert_allclose(moved[:2], shift.position, rtol=0, atol=1e-15)
+    assert not moved[2:].any()
     assert play_cycle(env, PAPER, shift) != play_cycle(env, PAPER)
-    # the choice minimises the mean cost over the copies
+    # the choice minimises the mean cost over the copies, which outcomes() lists per candidate
     means = {g: np.mean([CycleCost()(play_cycle(env, g, e)) for e in errors]) for g in candidates}
     assert means[noisy(env)] == min(means.values())
+    played = noisy.outcomes(env)
+    assert [len(copies) for copies in played] == [2] * len(candidates)
+    assert noisy.choose(played) == noisy(env)
+    assert [len(copies) for copies in exact.outcomes(env)] == [1] * len(candidates)
     for bad in ({"state_noise": -1.0}, {"position_noise": -1.0}, {"samples": 0}):
         with pytest.raises(ValueError, match="position_noise >= 0 and samples >= 1"):
             Lookahead(candidates, **bad)

@@ -152,11 +152,12 @@ class _Recorder:
         if self.teacher is None:  # the terrain's analytical gains, known once it is built
             self.reference = analytical_policy(env).gains
             self.teacher = Lookahead((*gain_grid(self.levels), self.reference), self.cost)
-        played: list[CycleOutcome] = self.teacher.outcomes(env)
+        copies = self.teacher.outcomes(env)  # the exact look-ahead: one copy per candidate
+        played: list[CycleOutcome] = [c[0] for c in copies]
         self.observations.append(np.array(observation, dtype=np.float32))
         self.outcomes.append([o[:SCORED] for o in played])
         self.teacher_steps += sum(o.steps for o in played)
-        return self.teacher.choose(played)
+        return self.teacher.choose(copies)
 
 
 def lattice_costs(demos: Demonstrations, cost: CycleCost) -> np.ndarray:
