@@ -185,11 +185,13 @@ def _noise_sentence(args: argparse.Namespace) -> str:
     return (
         " The rows 'from copies with ... error σ' choose the same way from "
         f"{args.samples} copies per candidate whose joint and body velocities (qvel, velocity "
-        "error) or horizontal position (the root's x and y, position error: the terrain known "
-        "to σ) carry an error drawn from N(0, σ²), the same errors for every candidate, by "
-        "the mean cost; the episode itself goes on from the exact state. What such a row "
-        "keeps of the exact look-ahead's advantage is foresight that a state known to σ "
-        "supports; what it loses was hindsight of how the contacts happened to play out."
+        "error) or horizontal position (the root's x and y, position error) carry an error "
+        "drawn from N(0, σ²), the same errors for every candidate, by the mean cost; the "
+        "episode itself goes on from the exact state. What such a row keeps of the exact "
+        "look-ahead's advantage is foresight that a state known to σ supports. A position "
+        "error moves the stance feet with the robot, so a copy can start with a foot pressed "
+        "into a block's face or off its edge: those rows say how much a cycle hangs on where "
+        "the feet stand relative to the blocks, not on a terrain-map error alone."
     )
 
 
