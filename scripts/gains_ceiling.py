@@ -14,12 +14,12 @@ look-ahead, which plays every candidate for every cycle; `--workers 2` halves th
 `--state-noise σ ...` adds, per σ, a look-ahead that chooses from copies whose velocities carry
 an error of σ (`--samples` copies per candidate, mean cost), while the episode runs on exactly:
 how much of the look-ahead's advantage is foresight rather than hindsight of chaotic contacts
-(see agents/gains_lookahead.py); `--position-noise σ_p ...` likewise with the robot shifted
-horizontally by σ_p per axis (the terrain known to σ_p). Such runs write
-`gains_foresight_<terrain>.md`/`.json`; `--no-grid` leaves out the fixed settings of the grid.
-The committed `reports/gains_foresight_blocks.md` is the run its header names (10 beds, 3
-velocity and 3 position errors, 4 copies each: about 65 min on 2 cores; each noisy row costs 4
-look-aheads).
+(see agents/gains_lookahead.py); `--position-noise σ_p ...` likewise with the robot, stance feet
+included, shifted horizontally by σ_p per axis (how much a cycle hangs on where the feet stand on
+the blocks). Such runs write `gains_foresight_<terrain>.md`/`.json`; `--no-grid` leaves out the
+fixed settings of the grid. The committed `reports/gains_foresight_blocks.md` is the run its
+header names (10 beds, 3 velocity and 3 position errors, 4 copies each: about 65 min on 2 cores;
+each noisy row costs 4 look-aheads).
 
 Run: python scripts/gains_ceiling.py [--terrain blocks] [--episodes 20] [--levels 0.2 0.5 0.8]
      [--no-lookahead] [--no-grid] [--state-noise S ...] [--position-noise P ...] [--samples K]
@@ -223,11 +223,11 @@ def main(argv: list[str] | None = None) -> None:
         args.episodes,
         args.levels,
         args.lookahead,
-        args.workers,
-        args.grid,
-        tuple(args.state_noise),
-        args.samples,
-        tuple(args.position_noise),
+        workers=args.workers,
+        with_grid=args.grid,
+        state_noise=tuple(args.state_noise),
+        samples=args.samples,
+        position_noise=tuple(args.position_noise),
     )
     args.out_dir.mkdir(parents=True, exist_ok=True)
     kind = "foresight" if args.state_noise or args.position_noise else "ceiling"
