@@ -189,3 +189,27 @@ def test_script_writes_the_table(tmp_path, monkeypatch):
     # the kept column: every row but the paper's; the exact look-ahead keeps all of its lead
     assert rows[0].endswith("| kept |") and rows[2].endswith("| 100% / 100% |")
     assert all(row.count("|") == rows[0].count("|") for row in rows)
+
+
+def test_footing_probe_moves_only_the_blocks_away_from_the_feet():
+    probe = _script("gains_footing_probe")
+    env = _env()
+    env.reset(seed=0)
+    base = env.unwrapped
+    before = base.model.geom_pos.copy()
+    twin = copy.deepcopy(env)
+    moved = probe.shift_far_blocks(twin, np.array([0.05, 0.0]))
+    boxes = [n for n in base.terrain_info.geom_names if n != "blocks_ground"]
+    assert 0 < moved < len(boxes)
+    np.testing.assert_array_equal(base.model.geom_pos, before)  # the copy's model only
+    shifted = twin.unwrapped.model.geom_pos - before
+    assert np.count_nonzero(shifted.any(axis=1)) == moved
+    under_feet = [  # the blocks under the feet stay
+        geom.id
+        for geom in (base.model.geom(name) for name in boxes)
+        for foot in base.sensors.foot_positions()[:, :2]
+        if (np.abs(foot - geom.pos[:2]) <= geom.size[:2]).all()
+    ]
+    assert len(under_feet) >= 3 and not shifted[under_feet].any()
+    unchanged, played = probe.probe(1, 1, make_env=lambda: _env(120))
+    assert played == len(probe.SHIFTS) * len(probe.SETTINGS) and 0 <= unchanged <= played
