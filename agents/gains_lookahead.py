@@ -76,6 +76,20 @@ class CycleOutcome(NamedTuple):
     """Control steps simulated (what the look-ahead spends of an env-step budget)."""
 
 
+def gains_env(terrain: str = "blocks", **kwargs) -> gym.Env:
+    """The env these measurements run on: HexapodIrregularTerrain-v0's held-out ``test`` beds
+    of `terrain` in the "gains" action mode, the gait searching for ground at every touch-down
+    (as the evaluation of the gains agents does); `kwargs` go to gym.make."""
+    return gym.make(
+        "HexapodIrregularTerrain-v0",
+        task_distribution="test",
+        terrain=terrain,
+        gait_ground_search="always",
+        action_mode="gains",
+        **kwargs,
+    )
+
+
 def gain_grid(levels: Sequence[float]) -> list[Gains]:
     """Every (k_z, k_α, k_β) with each gain in ``levels``."""
     return [tuple(float(v) for v in g) for g in itertools.product(levels, repeat=3)]
@@ -179,9 +193,14 @@ class Lookahead:
                 f"{self.state_noise}, {self.position_noise}, {self.samples}"
             )
 
+    @property
+    def noisy(self) -> bool:
+        """Whether the copies carry state errors (False: the exact look-ahead)."""
+        return self.state_noise > 0.0 or self.position_noise > 0.0
+
     def state_errors(self, env: gym.Env) -> list[StateError | None]:
         """The cycle's state errors, one per copy ([None]: the exact look-ahead)."""
-        if self.state_noise == 0.0 and self.position_noise == 0.0:
+        if not self.noisy:
             return [None]
         base = env.unwrapped
         tick = round(base.data.time * 1e6)  # [µs]: a different draw every cycle

@@ -36,8 +36,6 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-import gymnasium as gym
-
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import hexapod_envs  # noqa: E402, F401
 from agents.athena_policy import PAPER_GAINS  # noqa: E402
@@ -46,6 +44,7 @@ from agents.gains_lookahead import (  # noqa: E402
     Lookahead,
     beats,
     gain_grid,
+    gains_env,
     run_episode,
     summarize,
 )
@@ -53,14 +52,7 @@ from agents.gains_lookahead import (  # noqa: E402
 EXACT = "look-ahead over the grid and the paper's"
 
 
-def make_env(terrain: str) -> gym.Env:
-    return gym.make(
-        "HexapodIrregularTerrain-v0",
-        task_distribution="test",
-        terrain=terrain,
-        gait_ground_search="always",
-        action_mode="gains",
-    )
+make_env = gains_env  # the env of every row (a seam for the tests)
 
 
 def _row(terrain: str, episodes: int, choose) -> dict:
@@ -117,7 +109,7 @@ def measure(
 def report(rows: dict, terrain: str, args: argparse.Namespace) -> str:
     reference = next(iter(rows.values()))
     exact = rows.get(EXACT)
-    kept = exact is not None and bool(args.state_noise or args.position_noise)
+    kept = exact is not None and _noisy(args)
     title = (
         "how much of the one-cycle look-ahead's advantage is foresight"
         if kept
@@ -171,8 +163,12 @@ def _row_cost(choose) -> int:
     """Cycles played per episode cycle, roughly: the sort key of the rows' scheduling."""
     if not isinstance(choose, Lookahead):
         return 1
-    noisy = choose.state_noise > 0.0 or choose.position_noise > 0.0
-    return len(choose.candidates) * (choose.samples if noisy else 1)
+    return len(choose.candidates) * (choose.samples if choose.noisy else 1)
+
+
+def _noisy(args: argparse.Namespace) -> bool:
+    """Whether the run has look-aheads from noisy copies (a foresight run)."""
+    return bool(args.state_noise or args.position_noise)
 
 
 def _share(part: float, whole: float) -> str:
@@ -180,7 +176,7 @@ def _share(part: float, whole: float) -> str:
 
 
 def _noise_sentence(args: argparse.Namespace) -> str:
-    if not (args.state_noise or args.position_noise):
+    if not _noisy(args):
         return ""
     return (
         " The rows 'from copies with ... error σ' choose the same way from "
@@ -200,7 +196,7 @@ def _noise_flags(args: argparse.Namespace) -> str:
     for name, values in (("state", args.state_noise), ("position", args.position_noise)):
         if values:
             flags += f" --{name}-noise " + " ".join(f"{v:g}" for v in values)
-    if args.state_noise or args.position_noise:
+    if _noisy(args):
         flags += f" --samples {args.samples}"
     return flags
 
@@ -230,7 +226,7 @@ def main(argv: list[str] | None = None) -> None:
         position_noise=tuple(args.position_noise),
     )
     args.out_dir.mkdir(parents=True, exist_ok=True)
-    kind = "foresight" if args.state_noise or args.position_noise else "ceiling"
+    kind = "foresight" if _noisy(args) else "ceiling"
     stem = args.out_dir / f"gains_{kind}_{args.terrain}"
     stem.with_suffix(".md").write_text(report(rows, args.terrain, args))
     stem.with_suffix(".json").write_text(json.dumps(rows, indent=1) + "\n")

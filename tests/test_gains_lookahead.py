@@ -19,6 +19,7 @@ from agents.gains_lookahead import (
     StateError,
     beats,
     gain_grid,
+    gains_env,
     play_cycle,
     run_episode,
     summarize,
@@ -28,14 +29,7 @@ PAPER = PAPER_GAINS["blocks"]
 
 
 def _env(steps: int = 160) -> gym.Env:
-    return gym.make(
-        "HexapodIrregularTerrain-v0",
-        task_distribution="test",
-        terrain="blocks",
-        gait_ground_search="always",
-        action_mode="gains",
-        max_episode_steps=steps,
-    )
+    return gains_env(max_episode_steps=steps)
 
 
 def test_grid_and_the_beats_rule():
