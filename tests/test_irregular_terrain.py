@@ -260,6 +260,39 @@ def test_terrain_scan_is_the_torso_height_above_the_terrain_around_it(terrain):
 
 
 @pytest.mark.parametrize("terrain", TERRAINS)
+def test_foot_scan_is_each_foots_height_above_the_terrain_around_it(terrain):
+    from hexapod_envs.envs.irregular_terrain import FOOT_SCAN_X, FOOT_SCAN_Y
+
+    plain = gym.make(ENV_ID, terrain=terrain)
+    env = gym.make(ENV_ID, terrain=terrain, foot_scan=True, terrain_scan=True)
+    assert env.observation_space.shape[0] == plain.observation_space.shape[0] + 15 + 108
+    obs, _ = env.reset(seed=3)
+    for _ in range(7):
+        obs, *_ = env.step(np.zeros(env.action_space.shape))
+    base = env.unwrapped
+    scan = obs[base.observation_structure["foot_scan"]].reshape(6, len(FOOT_SCAN_X), 3)
+    rot = base.sensors.torso_rotation()
+    heading = math.atan2(rot[1, 0], rot[0, 0])
+    info = base.terrain_info
+    for leg, (fx, fy, fz) in enumerate(base.sensors.foot_positions().tolist()):
+        for i, ahead in enumerate(FOOT_SCAN_X):
+            for j, left in enumerate(FOOT_SCAN_Y):
+                px = fx + math.cos(heading) * ahead - math.sin(heading) * left
+                py = fy + math.sin(heading) * ahead + math.cos(heading) * left
+                ground = 0.0 if info is None else info.height_at(px, py)
+                assert scan[leg, i, j] == pytest.approx(fz - ground, abs=1e-6)
+    own_spot = scan[:, FOOT_SCAN_X.index(0.0), FOOT_SCAN_Y.index(0.0)]
+    loaded = obs[base.observation_structure["foot_contact"]] > 0
+    assert loaded.sum() >= 3
+    np.testing.assert_array_less(np.abs(own_spot[loaded]), 0.03)  # a loaded foot is on the ground
+    if terrain == "flat":
+        feet_z = base.sensors.foot_positions()[:, 2]
+        np.testing.assert_allclose(scan, np.broadcast_to(feet_z[:, None, None], scan.shape))
+    with pytest.raises(ValueError, match="foot_scan must be one of"):
+        gym.make(ENV_ID, foot_scan="yes")
+
+
+@pytest.mark.parametrize("terrain", TERRAINS)
 def test_footprint_clearance_is_the_lowest_point_of_the_torso_bottom_above_the_terrain(terrain):
     env = gym.make(ENV_ID, terrain=terrain)
     env.reset(seed=5)

@@ -57,12 +57,16 @@ non-adaptive "simple control".
 | gait_phase | 3 | sin, cos of 2π x the gait-cycle phase; 1 if the next step starts a gait cycle |
 | posture_gains | 3 | ("gains" mode only) (k_z, k_α, k_β) in effect this cycle |
 | terrain_scan | 15 | (``terrain_scan=True``) torso height above the terrain at 5 x 3 points [m] |
+| foot_scan | 108 | (``foot_scan=True``) each foot's height above the terrain at 6 x 3 points [m] |
 
 ``terrain_scan=True`` adds what the robot's sensors cannot give: the true terrain around and
 ahead of the torso, at `SCAN_X` (0.15 m behind to 0.25 m ahead along the torso's heading) x
 `SCAN_Y` (the feet's lateral span) - the privileged height samples that legged-robot RL
 commonly feeds a policy on rough ground (for a learner or a teacher policy; the paper's robot
-has no such sensor).
+has no such sensor). ``foot_scan=True`` samples the terrain around each foot instead, finely
+enough to place it relative to a block's edge: per leg (LF LM LR RF RM RR) the foot's height
+above the terrain at `FOOT_SCAN_X` (3 cm behind to 12 cm ahead, where the next steps land) x
+`FOOT_SCAN_Y`, 3 cm apart - the per-foot height samples of perceptive legged locomotion.
 
 Action modes (``action_mode=``):
 
@@ -211,6 +215,12 @@ SCAN_Y = (-0.15, 0.0, 0.15)
 """Terrain-scan columns: distance to the left of the torso centre [m] (the feet stand at about
 ±0.15 m)."""
 
+FOOT_SCAN_X = (-0.03, 0.0, 0.03, 0.06, 0.09, 0.12)
+"""Foot-scan rows: distance ahead of each foot along the torso's heading [m] (a stride is
+0.06 m; the blocks are 0.2-0.25 m wide)."""
+FOOT_SCAN_Y = (-0.03, 0.0, 0.03)
+"""Foot-scan columns: distance to the left of each foot [m]."""
+
 _CONTACT_CHECKS = 5
 """Torso-terrain contact is looked for this many times per control period (every 10 ms)."""
 
@@ -266,6 +276,8 @@ class IrregularTerrainSettings(EnvSettings):
     gait_ground_search: str = choice("auto", GROUND_SEARCH)
     terrain_scan: bool = choice(False, (False, True))
     """Add the privileged ``terrain_scan`` observation piece (see the module docstring)."""
+    foot_scan: bool = choice(False, (False, True))
+    """Add the privileged ``foot_scan`` observation piece (see the module docstring)."""
     servo_kp: float = number(6.8, strict=True)
     """Servo stiffness [N·m/rad] (calibrated to the paper's simple-control ramp sag, 0.068 m; 8
     before 2026-11-24)."""
@@ -346,6 +358,8 @@ class IrregularTerrainEnv(HexapodEnv):
         s = self.settings
         ahead, left = np.meshgrid(SCAN_X, SCAN_Y, indexing="ij")
         self._scan_offsets = (ahead.reshape(-1), left.reshape(-1))
+        ahead, left = np.meshgrid(FOOT_SCAN_X, FOOT_SCAN_Y, indexing="ij")
+        self._foot_scan_offsets = (ahead.reshape(-1), left.reshape(-1))
         if self.n_substeps % _CONTACT_CHECKS:
             raise ValueError(
                 f"control_dt / physics_dt = {self.n_substeps} substeps must be a multiple of "
@@ -732,6 +746,9 @@ class IrregularTerrainEnv(HexapodEnv):
             pieces["posture_gains"] = (3, lambda: self.controller.gains)
         if self.settings.terrain_scan:
             pieces["terrain_scan"] = (len(SCAN_X) * len(SCAN_Y), self.terrain_scan)
+        if self.settings.foot_scan:
+            size = 6 * len(FOOT_SCAN_X) * len(FOOT_SCAN_Y)
+            pieces["foot_scan"] = (size, self.foot_scan)
         return pieces
 
     def terrain_scan(self) -> np.ndarray:
@@ -744,6 +761,19 @@ class IrregularTerrainEnv(HexapodEnv):
         c, s = math.cos(heading), math.sin(heading)
         ahead, left = self._scan_offsets
         return z - self._ground(x + c * ahead - s * left, y + s * ahead + c * left)
+
+    def foot_scan(self) -> np.ndarray:
+        """(6 x 18,) each foot's height above the terrain at the foot-scan points [m]: per leg,
+        rows `FOOT_SCAN_X` ahead of the foot along the torso's heading, columns `FOOT_SCAN_Y`
+        to its left (privileged, like `terrain_scan`)."""
+        rot = self.sensors.torso_rotation()
+        heading = math.atan2(float(rot[1, 0]), float(rot[0, 0]))
+        c, s = math.cos(heading), math.sin(heading)
+        ahead, left = self._foot_scan_offsets
+        feet = self.sensors.foot_positions()
+        px = feet[:, :1] + (c * ahead - s * left)
+        py = feet[:, 1:2] + (s * ahead + c * left)
+        return np.broadcast_to(feet[:, 2:3] - self._ground(px, py), px.shape).reshape(-1)
 
     def step_cost_bound(self) -> float:
         """The largest cost one step can carry (the bounded negative parts of every term but
