@@ -7,6 +7,10 @@ Collect once (the expensive step), then fit:
     fit       fits the actor of the config's PPO model to them; writes a model directory that
               evaluate.py's ppo:<dir> runs
     curve     the held-out cost of fits to growing subsets of the training beds
+    choose    is the look-ahead's per-cycle choice predictable from the observation? A
+              diagnostic student (`fit_choice`) regresses every candidate's cost and picks the
+              cheapest predicted; its choices' cost on the last beds, trained on growing subsets
+              of the others, optionally without some observation pieces (--drop)
 
 Measured on the blocks (2026-11-24, at the then default 2 ms physics step; CONFIG below; the
 look-ahead over the 3 x 3 x 3 lattice of 0.2/0.5/0.8 and the paper's gains on 56 training beds,
@@ -25,6 +29,13 @@ cores; the last 11 beds held out):
   944, 8/20). The contact avoidance learned on the lower training blocks transfers to the
   taller test blocks; a lower rate does not: the trade of the low-k_z fixed settings in
   reports/gains_ceiling_blocks.md.
+
+`choose` on the blocks (2026-11-25, 2.5 ms physics; CONFIG with --set env.kwargs.foot_scan=true,
+112 training beds, 2480 cycles, 3.9 M env steps, 30 min on 2 cores; test: the last 22 beds,
+the paper's gains 0.16889, the teacher 0.14362): trained on 22 / 45 / 90 beds the student's
+choices cost 0.16983 / 0.17083 / 0.16944 (--drop foot_scan: 0.16877 / 0.17053 / 0.16834; --drop
+foot_scan terrain_scan: 0.17030 / 0.16967 / 0.16836), mean of 3 seeds: within 1 % of the paper's
+gains whatever it sees. The footing does not make the teacher's choice predictable.
 
 Run (CONFIG: configs/irregular_terrain_gains_blocks_scan.yaml):
     python scripts/distill_gains.py collect --config CONFIG --episodes 56 --workers 2 \
@@ -51,6 +62,7 @@ from agents.pipeline.gains_distill import (  # noqa: E402
     Demonstrations,
     demonstrate,
     distill,
+    fit_choice,
     held_out_rows,
 )
 from agents.pipeline.train_config import load_train_config  # noqa: E402
@@ -141,6 +153,60 @@ def curve(args: argparse.Namespace) -> None:
         )
 
 
+def choose(args: argparse.Namespace) -> None:
+    """Is the teacher's per-cycle choice predictable from the observation (`fit_choice`)? Test
+    rows: the last --test-beds beds; students trained on growing random subsets of the others
+    (a fifth of each subset's beds for early stopping), without the --drop pieces."""
+    demos = Demonstrations.load(args.demos)
+    env = env_spec(load_train_config(args.config, args.set)).make()
+    try:
+        structure = env.unwrapped.observation_structure
+    finally:
+        env.close()
+    width = max(piece.stop for piece in structure.values())
+    if demos.observations.shape[1] != width:
+        raise ValueError(
+            f"{args.demos} has {demos.observations.shape[1]}-wide observations, the config's env "
+            f"{width}: pass the --set options it was collected with"
+        )
+    unknown = sorted(set(args.drop) - set(structure))
+    if unknown:
+        raise ValueError(f"--drop {unknown}: not observation pieces; valid: {sorted(structure)}")
+    keep = np.ones(width, dtype=bool)
+    for name in args.drop:
+        keep[structure[name]] = False
+    beds = np.unique(demos.beds)
+    test = np.isin(demos.beds, beds[-args.test_beds :])
+    pool = beds[: -args.test_beds]
+    for n in args.beds:
+        results = []
+        for seed in range(args.seeds):
+            chosen = np.random.default_rng(seed).choice(pool, min(n, len(pool)), replace=False)
+            validation = np.isin(demos.beds, chosen[: max(1, len(chosen) // 5)])
+            train = np.isin(demos.beds, chosen) & ~validation
+            results.append(
+                fit_choice(
+                    demos.observations[:, keep],
+                    demos,
+                    train,
+                    validation,
+                    test,
+                    _cost(args),
+                    epochs=args.epochs,
+                    seed=seed,
+                )
+            )
+        costs = [r.cost for r in results]
+        first = results[0]
+        print(
+            f"{len(chosen)} training beds: test cost {np.mean(costs):.5f} ± {np.std(costs):.5f} "
+            f"over {args.seeds} seeds, {np.mean([r.departed for r in results]):.0%} of cycles "
+            f"off the reference (reference {first.reference_cost:.5f}, teacher "
+            f"{first.teacher_cost:.5f}; {test.sum()} test cycles)",
+            flush=True,
+        )
+
+
 def _cost(args: argparse.Namespace) -> CycleCost:
     return CycleCost(args.contact_cost, args.clearance_cost, args.clearance_margin)
 
@@ -159,7 +225,8 @@ def main(argv: list[str] | None = None) -> None:
     c = commands.add_parser("collect", help="the look-ahead's demonstrations on training beds")
     f = commands.add_parser("fit", help="fit the config's actor to demonstrations")
     r = commands.add_parser("curve", help="held-out cost against the number of training beds")
-    for p in (c, f, r):
+    h = commands.add_parser("choose", help="is the teacher's choice predictable? (fit_choice)")
+    for p in (c, f, r, h):
         p.add_argument("--config", type=Path, required=True, help="training config (gains mode)")
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
         # the cycle cost (agents.gains_lookahead.CycleCost) the teacher or the student minimises
@@ -181,8 +248,14 @@ def main(argv: list[str] | None = None) -> None:
     f.add_argument("--out", type=Path, required=True, help="model directory to write")
     r.add_argument("--fractions", type=float, nargs="+", default=[0.25, 0.5, 1.0])
     r.add_argument("--seeds", type=int, default=3)
+    h.add_argument("--demos", type=Path, required=True)
+    h.add_argument("--test-beds", type=int, default=22, help="the last beds, held out for testing")
+    h.add_argument("--beds", type=int, nargs="+", default=[22, 45, 90], help="training beds")
+    h.add_argument("--seeds", type=int, default=3)
+    h.add_argument("--epochs", type=int, default=150)
+    h.add_argument("--drop", nargs="+", default=[], metavar="PIECE", help="observation pieces")
     args = parser.parse_args(argv)
-    {"collect": collect, "fit": fit, "curve": curve}[args.command](args)
+    {"collect": collect, "fit": fit, "curve": curve, "choose": choose}[args.command](args)
 
 
 if __name__ == "__main__":

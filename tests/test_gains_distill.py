@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -16,6 +18,7 @@ from agents.pipeline.gains_distill import (
     Demonstrations,
     demonstrate,
     fit_actor,
+    fit_choice,
     interpolated_cost,
     lattice_costs,
 )
@@ -197,3 +200,32 @@ def test_script_collects_fits_and_the_model_runs_in_the_evaluation(tmp_path, cap
         ]
     )
     assert "1 training beds: held-out cost" in capsys.readouterr().out
+    # choose: two more beds (the same rows relabelled) so that test, validation and training
+    # each get one
+    collected = Demonstrations.load(demos)
+    four = tmp_path / "four.npz"
+    relabelled = dataclasses.replace(collected, beds=collected.beds + 2)
+    Demonstrations.concatenate([collected, relabelled]).save(four)
+    choose = ["choose", "--config", CONFIG, "--demos", str(four), "--test-beds", "1"]
+    script.main([*choose, "--beds", "3", "--seeds", "1", "--epochs", "2", "--drop", "terrain_scan"])
+    assert "2 training beds" not in (out := capsys.readouterr().out)
+    assert "3 training beds: test cost" in out and "reference" in out
+    with pytest.raises(ValueError, match="not observation pieces; valid: .*terrain_scan"):
+        script.main([*choose, "--drop", "terrain"])
+    with pytest.raises(ValueError, match="wide observations.*--set"):
+        script.main([*choose, "--set", "env.kwargs.foot_scan=true"])
+
+
+def test_fit_choice_predicts_the_state_dependent_choice():
+    demos = _synthetic()
+    beds = demos.beds
+    result = fit_choice(
+        demos.observations, demos, beds < 12, (beds >= 12) & (beds < 16), beds >= 16
+    )
+    # the reference (k_z 0.6) is 0.2 or 0.4 from the cheapest k_z; the student follows feature 0
+    assert result.cost < result.teacher_cost + 0.05 < result.reference_cost - 0.15
+    assert result.departed > 0.9
+    blind = fit_choice(np.zeros_like(demos.observations), demos, beds < 12, beds >= 12, beds >= 16)
+    assert blind.cost > result.cost + 0.1  # without feature 0 no choice follows it
+    with pytest.raises(ValueError, match="training, validation and test"):
+        fit_choice(demos.observations, demos, beds < 0, beds >= 12, beds >= 16)
