@@ -176,6 +176,11 @@ def choose(args: argparse.Namespace) -> None:
     for name in args.drop:
         keep[structure[name]] = False
     beds = np.unique(demos.beds)
+    if not 0 < args.test_beds <= len(beds) - 2:
+        raise ValueError(
+            f"--test-beds {args.test_beds}: {args.demos} has {len(beds)} beds, and at least two "
+            "must remain for training and validation"
+        )
     test = np.isin(demos.beds, beds[-args.test_beds :])
     pool = beds[: -args.test_beds]
     for n in args.beds:

@@ -212,6 +212,8 @@ def test_script_collects_fits_and_the_model_runs_in_the_evaluation(tmp_path, cap
     assert "3 training beds: test cost" in out and "reference" in out
     with pytest.raises(ValueError, match="not observation pieces; valid: .*terrain_scan"):
         script.main([*choose, "--drop", "terrain"])
+    with pytest.raises(ValueError, match="--test-beds 3: .* 4 beds, and at least two"):
+        script.main([*choose[:-1], "3"])
     with pytest.raises(ValueError, match="wide observations.*--set"):
         script.main([*choose, "--set", "env.kwargs.foot_scan=true"])
 
