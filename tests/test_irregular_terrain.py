@@ -4,6 +4,7 @@ cycle-start rule, per-cycle statistics, torso contact, start poses and bad input
 import math
 
 import gymnasium as gym
+import mujoco
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env as gym_check_env
@@ -281,6 +282,17 @@ def test_foot_scan_is_each_foots_height_above_the_terrain_around_it(terrain):
                 py = fy + math.sin(heading) * ahead + math.cos(heading) * left
                 ground = 0.0 if info is None else info.height_at(px, py)
                 assert scan[leg, i, j] == pytest.approx(fz - ground, abs=1e-6)
+    if terrain == "blocks":  # turned to face +y: ahead is +y and left is -x
+        root = base.model.jnt_qposadr[0]
+        base.data.qpos[root + 3 : root + 7] = [math.cos(math.pi / 4), 0, 0, math.sin(math.pi / 4)]
+        mujoco.mj_forward(base.model, base.data)
+        turned = base.foot_scan().reshape(6, len(FOOT_SCAN_X), 3)
+        for leg, (fx, fy, fz) in enumerate(base.sensors.foot_positions().tolist()):
+            for i, ahead in enumerate(FOOT_SCAN_X):
+                for j, left in enumerate(FOOT_SCAN_Y):
+                    expected = fz - info.height_at(fx - left, fy + ahead)
+                    assert turned[leg, i, j] == pytest.approx(expected, abs=1e-9)
+        assert np.ptp(turned) > 0.02  # the block edges show
     own_spot = scan[:, FOOT_SCAN_X.index(0.0), FOOT_SCAN_Y.index(0.0)]
     loaded = obs[base.observation_structure["foot_contact"]] > 0
     assert loaded.sum() >= 3

@@ -64,9 +64,10 @@ ahead of the torso, at `SCAN_X` (0.15 m behind to 0.25 m ahead along the torso's
 `SCAN_Y` (the feet's lateral span) - the privileged height samples that legged-robot RL
 commonly feeds a policy on rough ground (for a learner or a teacher policy; the paper's robot
 has no such sensor). ``foot_scan=True`` samples the terrain around each foot instead, finely
-enough to place it relative to a block's edge: per leg (LF LM LR RF RM RR) the foot's height
-above the terrain at `FOOT_SCAN_X` (3 cm behind to 12 cm ahead, where the next steps land) x
-`FOOT_SCAN_Y`, 3 cm apart - the per-foot height samples of perceptive legged locomotion.
+enough to place it relative to a block's edge: per leg (LF LM LR RF RM RR) the height of the
+foot sphere's centre above the terrain at `FOOT_SCAN_X` (3 cm behind to 12 cm ahead, where the
+next steps land) x `FOOT_SCAN_Y`, 3 cm apart - the per-foot height samples of perceptive legged
+locomotion.
 
 Action modes (``action_mode=``):
 
@@ -765,7 +766,8 @@ class IrregularTerrainEnv(HexapodEnv):
     def foot_scan(self) -> np.ndarray:
         """(6 x 18,) each foot's height above the terrain at the foot-scan points [m]: per leg,
         rows `FOOT_SCAN_X` ahead of the foot along the torso's heading, columns `FOOT_SCAN_Y`
-        to its left (privileged, like `terrain_scan`)."""
+        to its left (privileged, like `terrain_scan`). The height is the foot sphere's centre's,
+        so a foot standing on the ground reads its radius (0.02 m) at its own point."""
         rot = self.sensors.torso_rotation()
         heading = math.atan2(float(rot[1, 0]), float(rot[0, 0]))
         c, s = math.cos(heading), math.sin(heading)
