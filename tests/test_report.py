@@ -42,7 +42,7 @@ def test_report_has_no_placeholder_a_verdict_per_env_and_the_reading_guide(repor
     assert metrics["envs"]["HexapodDitchCrossing-v0"]["xi_deg"] == 0.0
 
 
-def _record(length, time_below, distance, tipped, dt=0.02):
+def _record(length, time_below, distance, tipped, dt=0.02, fasm_min=None):
     return EpisodeRecord(
         length=length,
         duration_s=length * dt,
@@ -52,7 +52,7 @@ def _record(length, time_below, distance, tipped, dt=0.02):
         tipped_over=tipped,
         terminated=tipped,
         truncated=not tipped,
-        fasm_min_deg=5.0 if tipped else 30.0,
+        fasm_min_deg=fasm_min if fasm_min is not None else (5.0 if tipped else 30.0),
         fasm_mean_deg=30.0,
         time_below_xi_s=time_below,
         fraction_below_xi=time_below / (length * dt),
@@ -80,6 +80,22 @@ def test_a_policy_that_tips_early_does_not_beat_on_shorter_totals():
     assert "time_below_xi_s" not in outcome and "distance_m" not in outcome
     paragraph = verdict_paragraph(result, aggs)
     assert paragraph.startswith("**Verdict:** `zero` succeeds most often (3/3 successes")
+
+
+def test_the_verdict_compares_the_leaders_stability_only_where_it_differs():
+    result = EnvResult("Env-v0", {}, 100, 0.02, [])
+    upright = [_record(100, 0.5, 1.0, False)] * 3  # minimum FASM 30°
+    result.runs = {name: PolicyRun(name, name, upright) for name in ("analytical", "ppo:x")}
+    aggs = {n: aggregate(r.episodes) for n, r in result.runs.items()}
+    paragraph = verdict_paragraph(result, aggs)
+    assert "Their median minimum FASM is the same, 30°." in paragraph
+    assert "differs" not in paragraph
+    lower = [_record(100, 0.5, 1.0, False, fasm_min=20.0)] * 3
+    result.runs["ppo:x"] = PolicyRun("ppo:x", "x", lower)
+    aggs = {n: aggregate(r.episodes) for n, r in result.runs.items()}
+    assert "differs: median minimum FASM 30° for `analytical` down to 20° for `ppo:x`" in (
+        verdict_paragraph(result, aggs)
+    )
 
 
 def test_video_is_written_linked_and_embedded(tmp_path):

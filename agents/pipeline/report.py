@@ -233,13 +233,15 @@ def verdict_paragraph(result: EnvResult, aggs: dict[str, dict]) -> str:
         head = f"{names} {verb} most often ({outcome})."
     parts = [f"**Verdict:** {head}"]
     with_fasm = [n for n in leaders if math.isfinite(_median_min_fasm(aggs[n]))]
-    if len(with_fasm) > 1:
+    medians = [_median_min_fasm(aggs[n]) for n in with_fasm]
+    if len(with_fasm) > 1 and medians[0] != medians[-1]:
         most, least = with_fasm[0], with_fasm[-1]
         parts.append(
             f"Among them the stability cost differs: median minimum FASM "
-            f"{_num(_median_min_fasm(aggs[most]))}° for `{most}` down to "
-            f"{_num(_median_min_fasm(aggs[least]))}° for `{least}`."
+            f"{_num(medians[0])}° for `{most}` down to {_num(medians[-1])}° for `{least}`."
         )
+    elif len(with_fasm) > 1:
+        parts.append(f"Their median minimum FASM is the same, {_num(medians[0])}°.")
     elif with_fasm:
         parts.append(f"Median minimum FASM {_num(_median_min_fasm(best))}°.")
     others = [
