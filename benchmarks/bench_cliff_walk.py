@@ -3,12 +3,16 @@
 Targets (issue 2): env/raw ratio >= 0.9 (Gymnasium's Ant-v5 is measured alongside for context),
 FASM <= 20 us per call. The same rates in simulated seconds per wall second (x the model's
 timestep) show issue 14's target for the cliff (>= 100 with random actions) beside what the raw
-physics alone reaches at the 1 ms step. Run: python benchmarks/bench_cliff_walk.py
+physics alone reaches at the 1 ms step. ``--solver-options`` adds raw rates under MuJoCo's
+other solver options (is any of them a factor of 2?). Run:
+python benchmarks/bench_cliff_walk.py [--solver-options]
 """
 
 from __future__ import annotations
 
+import argparse
 import sys
+import time
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +24,10 @@ from benchmarks.common import env_vs_raw, per_call_us
 from hexapod_envs.stability import fasm
 
 
-def main() -> None:
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--solver-options", action="store_true", help="raw rate per solver option")
+    args = parser.parse_args(argv)
     rows = [("HexapodCliffWalk-v0", *env_vs_raw("HexapodCliffWalk-v0"))]
     try:
         rows.append(("Ant-v5 (Gymnasium)", *env_vs_raw("Ant-v5")))
@@ -44,6 +51,54 @@ def main() -> None:
     moment = np.array([100.0, -50.0, 0.0])
     print(f"FASM, 3 feet: {per_call_us(fasm, tripod, cog, weight, moment):6.1f} us per call")
     print(f"FASM, 6 feet: {per_call_us(fasm, six, cog, weight, moment):6.1f} us per call")
+    if args.solver_options:
+        solver_options()
+
+
+def solver_options(steps: int = 4000, repeats: int = 3) -> None:
+    """Raw mj_step/s of the cliff walk's model from a standing state (after 50 zero-action env
+    steps), best of `repeats` rounds over all options, per MuJoCo solver option (one option
+    changed at a time)."""
+    import gymnasium as gym
+    import mujoco
+
+    env = gym.make("HexapodCliffWalk-v0")
+    env.reset(seed=0)
+    for _ in range(50):
+        env.step(np.zeros(env.action_space.shape))
+    model, data = env.unwrapped.model, env.unwrapped.data
+    kind = mujoco.mjtState.mjSTATE_INTEGRATION
+    start = np.empty(mujoco.mj_stateSize(model, kind))
+    mujoco.mj_getState(model, data, start, kind)
+    opt, off = model.opt, mujoco.mjtDisableBit
+    options = {
+        "default": {},
+        "solver CG": {"solver": mujoco.mjtSolver.mjSOL_CG},
+        "solver PGS": {"solver": mujoco.mjtSolver.mjSOL_PGS},
+        "pyramidal cone": {"cone": mujoco.mjtCone.mjCONE_PYRAMIDAL},
+        "dense Jacobian": {"jacobian": mujoco.mjtJacobian.mjJAC_DENSE},
+        "sparse Jacobian": {"jacobian": mujoco.mjtJacobian.mjJAC_SPARSE},
+        "no midphase": {"disableflags": opt.disableflags | off.mjDSBL_MIDPHASE},
+        "no warm start": {"disableflags": opt.disableflags | off.mjDSBL_WARMSTART},
+        "default, again": {},  # the spread of the timing itself
+    }
+    default = {name: getattr(opt, name) for change in options.values() for name in change}
+    for _ in range(steps):  # warm up: the first timed loop ran 15 % slow without this
+        mujoco.mj_step(model, data)
+    best = dict.fromkeys(options, 0.0)
+    for _ in range(repeats):  # rounds over all options, so that drifts of the machine spread
+        for label, change in options.items():
+            for name, value in {**default, **change}.items():
+                setattr(opt, name, value)
+            mujoco.mj_setState(model, data, start, kind)
+            t0 = time.perf_counter()
+            for _ in range(steps):
+                mujoco.mj_step(model, data)
+            best[label] = max(best[label], steps / (time.perf_counter() - t0))
+    print(f"{'solver option':18s} {'raw mj_step/s':>14s} {'x default':>10s}")
+    for label, rate in best.items():
+        print(f"{label:18s} {rate:14.0f} {rate / best['default']:10.2f}")
+    env.close()
 
 
 def _timestep(env_id: str) -> float:
