@@ -161,12 +161,9 @@ def choose(args: argparse.Namespace) -> None:
     rows: the last --test-beds beds; students trained on growing random subsets of the others
     (a fifth of each subset's beds for early stopping), without the --drop pieces."""
     demos = Demonstrations.load(args.demos)
-    env = env_spec(load_train_config(args.config, args.set)).make()
-    try:
+    with env_spec(load_train_config(args.config, args.set)).make() as env:
         structure = env.unwrapped.observation_structure
-    finally:
-        env.close()
-    width = max(piece.stop for piece in structure.values())
+        (width,) = env.observation_space.shape
     if demos.observations.shape[1] != width:
         raise ValueError(
             f"{args.demos} has {demos.observations.shape[1]}-wide observations, the config's env "

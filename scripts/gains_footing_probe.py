@@ -73,9 +73,9 @@ def probe(beds: int, cycles: int, make_env=gains_env) -> tuple[int, int]:
             starts += 1
             as_is = {gains: play_cycle(env, gains) for gains in SETTINGS}
             for shift in SHIFTS:
+                twin = copy.deepcopy(env)  # play_cycle plays copies of it: one shift serves all
+                shift_far_blocks(twin, np.asarray(shift))
                 for gains in SETTINGS:
-                    twin = copy.deepcopy(env)
-                    shift_far_blocks(twin, np.asarray(shift))
                     unchanged += play_cycle(twin, gains) == as_is[gains]
                     played += 1
         env.close()

@@ -357,10 +357,8 @@ class IrregularTerrainEnv(HexapodEnv):
 
     def _setup(self) -> None:
         s = self.settings
-        ahead, left = np.meshgrid(SCAN_X, SCAN_Y, indexing="ij")
-        self._scan_offsets = (ahead.reshape(-1), left.reshape(-1))
-        ahead, left = np.meshgrid(FOOT_SCAN_X, FOOT_SCAN_Y, indexing="ij")
-        self._foot_scan_offsets = (ahead.reshape(-1), left.reshape(-1))
+        self._scan_offsets = _offsets(SCAN_X, SCAN_Y)
+        self._foot_scan_offsets = _offsets(FOOT_SCAN_X, FOOT_SCAN_Y)
         if self.n_substeps % _CONTACT_CHECKS:
             raise ValueError(
                 f"control_dt / physics_dt = {self.n_substeps} substeps must be a multiple of "
@@ -748,7 +746,7 @@ class IrregularTerrainEnv(HexapodEnv):
         if self.settings.terrain_scan:
             pieces["terrain_scan"] = (len(SCAN_X) * len(SCAN_Y), self.terrain_scan)
         if self.settings.foot_scan:
-            size = 6 * len(FOOT_SCAN_X) * len(FOOT_SCAN_Y)
+            size = len(LEG_NAMES) * len(FOOT_SCAN_X) * len(FOOT_SCAN_Y)
             pieces["foot_scan"] = (size, self.foot_scan)
         return pieces
 
@@ -757,25 +755,28 @@ class IrregularTerrainEnv(HexapodEnv):
         ahead along the torso's heading, columns `SCAN_Y` to its left (privileged: the terrain
         model and the true pose)."""
         x, y, z = self.sensors.torso_position().tolist()
-        rot = self.sensors.torso_rotation()
-        heading = math.atan2(float(rot[1, 0]), float(rot[0, 0]))
-        c, s = math.cos(heading), math.sin(heading)
-        ahead, left = self._scan_offsets
-        return z - self._ground(x + c * ahead - s * left, y + s * ahead + c * left)
+        return z - self._ground_around(x, y, self._scan_offsets)
 
     def foot_scan(self) -> np.ndarray:
         """(6 x 18,) each foot's height above the terrain at the foot-scan points [m]: per leg,
         rows `FOOT_SCAN_X` ahead of the foot along the torso's heading, columns `FOOT_SCAN_Y`
         to its left (privileged, like `terrain_scan`). The height is the foot sphere's centre's,
         so a foot standing on the ground reads its radius (0.02 m) at its own point."""
+        feet = self.sensors.foot_positions()
+        points = len(self._foot_scan_offsets[0])
+        ground = self._ground_around(feet[:, :1], feet[:, 1:2], self._foot_scan_offsets)
+        heights = feet[:, 2:3] - ground  # (6, 1) on flat ground, which has no model
+        return np.broadcast_to(heights, (len(feet), points)).reshape(-1)
+
+    def _ground_around(self, x, y, offsets: tuple[np.ndarray, np.ndarray]):
+        """True terrain height [m] at `offsets` (ahead, left) [m] from the world points (x, y),
+        ahead along the torso's heading: (n,) offsets around a point, (k, n) around k points
+        given as (k, 1) columns (a float 0 on flat ground)."""
         rot = self.sensors.torso_rotation()
         heading = math.atan2(float(rot[1, 0]), float(rot[0, 0]))
         c, s = math.cos(heading), math.sin(heading)
-        ahead, left = self._foot_scan_offsets
-        feet = self.sensors.foot_positions()
-        px = feet[:, :1] + (c * ahead - s * left)
-        py = feet[:, 1:2] + (s * ahead + c * left)
-        return np.broadcast_to(feet[:, 2:3] - self._ground(px, py), px.shape).reshape(-1)
+        ahead, left = offsets
+        return self._ground(x + c * ahead - s * left, y + s * ahead + c * left)
 
     def step_cost_bound(self) -> float:
         """The largest cost one step can carry (the bounded negative parts of every term but
@@ -835,6 +836,12 @@ class IrregularTerrainEnv(HexapodEnv):
             # A fresh copy whenever the lists change (and at reset): infos must not share data.
             info["episode_metrics"] = {k: list(v) for k, v in self._episode_metrics.items()}
         return info
+
+
+def _offsets(ahead: tuple[float, ...], left: tuple[float, ...]) -> tuple[np.ndarray, np.ndarray]:
+    """The (ahead, left) offsets [m] of a scan grid, rows `ahead`, columns `left`, flattened."""
+    rows, columns = np.meshgrid(ahead, left, indexing="ij")
+    return rows.reshape(-1), columns.reshape(-1)
 
 
 def _gain_kwargs(gains: tuple[float, ...]) -> dict[str, float]:
