@@ -1,11 +1,16 @@
-"""Compiled geometry of the force-distribution QP (private; numba).
+"""Compiled kernels of the tipping recovery's control step (private; numba).
 
-The QP is rebuilt every control period of the tipping recovery on 3-6 stance feet; as
-plain-float Python its geometry (stability cone, tipping-force terms, wrench map) took most of
-the build's time in interpreter overhead. These ``numba.njit`` kernels do the same arithmetic
-in the same order, so U, f, G and h stay bit-identical
-(tests/test_tipping_force_distribution.py checks it against the original assembly); the matrix
-products stay in numpy in :mod:`.force_distribution`. Compiled on first use and cached on disk,
+The force-distribution QP is rebuilt every control period on 3-6 stance feet, and the supported
+phase around it (sensing, desired wrench, the force error's internal part, the servo offsets)
+runs every period too; as Python and small numpy calls these took most of the step's time in
+interpreter overhead. These ``numba.njit`` kernels do the same arithmetic in the same order:
+plain-float formulas stay plain floats (numba does not fuse multiply-adds), and the matrix
+products are ``np.dot`` calls, i.e. the BLAS routines numpy's ``@`` calls (numba binds them
+through scipy's BLAS). Where numpy's and scipy's BLAS give the same bits, as they do for these
+small products on the machines this was measured on, U, f, G, h and the controller's actions
+are unchanged to the bit (tests/test_tipping_force_distribution.py checks it against the
+original assembly). The 6 x 6 solve stays numpy's LAPACK call (scipy's, reached from numba,
+differs in the last bit for about 6 % of systems). Compiled on first use and cached on disk,
 like :mod:`hexapod_envs.stability._compiled`. Kernels return status codes; the callers raise.
 """
 
@@ -233,6 +238,89 @@ def qp_geometry(feet, cog, wrench, normal, fit_normal, cone_ratio, with_cone):
 
 
 @njit(cache=True)
+def qp_problem(
+    feet,
+    cog,
+    wrench,
+    normal,
+    fit_normal,
+    cone_ratio,
+    with_cone,
+    weights,
+    unit_weights,
+    reg,
+    pyramid,
+    min_normal_force,
+):
+    """One whole QP build (see ForceDistributor.build): :func:`qp_geometry` and the matrices.
+
+    ``weights`` is S as a (6, 1) column (``unit_weights``: all ones), ``reg`` is 2κW (3k, 3k),
+    ``pyramid`` the (4, 3) friction rows in the tangent frame. Returns (status, detail, normal,
+    A, hull, edges, cone values, d_min, radius, scale, U, f, G, h); past a failed status the
+    last five are placeholders. The products are ``np.dot`` calls, i.e. the same BLAS routines
+    that numpy's ``@`` calls (numba binds them through scipy), in the order of the former numpy
+    expressions, so U, f, G and h keep their bits where the two libraries agree (checked against
+    the original assembly in tests/test_tipping_force_distribution.py).
+    """
+    status, bad, normal, a_mat, frame, hull, edges, values, d_min, radius, ima, couple = (
+        qp_geometry(feet, cog, wrench, normal, fit_normal, cone_ratio, with_cone)
+    )
+    k, m = feet.shape[0], hull.shape[0]
+    rows = 5 * k + (4 * m if with_cone else 0)
+    g_mat = np.zeros((rows, 3 * k))
+    h_vec = np.zeros(rows)
+    if status != OK:
+        empty = np.empty((0, 0))
+        return (
+            *(status, bad, normal, a_mat, hull, edges, values, d_min, radius),
+            *(0.0, empty, np.empty(0), g_mat, h_vec),
+        )
+    force = wrench[:3]
+    scale = max(math.sqrt(np.dot(force, force)), k * min_normal_force, 1.0)
+    sa = a_mat if unit_weights else weights * a_mat  # 1.0 * v is v exactly
+    u_mat = np.dot(2.0 * a_mat.T, sa) + reg
+    f_vec = np.dot(-2.0 * sa.T, wrench / scale)
+    # G: per foot its normal row (-n), then its four friction rows; then 4 rows per edge.
+    friction_rows = np.dot(pyramid, frame)  # frame rows t1, t2, n
+    for i in range(k):
+        c = 3 * i
+        for j in range(3):
+            g_mat[i, c + j] = -normal[j]
+            for r in range(4):
+                g_mat[k + 4 * i + r, c + j] = friction_rows[r, j]
+        h_vec[i] = -min_normal_force / scale
+    if with_cone:
+        # faces · f*_e <= 0 with f*_e = -V_e x, V_e = couple_e [[P_1]x ... [P_k]x]
+        # + [I - a aᵀ ... I - a aᵀ]: rows -(faces @ V_e), edge by edge.
+        moment_rows = np.ascontiguousarray(a_mat[3:])
+        faces = np.ascontiguousarray(values[19:31]).reshape(4, 3)
+        for e in range(m):
+            v = np.dot(couple[e], moment_rows)
+            for r in range(3):
+                for c in range(3 * k):
+                    v[r, c] += ima[e, r, c % 3]
+            cone_rows = np.dot(faces, v)
+            for r in range(4):
+                for c in range(3 * k):
+                    g_mat[5 * k + 4 * e + r, c] = -cone_rows[r, c]
+    return (
+        *(status, bad, normal, a_mat, hull, edges, values, d_min, radius),
+        *(scale, u_mat, f_vec, g_mat, h_vec),
+    )
+
+
+@njit(cache=True)
+def qp_outcome(g_mat, h_vec, x_scaled, scale, a_mat, wrench):
+    """What ForceDistributor.solve_qp reports of a scaled solution: (slack of every constraint
+    [N], largest violation [N], forces x (3k,) [N], their wrench A x, its residual A x - b)."""
+    slack = (h_vec - np.dot(g_mat, x_scaled)) * scale
+    violation = max(0.0, -slack.min())
+    x = x_scaled * scale
+    achieved = np.dot(a_mat, x)
+    return slack, violation, x, achieved, achieved - wrench
+
+
+@njit(cache=True)
 def _failed(status, feet, normal):
     """qp_geometry's result for inputs it refuses: ``status`` and empty placeholders."""
     a_mat = np.zeros((6, 3 * feet.shape[0]))
@@ -305,4 +393,79 @@ def servo_change_for_force(joints, delta_force, legs, l1, k_z, l2, stiffness, jo
         out[r, 0] = (-g_x / stiffness[0]) / joint_scale[0]
         out[r, 1] = (-g_d / stiffness[1]) / joint_scale[1]
         out[r, 2] = (-g_t / stiffness[2]) / joint_scale[2]
+    return out
+
+
+@njit(cache=True)
+def force_error_system(planned, measured, a_mat):
+    """The force error e = planned - measured as (3k,) [N] and the system (A Aᵀ, A e) whose
+    solution y gives e's wrench part Aᵀ y (see TippingRecoveryController._supported)."""
+    error = (planned - measured).ravel()
+    return error, np.dot(a_mat, a_mat.T), np.dot(a_mat, error)
+
+
+@njit(cache=True)
+def internal_part(error, a_mat, y):
+    """e - Aᵀ y: the part of the force error that leaves the support wrench unchanged."""
+    return error - np.dot(a_mat.T, y)
+
+
+@njit(cache=True)
+def add_offsets(offsets, legs, change, gain, max_offset):
+    """offsets[legs] = clip(offsets[legs] + gain change, ±max_offset), in place (the numpy
+    expression's operations, without its fancy-index copies)."""
+    for i in range(legs.shape[0]):
+        leg = legs[i]
+        for j in range(3):
+            value = offsets[leg, j] + gain * change[i, j]
+            offsets[leg, j] = np.minimum(np.maximum(value, -max_offset[j]), max_offset[j])
+
+
+@njit(cache=True)
+def offset_targets(targets, nominal, offsets, legs):
+    """targets[legs] = nominal[legs] + offsets[legs], in place."""
+    for i in range(legs.shape[0]):
+        leg = legs[i]
+        for j in range(3):
+            targets[leg, j] = nominal[leg, j] + offsets[leg, j]
+
+
+@njit(cache=True)
+def body_sensing(quat, foot_forces, contact_sq):
+    """(rotation body -> world (3, 3), foot forces in the body frame (6, 3) [N], loaded (6,))
+    from the IMU quaternion (w, x, y, z) and the world-frame foot forces: the arithmetic of
+    ``quat_to_matrix``, ``forces_to_body`` and the controller's contact test (|f|² above
+    ``contact_sq``) in one call. The caller checks the quaternion's norm."""
+    w, x, y, z = quat[0], quat[1], quat[2], quat[3]
+    s = 2.0 / (w * w + x * x + y * y + z * z)
+    rot = np.empty((3, 3))
+    rot[0, 0] = 1.0 - s * (y * y + z * z)
+    rot[0, 1] = s * (x * y - w * z)
+    rot[0, 2] = s * (x * z + w * y)
+    rot[1, 0] = s * (x * y + w * z)
+    rot[1, 1] = 1.0 - s * (x * x + z * z)
+    rot[1, 2] = s * (y * z - w * x)
+    rot[2, 0] = s * (x * z - w * y)
+    rot[2, 1] = s * (y * z + w * x)
+    rot[2, 2] = 1.0 - s * (x * x + y * y)
+    forces = np.dot(np.ascontiguousarray(foot_forces), rot)
+    loaded = np.empty(forces.shape[0], dtype=np.bool_)
+    for i in range(forces.shape[0]):
+        f0, f1, f2 = forces[i, 0], forces[i, 1], forces[i, 2]
+        loaded[i] = f0 * f0 + f1 * f1 + f2 * f2 > contact_sq
+    return rot, forces, loaded
+
+
+@njit(cache=True)
+def newton_euler_wrench(mass, inertia, gravity, accel, omega, omega_dot):
+    """[m (a - g), I ω̇ + ω × I ω] (6,): the arithmetic of ``desired_wrench`` in one call."""
+    i_omega = np.dot(inertia, omega)
+    i_omega_dot = np.dot(inertia, omega_dot)
+    w0, w1, w2 = omega[0], omega[1], omega[2]
+    out = np.empty(6)
+    for j in range(3):
+        out[j] = mass * (accel[j] - gravity[j])
+    out[3] = i_omega_dot[0] + (w1 * i_omega[2] - w2 * i_omega[1])
+    out[4] = i_omega_dot[1] + (w2 * i_omega[0] - w0 * i_omega[2])
+    out[5] = i_omega_dot[2] + (w0 * i_omega[1] - w1 * i_omega[0])
     return out

@@ -57,10 +57,10 @@ import gymnasium as gym
 import numpy as np
 
 from agents.policy import ObservationReader
+from agents.tipping import _compiled
 from agents.tipping.body_model import (
     GRAVITY,
     HeavyDutyBodyModel,
-    forces_to_body,
     gravity_in_body,
     quat_to_matrix,
 )
@@ -351,11 +351,15 @@ class TippingRecoveryController:
         """(6, 3) joint targets for this control period."""
         cfg = self.config
         self._filter(reading)
-        rot = quat_to_matrix(reading.quat)
+        quat = np.asarray(reading.quat, dtype=float)
+        if not float(quat @ quat) > 0.0:
+            quat_to_matrix(quat)  # raises the error that names the problem
+        # quat_to_matrix, forces_to_body and |f|² > threshold, compiled into one call
+        rot, forces, loaded = _compiled.body_sensing(
+            quat, np.asarray(reading.foot_forces, dtype=float).reshape(6, 3), self._contact_sq
+        )
         joints = np.asarray(reading.joints, dtype=float).reshape(6, 3)
         feet, cog = self.body.feet_and_cog(joints)
-        forces = forces_to_body(reading.foot_forces, rot)
-        loaded = np.add.reduce(forces * forces, axis=1) > self._contact_sq  # .sum(axis=1)
         # FASM [deg] over the loaded feet (body frame), (0, None) without a support polygon; f_r
         # and n_r are minus the measured support wrench about the CoG (Zhang et al. 2024 eq. 4).
         margin, edge = fasm_from_feet(feet, forces, cog, loaded)
@@ -607,16 +611,15 @@ class TippingRecoveryController:
             if result is not None and result.ok and cfg.force_control and complete:
                 # Internal part: error - Aᵀ (A Aᵀ)⁻¹ A error (A has full row rank, k >= 3).
                 a_mat = self._last_qp_a
-                error = (result.forces - measured).reshape(-1)
-                internal = error - a_mat.T @ _solve(a_mat @ a_mat.T, a_mat @ error)
+                error, a_at, a_error = _compiled.force_error_system(result.forces, measured, a_mat)
+                internal = _compiled.internal_part(error, a_mat, _solve(a_at, a_error))
                 change = self.body.target_change_for_force(
                     joints, internal.reshape(-1, 3), legs=support
                 )
-                updated = self._offsets[support] + cfg.force_gain * change
-                self._offsets[support] = np.minimum(
-                    np.maximum(updated, -self._max_offset), self._max_offset
+                _compiled.add_offsets(
+                    self._offsets, support, change, cfg.force_gain, self._max_offset
                 )
-        targets[held] = self._nominal[held] + self._offsets[held]
+        _compiled.offset_targets(targets, self._nominal, self._offsets, held)
 
 
 class TippingRecoveryPolicy:

@@ -133,44 +133,24 @@ def desired_wrench(
     Returns:
         (6,) [F_b (N), T_b (N m)] that the ground must apply through the feet.
     """
-    zero = np.zeros(3)
     inertia = np.asarray(inertia, dtype=float)
     if inertia.shape != (3, 3):
         raise ValueError(f"inertia must be a (3, 3) matrix, got shape {inertia.shape}")
-    g = np.asarray(gravity_body, dtype=float)
-    a = zero if accel_body is None else np.asarray(accel_body, dtype=float)
-    w = zero if omega is None else np.asarray(omega, dtype=float)
-    wd = zero if omega_dot is None else np.asarray(omega_dot, dtype=float)
-    force = mass * (a - g)
-    torque = inertia @ wd + _cross(w, inertia @ w)
-    return np.concatenate([force, torque])
+    vectors = []
+    for name, value in (
+        ("gravity_body", gravity_body),
+        ("accel_body", accel_body),
+        ("omega", omega),
+        ("omega_dot", omega_dot),
+    ):
+        vector = _ZERO3 if value is None else np.asarray(value, dtype=float)
+        if vector.shape != (3,):
+            raise ValueError(f"{name} must be a (3,) vector, got shape {vector.shape}")
+        vectors.append(vector)
+    return _compiled.newton_euler_wrench(float(mass), inertia, *vectors)
 
 
-def _skew(v: np.ndarray) -> np.ndarray:
-    """[v]x for one (3,) or many (m, 3) vectors (-> (3, 3) or (m, 3, 3))."""
-    v = np.asarray(v, dtype=float)
-    out = np.zeros(v.shape[:-1] + (3, 3))
-    out[..., 0, 1], out[..., 0, 2] = -v[..., 2], v[..., 1]
-    out[..., 1, 0], out[..., 1, 2] = v[..., 2], -v[..., 0]
-    out[..., 2, 0], out[..., 2, 1] = -v[..., 1], v[..., 0]
-    return out
-
-
-def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Cross product along the last axis (np.cross is slow for tiny arrays; two 3-vectors are
-    crossed on floats, with the same operations)."""
-    if a.shape == b.shape == (3,):
-        a0, a1, a2 = a.tolist()
-        b0, b1, b2 = b.tolist()
-        return np.array((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0))
-    return np.stack(
-        [
-            a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1],
-            a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2],
-            a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0],
-        ],
-        axis=-1,
-    )
+_ZERO3 = np.zeros(3)
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -376,7 +356,6 @@ class ForceDistributor:
         self._blocks = {"normal": slice(0, k), "friction": slice(k, 5 * k)}
         self._s_col = self._s[:, None]
         self._unit_weights = bool(np.all(self._s == 1.0))
-        self._g_buffers: dict[int, tuple[np.ndarray, ...]] = {}  # see _g_buffer
         self._blocks_by_m: dict[int, dict[str, slice]] = {}
 
     def build(
@@ -391,10 +370,8 @@ class ForceDistributor:
         ``normal`` is the terrain's unit up-normal in the body frame (default: least-squares
         plane through the feet). Raises ValueError on malformed input or degenerate geometry.
 
-        Runs every control period, so the geometry comes from one compiled kernel
-        (:func:`agents.tipping._compiled.qp_geometry`) and is written into per-polygon-size
-        buffers whose constant parts are built once (see :meth:`_g_buffer`); the returned
-        arrays are fresh copies.
+        Runs every control period, so the geometry and the matrices come from one compiled
+        kernel (:func:`agents.tipping._compiled.qp_problem`); the returned arrays are fresh.
         """
         k, cfg = self.n_feet, self.config
         feet = np.asarray(feet, dtype=float)
@@ -409,8 +386,21 @@ class ForceDistributor:
             n = _NO_NORMAL
         else:
             n = np.array(_v_unit(np.asarray(normal, dtype=float).tolist()))
-        status, bad, n, a_mat, frame, hull, edges, values, d_min, radius, ima, couple = (
-            _compiled.qp_geometry(feet, cog, b, n, fit_normal, cfg.cone_ratio, cfg.stability_cone)
+        status, bad, n, a_mat, hull, edges, values, d_min, radius, scale, u_mat, f_vec, g, h = (
+            _compiled.qp_problem(
+                feet,
+                cog,
+                b,
+                n,
+                fit_normal,
+                cfg.cone_ratio,
+                cfg.stability_cone,
+                self._s_col,
+                self._unit_weights,
+                self._reg,
+                self._pyramid,
+                cfg.min_normal_force,
+            )
         )
         if status == _compiled.NOT_FINITE:
             # The kernel's check is a finite sum (NaN and ±inf propagate): finite entries fail
@@ -426,72 +416,29 @@ class ForceDistributor:
             raise ValueError(_cog_below(cog, n))
         if status == _compiled.COG_ON_EDGE:
             raise ValueError(_cog_on_edge(edges[bad]))
-
-        scale = max(math.sqrt(float(b[:3] @ b[:3])), k * cfg.min_normal_force, 1.0)
-        b_scaled = b / scale
-        sa = a_mat if self._unit_weights else self._s_col * a_mat  # 1.0 * v is v exactly
-        u_mat = 2.0 * a_mat.T @ sa + self._reg
-        f_vec = -2.0 * sa.T @ b_scaled
-
-        friction_rows = self._pyramid @ frame  # (4, 3); frame rows t1, t2, n
-
-        m = len(hull)
-        g_buf, normal_block, friction_block, cone_block = self._g_buffer(m)
-        normal_block[...] = -n
-        friction_block[...] = friction_rows
-        h_vec = np.zeros(len(g_buf))
-        h_vec[:k] = -cfg.min_normal_force / scale
-        cone = None
-        if cfg.stability_cone:
-            cone = _cone_from(values, d_min, radius, cog)
-            v_all = _add_tipping_products(ima, couple, a_mat[3:])
-            # faces · f*_i <= 0 with f*_i = -V_i x: rows -(faces @ V_i), edge by edge.
-            np.matmul(cone.faces, v_all, out=cone_block)
-            np.negative(cone_block, out=cone_block)
         return ForceQp(
             U=u_mat,
             f=f_vec,
-            G=g_buf.copy(),
-            h=h_vec,
+            G=g,
+            h=h,
             A=a_mat,
             b=b,
             scale=scale,
-            blocks=dict(self._blocks_by_m[m]),
+            blocks=self._blocks_for(len(hull)),
             edges=edges,
-            cone=cone,
+            cone=_cone_from(values, d_min, radius, cog) if cfg.stability_cone else None,
             normal=n,
         )
 
-    def _g_buffer(self, m: int):
-        """(G buffer, normal block, friction block, cone rows) for an m-gon support polygon.
-
-        Built once per m: a zero G whose constant zeros are never touched again, with writable
-        views of the parts :meth:`build` fills in - the normal block (k, 3) (foot i: row i,
-        columns 3i..3i+2), the friction block (k, 4, 3) (foot i: rows k+4i..k+4i+3, same
-        columns) and the 4m stability rows as (m, 4, 3k) (edge, face). Replaces a fresh zeros
-        and two fancy-index scatters per call.
-        """
-        buf = self._g_buffers.get(m)
-        if buf is None:
-            k = self.n_feet
-            n_cone = 4 * m if self.config.stability_cone else 0
-            g = np.zeros((5 * k + n_cone, 3 * k))
-            flat = g.reshape(-1)
-            step = g.itemsize
-            normal_block = flat[: k * (3 * k + 3)].reshape(k, 3 * k + 3)[:, :3]
-            friction_block = np.lib.stride_tricks.as_strided(
-                flat[k * 3 * k :],
-                shape=(k, 4, 3),
-                strides=((12 * k + 3) * step, 3 * k * step, step),
-                writeable=True,
-            )
-            cone_block = g[5 * k :].reshape(m, 4, 3 * k) if n_cone else None
-            buf = self._g_buffers[m] = (g, normal_block, friction_block, cone_block)
-            blocks = dict(self._blocks)
-            if n_cone:
-                blocks["stability"] = slice(5 * k, 5 * k + n_cone)
-            self._blocks_by_m[m] = blocks
-        return buf
+    def _blocks_for(self, m: int) -> dict[str, slice]:
+        """Rows of G per constraint group for an m-gon support polygon (a fresh dict)."""
+        blocks = self._blocks_by_m.get(m)
+        if blocks is None:
+            blocks = self._blocks_by_m[m] = dict(self._blocks)
+            if self.config.stability_cone:
+                k = self.n_feet
+                blocks["stability"] = slice(5 * k, 5 * k + 4 * m)
+        return dict(blocks)
 
     def solve_qp(self, qp: ForceQp, solver: str | None = None) -> ForceDistributionResult:
         """Solve a built QP with ``solver`` (default: the config's). Never raises on failure."""
@@ -514,10 +461,9 @@ class ForceDistributor:
                     f"constraints need a relaxation of {relax * qp.scale:.4g} N to be satisfiable",
                 )
             return self._failure(qp, solver, "solver_error", "solver failed on a feasible problem")
-        slack_all = (qp.h - qp.G @ x_scaled) * qp.scale
-        violation = max(0.0, -float(np.minimum.reduce(slack_all)))  # .min() minus its wrapper
-        x = x_scaled * qp.scale
-        wrench = qp.A @ x
+        slack_all, violation, x, wrench, residual = _compiled.qp_outcome(
+            qp.G, qp.h, x_scaled, qp.scale, qp.A, qp.b
+        )
         status, message = "optimal", ""
         if violation > _ACCEPT_TOL * qp.scale:
             status, message = "solver_error", f"solution violates constraints by {violation:.4g} N"
@@ -525,7 +471,7 @@ class ForceDistributor:
             status=status,
             forces=x.reshape(self.n_feet, 3) if status == "optimal" else self._nan_forces(),
             wrench=wrench,
-            wrench_residual=wrench - qp.b,
+            wrench_residual=residual,
             slack=self._split(slack_all, qp),
             max_violation=violation,
             solver=solver,
