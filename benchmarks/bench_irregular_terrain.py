@@ -24,10 +24,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run as a script 
 
 import hexapod_envs  # noqa: F401
 from benchmarks.common import env_vs_raw, per_call_us
-from hexapod_envs.envs.heavy_duty import fasm_from_feet
 from hexapod_envs.robots.athena.gait import AthenaPostureController
 from hexapod_envs.robots.athena.kinematics import leg_ik
-from hexapod_envs.stability import zmp_margin
+from hexapod_envs.stability import fasm_from_feet, zmp_margin
 
 ENV_ID = "HexapodIrregularTerrain-v0"
 
@@ -84,7 +83,12 @@ def env_piece_costs(terrain: str = "ramp") -> dict[str, float]:
     action = np.zeros(18, np.float32)
     costs = {
         "read sensors (forces, FASM, ZMP)": per_call_us(base._measure, repeat=4000),
-        "  of which FASM": per_call_us(fasm_from_feet, feet, forces, cog, loaded, repeat=4000),
+        "  of which forces, contacts, CoG, FASM (one call)": per_call_us(
+            s.support, base._contact_force_sq, repeat=4000
+        ),
+        "  FASM alone (fasm_from_feet)": per_call_us(
+            fasm_from_feet, feet, forces, cog, loaded, repeat=4000
+        ),
         "  of which ZMP margin": per_call_us(zmp_margin, torso_feet, normal, repeat=4000),
         "observation": per_call_us(base._observation, repeat=4000),
         "info dict": per_call_us(base._info, {}, False, repeat=4000),

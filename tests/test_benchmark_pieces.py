@@ -12,4 +12,4 @@ from benchmarks.bench_irregular_terrain import env_piece_costs  # noqa: E402
 
 def test_irregular_terrain_env_pieces_run():
     costs = env_piece_costs()
-    assert len(costs) == 6 and all(math.isfinite(us) and us > 0 for us in costs.values())
+    assert len(costs) == 7 and all(math.isfinite(us) and us > 0 for us in costs.values())

@@ -103,10 +103,11 @@ from ..robots.upu.gait_schedule import (
 )
 from ..robots.upu.model import add_upu
 from ..robots.upu.params import LEG_NAMES, UpuParams
-from ..stability import fasm_from_feet
+from ..stability import _compiled as _stability
 from ..stability._geometry import hull_2d, signed_distance_2d
 from ..terrain.ditch import add_ditch
 from ..terrain.flat import add_flat
+from . import _compiled
 from .base import HexapodEnv
 from .sensors import RobotSensors
 from .settings import EnvSettings, RewardScales, TaskRanges, choice, number, numbers, option
@@ -501,22 +502,30 @@ class DitchCrossingEnv(HexapodEnv):
     # --- measurements ------------------------------------------------------------------------
     def _measure(self) -> None:
         d = self.data
-        sd = d.sensordata
         act = self._act
-        self._power = float(np.abs(d.actuator_force[act] * d.actuator_velocity[act]).sum())
-        # Every foot site is parallel to its platform and the platforms stay parallel (the
-        # mechanism only translates), so one rotation takes all six force readings to the world
-        # frame. Ground reaction = -R s + m_foot g (see model.py).
-        rot = d.xmat[self._torso].reshape(3, 3)
-        forces = self._foot_weight - sd[self._force_idx] @ rot.T
-        self._forces = forces
-        # The per-leg pressure switch (paper §2): the touch sensor's normal contact force, free
-        # of the foot's own inertia that the 3-D force sensor also measures.
-        loaded = sd[self._touch] > self.contact_force
-        self._loaded = loaded
-        soles = d.xpos[self._foot_body]
-        cog = self._cog = d.subtree_com[self._torso].copy()
-        self._fasm_deg, self._fasm_edge = fasm_from_feet(soles, forces, cog, loaded)
+        # One compiled call (hexapod_envs.envs._compiled.upu_measure). Every foot site is
+        # parallel to its platform and the platforms stay parallel (the mechanism only
+        # translates), so one rotation takes all six force readings to the world frame: ground
+        # reaction = -R s + m_foot g (see model.py). The contacts are the per-leg pressure
+        # switch (paper §2): the touch sensor's normal contact force, free of the foot's own
+        # inertia that the 3-D force sensor also measures.
+        forces, loaded, soles, cog, status, margin, i, j, power = _compiled.upu_measure(
+            d.sensordata,
+            self._force_idx,
+            d.xmat[self._torso],
+            self._foot_weight,
+            self._touch,
+            self.contact_force,
+            d.xpos,
+            self._foot_body,
+            d.subtree_com[self._torso],
+            d.actuator_force[act],
+            d.actuator_velocity[act],
+        )
+        if status == _stability.NOT_FINITE:
+            raise ValueError("foot forces, feet or CoG contain NaN or infinite values")
+        self._forces, self._loaded, self._cog, self._power = forces, loaded, cog, power
+        self._fasm_deg, self._fasm_edge = margin, ((i, j) if status == _stability.OK else None)
         self._static_margin = 0.0
         if loaded.sum() >= 3:
             pts = soles[loaded].tolist()

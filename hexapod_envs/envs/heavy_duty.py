@@ -22,7 +22,6 @@ from gymnasium import spaces
 from ..robots.heavy_duty import LEG_NAMES, HeavyDutyParams
 from ..robots.heavy_duty.gait import TripodGait, TripodGaitParams
 from ..robots.heavy_duty.model import add_heavy_duty
-from ..stability import fasm_from_feet
 from .base import HexapodEnv, JointActionMap
 from .sensors import RobotSensors
 from .settings import EnvSettings, RewardScales, choice, number, option
@@ -227,16 +226,10 @@ class HeavyDutyEnv(HexapodEnv):
 
     # --- measurements ----------------------------------------------------------------------
     def _measure(self) -> None:
-        forces = self.sensors.foot_forces()
-        self._forces = forces
-        self._loaded = (forces * forces).sum(axis=1) > self._contact_force_sq
-        self._cog = self.sensors.cog().copy()
-        self._fasm_deg, self._fasm_edge = fasm_from_feet(
-            self.sensors.foot_positions(), forces, self._cog, self._loaded
-        )
-        self._power = float(
-            np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
-        )
+        reading = self.sensors.support(self._contact_force_sq)
+        self._forces, self._loaded, self._cog = reading.forces, reading.loaded, reading.cog
+        self._fasm_deg, self._fasm_edge = reading.fasm_deg, reading.fasm_edge
+        self._power = reading.power
 
     # --- observation, reward, info ----------------------------------------------------------
     def _observation_pieces(self) -> dict:

@@ -136,7 +136,6 @@ from ..robots.athena.gait import (
 from ..robots.athena.kinematics import standing_foot_positions
 from ..robots.athena.model import add_athena
 from ..robots.athena.params import ATHENA, LEG_NAMES
-from ..stability import fasm_from_feet
 from ..stability.zmp import zmp_margin
 from ..terrain.flat import add_flat
 from ..terrain.irregular import PAPER_FRICTION, add_blocks, add_ramp
@@ -616,15 +615,12 @@ class IrregularTerrainEnv(HexapodEnv):
         self._collisions += self._touched
         s = self.sensors
         self._joints = s.joint_positions()  # fancy indexing: already a copy
-        self._forces = s.foot_forces()
-        self._loaded = (self._forces * self._forces).sum(axis=1) > self._contact_force_sq
+        reading = s.support(self._contact_force_sq)
+        self._forces, self._loaded, self._cog = reading.forces, reading.loaded, reading.cog
+        self._fasm_deg, self._fasm_edge = reading.fasm_deg, reading.fasm_edge
         self._height = float(self.data.sensordata[self._height_adr])
         self._gyro = s.gyro().copy()
-        self._cog = s.cog().copy()
         feet_world = s.foot_positions()
-        self._fasm_deg, self._fasm_edge = fasm_from_feet(
-            feet_world, self._forces, self._cog, self._loaded
-        )
         # Eqs. (32)-(33) in the torso frame (the paper's relative foot coordinates), weighted by
         # the vertical component of each foot's ground reaction.
         feet_torso = (feet_world - s.torso_position()) @ s.torso_rotation()

@@ -7,14 +7,36 @@ Every robot follows the same naming contract (see robots/*/model.py): per leg `L
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import mujoco
 import numpy as np
+
+from hexapod_envs.envs import _compiled
+from hexapod_envs.stability import _compiled as _stability
 
 
 def _sensor_slice(model: mujoco.MjModel, name: str) -> slice:
     sid = model.sensor(name).id
     adr, dim = model.sensor_adr[sid], model.sensor_dim[sid]
     return slice(adr, adr + dim)
+
+
+class SupportReading(NamedTuple):
+    """What an env derives from the feet's sensors each step (see RobotSensors.support)."""
+
+    forces: np.ndarray
+    """(n_legs, 3) ground reaction on each foot, world frame [N]."""
+    loaded: np.ndarray
+    """(n_legs,) the foot's force exceeds the contact threshold."""
+    cog: np.ndarray
+    """(3,) whole-robot centre of gravity, world frame [m]."""
+    fasm_deg: float
+    """FASM over the loaded feet [deg]; 0 without a support polygon."""
+    fasm_edge: tuple[int, int] | None
+    """Its edge as leg indices, None without a support polygon."""
+    power: float
+    """Σ |actuator force x actuator velocity| [W]."""
 
 
 class RobotSensors:
@@ -60,6 +82,29 @@ class RobotSensors:
         local = self.data.sensordata[self._force_idx]
         rot = self.data.site_xmat[self._foot_site].reshape(-1, 3, 3)
         return -(rot @ local[:, :, None])[:, :, 0]
+
+    def support(self, contact_force_sq: float) -> SupportReading:
+        """Foot forces, contacts (|f|² > ``contact_force_sq`` [N²]), CoG, FASM and actuator power
+        in one compiled call: the arithmetic of `foot_forces`, `cog`, `foot_positions`,
+        `hexapod_envs.stability.fasm_from_feet` and Σ|F v| (see hexapod_envs.envs._compiled)."""
+        d = self.data
+        forces, loaded, cog, status, margin, i, j, power = _compiled.heavy_duty_measure(
+            d.sensordata,
+            self._force_idx,
+            d.site_xmat,
+            d.site_xpos,
+            self._foot_site,
+            d.subtree_com,
+            self.torso_id,
+            d.actuator_force,
+            d.actuator_velocity,
+            self._act,
+            contact_force_sq,
+        )
+        if status == _stability.NOT_FINITE:
+            raise ValueError("foot forces, feet or CoG contain NaN or infinite values")
+        edge = (i, j) if status == _stability.OK else None
+        return SupportReading(forces, loaded, cog, margin, edge, power)
 
     def foot_positions(self) -> np.ndarray:
         """(n_legs, 3) foot (sole) points in the world frame [m] (FK of the encoders + IMU)."""
