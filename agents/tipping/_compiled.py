@@ -149,8 +149,8 @@ def cone_geometry(proj, cog, normal, cone_ratio, hull):
 def tipping_terms(feet, cog, edges):
     """Per support edge, I - a aᵀ and the couple term (l̂ × a) aᵀ / ‖l‖ of eq. (20).
 
-    Returns (status, index of the offending edge, ima (m, 3, 3), couple (m, 3, 3)); V_i is
-    couple_i [[P_1]x ... [P_k]x] + [I - a aᵀ ... I - a aᵀ] (the products are done in numpy).
+    Returns (status, index of the offending edge, ima (m, 3, 3), couple (m, 3, 3)), from which
+    :func:`tipping_products` forms V_i.
     """
     m = edges.shape[0]
     q0, q1, q2 = cog[0], cog[1], cog[2]
@@ -238,6 +238,22 @@ def qp_geometry(feet, cog, wrench, normal, fit_normal, cone_ratio, with_cone):
 
 
 @njit(cache=True)
+def tipping_products(ima, couple, moment_rows):
+    """V_e = couple_e [[P_1]x ... [P_k]x] + [I - a aᵀ ... I - a aᵀ] (m, 3, 3k) of eq. (20) for
+    every edge e, from :func:`tipping_terms` and the wrench map's moment rows (3, 3k)."""
+    m, k3 = couple.shape[0], moment_rows.shape[1]
+    rows = np.ascontiguousarray(moment_rows)
+    v_all = np.empty((m, 3, k3))
+    for e in range(m):
+        v = np.dot(couple[e], rows)
+        for r in range(3):
+            for c in range(k3):
+                v[r, c] += ima[e, r, c % 3]
+        v_all[e] = v
+    return v_all
+
+
+@njit(cache=True)
 def qp_problem(
     feet,
     cog,
@@ -290,16 +306,11 @@ def qp_problem(
                 g_mat[k + 4 * i + r, c + j] = friction_rows[r, j]
         h_vec[i] = -min_normal_force / scale
     if with_cone:
-        # faces · f*_e <= 0 with f*_e = -V_e x, V_e = couple_e [[P_1]x ... [P_k]x]
-        # + [I - a aᵀ ... I - a aᵀ]: rows -(faces @ V_e), edge by edge.
-        moment_rows = np.ascontiguousarray(a_mat[3:])
+        # faces · f*_e <= 0 with f*_e = -V_e x: rows -(faces @ V_e), edge by edge.
+        v_all = tipping_products(ima, couple, a_mat[3:])
         faces = np.ascontiguousarray(values[19:31]).reshape(4, 3)
         for e in range(m):
-            v = np.dot(couple[e], moment_rows)
-            for r in range(3):
-                for c in range(3 * k):
-                    v[r, c] += ima[e, r, c % 3]
-            cone_rows = np.dot(faces, v)
+            cone_rows = np.dot(faces, v_all[e])
             for r in range(4):
                 for c in range(3 * k):
                     g_mat[5 * k + 4 * e + r, c] = -cone_rows[r, c]

@@ -265,17 +265,7 @@ def tipping_force_matrices(
     status, bad, ima, couple = _compiled.tipping_terms(feet, cog, edges)
     if status != _compiled.OK:
         raise ValueError(_cog_on_edge(edges[bad]))
-    return _add_tipping_products(ima, couple, moment_rows)
-
-
-def _add_tipping_products(ima, couple, moment_rows: np.ndarray) -> np.ndarray:
-    """V_i = couple_i [[P_1]x ... [P_k]x] + [I - a aᵀ ... I - a aᵀ] for every edge i."""
-    out = couple @ moment_rows  # (m, 3, 3k)
-    # + [I - a aᵀ ... I - a aᵀ], added per foot block in place (np.tile cost a copy).
-    m, k = len(ima), moment_rows.shape[1] // 3
-    blocks = out.reshape(m, 3, k, 3)
-    np.add(blocks, ima.reshape(m, 3, 1, 3), out=blocks)
-    return out
+    return _compiled.tipping_products(ima, couple, np.asarray(moment_rows, dtype=float))
 
 
 @dataclass(frozen=True)
