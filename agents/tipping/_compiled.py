@@ -273,10 +273,8 @@ def qp_problem(
     ``weights`` is S as a (6, 1) column (``unit_weights``: all ones), ``reg`` is 2κW (3k, 3k),
     ``pyramid`` the (4, 3) friction rows in the tangent frame. Returns (status, detail, normal,
     A, hull, edges, cone values, d_min, radius, scale, U, f, G, h); past a failed status the
-    last five are placeholders. The products are ``np.dot`` calls, i.e. the same BLAS routines
-    that numpy's ``@`` calls (numba binds them through scipy), in the order of the former numpy
-    expressions, so U, f, G and h keep their bits where the two libraries agree (checked against
-    the original assembly in tests/test_tipping_force_distribution.py).
+    last five are placeholders. The products follow the former numpy expressions (see the
+    module docstring).
     """
     status, bad, normal, a_mat, frame, hull, edges, values, d_min, radius, ima, couple = (
         qp_geometry(feet, cog, wrench, normal, fit_normal, cone_ratio, with_cone)
