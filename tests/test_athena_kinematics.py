@@ -151,3 +151,42 @@ def test_bad_inputs_raise_clear_errors():
     with pytest.raises(ValueError, match="joint"):
         ATHENA.joint_range("knee")
     assert JOINT_NAMES == ("TC", "CTr", "FTi")
+
+
+def test_compiled_hypot_is_cpythons():
+    """cpython_hypot = math.hypot to the bit (libm's hypot is not), edge cases included."""
+    from hexapod_envs.robots.athena._compiled import cpython_hypot
+
+    rng = np.random.default_rng(5)
+    xs = rng.normal(size=20000) * 10 ** rng.uniform(-4, 2, 20000)
+    ys = rng.normal(size=20000) * 10 ** rng.uniform(-4, 2, 20000)
+    pairs = list(zip(xs.tolist(), ys.tolist(), strict=True))
+    pairs += [(0.0, 0.0), (-0.0, 3.0), (5e-324, 1e-320), (1e300, 1e300), (3.0, -4.0)]
+    pairs += [(math.inf, 1.0), (math.nan, 1.0), (1.0, -math.inf)]
+    for x, y in pairs:
+        expected = math.hypot(x, y)
+        assert cpython_hypot(x, y) == expected or (math.isnan(expected) and x != x), (x, y)
+
+
+def test_compiled_six_leg_ik_is_leg_ik_solve():
+    """solve_legs gives LegIK.solve's angles to the bit where it solves, and flags exactly the
+    points LegIK.solve reports a problem for (out of reach, behind the hip, out of range)."""
+    from hexapod_envs.robots.athena._compiled import solve_legs
+
+    iks = [kin.leg_ik(leg) for leg in LEG_NAMES]
+    constants = np.array([ik._constants for ik in iks])
+    rng = np.random.default_rng(7)
+    standing = kin.forward_kinematics_all(np.tile(ATHENA.standing_posture, (6, 1)))
+    flagged = solved = 0
+    for _ in range(400):
+        feet = standing + rng.normal(scale=rng.choice([0.01, 0.05, 0.2]), size=(6, 3))
+        angles, ok = solve_legs(constants, feet)
+        for i, ik in enumerate(iks):
+            t2, t3, t4, problem = ik.solve(*feet[i].tolist())
+            assert ok[i] == (problem is None)
+            if problem is None:
+                assert angles[i].tolist() == [t2, t3, t4]
+                solved += 1
+            else:
+                flagged += 1
+    assert solved > 1000 and flagged > 100

@@ -57,6 +57,7 @@ import numpy as np
 
 from ...checks import check_number
 from ...stability.plane_fit import fit_plane
+from . import _compiled
 from .kinematics import foot_position_closed_form, forward_kinematics_all, leg_ik
 from .params import ATHENA, LEG_NAMES, TRIPODS, AthenaParams
 
@@ -291,7 +292,8 @@ class AthenaPostureController:
         self.ground_search = ground_search
         self.rng = rng
         self._iks = [leg_ik(leg, params) for leg in LEG_NAMES]
-        self._solvers = [ik.solve for ik in self._iks]  # bound once (six calls every tick)
+        self._solvers = [ik.solve for ik in self._iks]  # bound once
+        self._ik_constants = np.array([ik._constants for ik in self._iks])  # see _joint_targets
         self._gains = _checked_gains(kz, k_alpha, k_beta)
         self.reset()
 
@@ -491,15 +493,19 @@ class AthenaPostureController:
         return max(triples, key=lambda t: triangle_area_xy(feet[list(t)]))
 
     def _joint_targets(self) -> np.ndarray:
-        """IK of the commanded feet; unreachable points get the nearest reachable pose."""
-        solutions = [
-            solve(x, y, z)
-            for solve, (x, y, z) in zip(self._solvers, self._command.tolist(), strict=True)
-        ]
-        self.clamped_legs = tuple(
-            leg for leg, sol in zip(LEG_NAMES, solutions, strict=True) if sol[3] is not None
-        )
-        return np.array([sol[:3] for sol in solutions])
+        """IK of the commanded feet; unreachable points get the nearest reachable pose.
+
+        The six legs are solved in one compiled call (`_compiled.solve_legs`, `LegIK.solve`'s
+        arithmetic); a leg it flags goes through `LegIK.solve` for its clamped pose."""
+        angles, solved = _compiled.solve_legs(self._ik_constants, self._command)
+        clamped = []
+        for i in np.flatnonzero(~solved).tolist():
+            t2, t3, t4, problem = self._solvers[i](*self._command[i].tolist())
+            angles[i] = (t2, t3, t4)
+            if problem is not None:
+                clamped.append(LEG_NAMES[i])
+        self.clamped_legs = tuple(clamped)
+        return angles
 
 
 def _rows(legs: tuple[int, ...]) -> slice | list[int]:

@@ -1,0 +1,119 @@
+"""ATHENA's six-leg inverse kinematics as one compiled call (private; numba).
+
+The posture controller solves the IK of all six feet at every 2.5 ms control tick;
+:func:`solve_legs` is `LegIK.solve`'s usual case (a reachable point inside the joint ranges)
+for the six legs at once, with the same operations in the same order. ``math.atan2``, ``sin``,
+``cos`` and ``acos`` are the C library's in CPython and in numba alike; ``math.hypot`` is not
+(CPython computes it with its own correctly rounded algorithm, libm's ``hypot`` differs in the
+last bit for about 0.3 % of inputs), so :func:`cpython_hypot` reproduces CPython's. A leg that
+is out of reach or outside a joint range is flagged, and the caller asks `LegIK.solve` for its
+clamped pose and the message.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+_VELTKAMP = 134217729.0  # 2**27 + 1
+_DBL_MIN = 2.2250738585072014e-308
+
+
+@njit(cache=True)
+def _split(x):
+    t = x * _VELTKAMP
+    hi = t - (t - x)
+    return hi, x - hi
+
+
+@njit(cache=True)
+def _exact_product(x, y):
+    """(x y rounded, its rounding error) exactly: Dekker's product, what fma(x, y, -x y) gives."""
+    z = x * y
+    xh, xl = _split(x)
+    yh, yl = _split(y)
+    return z, ((xh * yh - z) + xh * yl + xl * yh) + xl * yl
+
+
+@njit(cache=True)
+def _fast_two_sum(a, b):
+    """(a + b rounded, its rounding error) for |a| >= |b|."""
+    s = a + b
+    return s, (a - s) + b
+
+
+@njit(cache=True)
+def cpython_hypot(x, y):
+    """CPython's ``math.hypot(x, y)`` to the bit (its vector_norm: lossless power-of-two
+    scaling, exact squares, compensated sum and one differential correction of the root)."""
+    ax, ay = abs(x), abs(y)
+    if math.isinf(ax) or math.isinf(ay):
+        return math.inf
+    if math.isnan(ax) or math.isnan(ay):
+        return math.nan
+    largest = max(ax, ay)
+    if largest == 0.0:
+        return largest
+    _, exponent = math.frexp(largest)
+    if exponent < -1023:  # subnormal: 2**-exponent would overflow
+        return _DBL_MIN * cpython_hypot(ax / _DBL_MIN, ay / _DBL_MIN)
+    scale = math.ldexp(1.0, -exponent)
+    csum, frac1, frac2 = 1.0, 0.0, 0.0
+    for value in (ax, ay):
+        v = value * scale
+        hi, lo = _exact_product(v, v)
+        csum, err = _fast_two_sum(csum, hi)
+        frac1 += lo
+        frac2 += err
+    h = math.sqrt(csum - 1.0 + (frac1 + frac2))
+    hi, lo = _exact_product(-h, h)
+    csum, err = _fast_two_sum(csum, hi)
+    frac1 += lo
+    frac2 += err
+    h += (csum - 1.0 + (frac1 + frac2)) / (2.0 * h)
+    return h / scale
+
+
+@njit(cache=True)
+def _wrap(angle):
+    return math.atan2(math.sin(angle), math.cos(angle))
+
+
+@njit(cache=True)
+def solve_legs(constants, feet):
+    """(joint angles (6, 3) [rad], solved (6,)) for body-frame feet (6, 3) [m].
+
+    ``constants`` (6, 18) holds each leg's `LegIK._constants`. ``solved[i]`` is False where
+    `LegIK.solve` would report a problem (out of reach, or a joint range exceeded by more than
+    1e-9 rad); that row's angles are then to be replaced by its clamped pose.
+    """
+    n = feet.shape[0]
+    angles = np.empty((n, 3))
+    solved = np.empty(n, dtype=np.bool_)
+    for i in range(n):
+        hx, hy, hz, theta1, l2, l3, l4 = constants[i, 0:7]
+        lo2, hi2, lo3, hi3, lo4, hi4 = constants[i, 7:13]
+        l3_sq, l4_sq, two_l3_l4, s_low, s_high = constants[i, 13:18]
+        dx, dy, dz = feet[i, 0] - hx, feet[i, 1] - hy, feet[i, 2] - hz
+        t2 = _wrap(math.atan2(dy, dx) - theta1)  # eq. (14)
+        horizontal = cpython_hypot(dx, dy)
+        if not lo2 <= t2 <= hi2 and lo2 <= _wrap(t2 + math.pi) <= hi2:
+            t2, horizontal = _wrap(t2 + math.pi), -horizontal  # foot behind the hip
+        rho, zz = horizontal - l2, dz
+        s = cpython_hypot(rho, zz)
+        solved[i] = s_low <= s <= s_high
+        if not solved[i]:
+            angles[i, 0] = angles[i, 1] = angles[i, 2] = math.nan
+            continue
+        c4 = (s * s - l3_sq - l4_sq) / two_l3_l4  # eqs. (17)-(18), knee up
+        t4 = -math.acos(c4 if -1.0 <= c4 <= 1.0 else min(1.0, max(-1.0, c4)))
+        t3 = _wrap(math.atan2(zz, rho) - math.atan2(l4 * math.sin(t4), l3 + l4 * math.cos(t4)))
+        angles[i, 0], angles[i, 1], angles[i, 2] = t2, t3, t4
+        solved[i] = (
+            lo2 - 1e-9 <= t2 <= hi2 + 1e-9
+            and lo3 - 1e-9 <= t3 <= hi3 + 1e-9
+            and lo4 - 1e-9 <= t4 <= hi4 + 1e-9
+        )
+    return angles, solved
