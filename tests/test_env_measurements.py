@@ -6,7 +6,7 @@ import pytest
 
 import hexapod_envs  # noqa: F401
 from hexapod_envs.envs._compiled import numpy_sum
-from hexapod_envs.stability import fasm_from_feet
+from hexapod_envs.stability import fasm_from_feet, static_stability_margin
 
 
 @pytest.mark.parametrize("n", [0, 1, 7, 8, 9, 15, 16, 17, 18, 31, 64, 127, 128])
@@ -85,5 +85,13 @@ def test_ditch_measurements_match_their_numpy_form():
         act = base._act
         power = np.abs(d.actuator_force[act] * d.actuator_velocity[act]).sum()
         assert base._power == pytest.approx(power, rel=1e-12)
+        soles = d.xpos[base._foot_body][loaded]
+        static = 0.0
+        if len(soles) >= 3:
+            try:
+                static = static_stability_margin(soles, cog, gravity=(0.0, 0.0, -9.81))
+            except ValueError:  # collinear: no polygon
+                pass
+        assert base._static_margin == pytest.approx(static, abs=1e-12)
     assert polygons > 0
     env.close()

@@ -200,3 +200,43 @@ def test_stability_package_imports_only_numpy_numba_and_the_standard_library():
                 assert name.split(".")[0] in allowed, f"{path.name} imports {name}"
                 if name.startswith("hexapod_envs"):
                     assert name.startswith("hexapod_envs.stability"), f"{path.name}: {name}"
+
+
+def _python_signed_distance(xs, ys, hull, px, py):
+    """The former plain-Python signed_distance_2d (CPython's math.hypot, min and max)."""
+    m = len(hull)
+    edges = []
+    d_in = math.inf
+    for j in range(m):
+        x0, y0 = xs[hull[j]], ys[hull[j]]
+        i1 = hull[(j + 1) % m]
+        ex, ey = xs[i1] - x0, ys[i1] - y0
+        wx, wy = px - x0, py - y0
+        edges.append((ex, ey, wx, wy))
+        d_in = min(d_in, (ex * wy - ey * wx) / math.hypot(ex, ey))
+    if d_in >= 0.0:
+        return d_in
+    d_out = math.inf
+    for ex, ey, wx, wy in edges:
+        t = min(1.0, max(0.0, (ex * wx + ey * wy) / (ex * ex + ey * ey)))
+        d_out = min(d_out, math.hypot(wx - t * ex, wy - t * ey))
+    return -d_out
+
+
+def test_compiled_signed_distance_is_the_python_one_to_the_bit():
+    """Inside and outside points of random polygons (the compiled kernel uses CPython's hypot
+    algorithm; libm's hypot would differ in the last bit now and then)."""
+    from hexapod_envs.stability._geometry import hull_2d, signed_distance_2d
+
+    rng = np.random.default_rng(11)
+    inside = outside = 0
+    for _ in range(3000):
+        k = int(rng.integers(3, 7))
+        xs, ys = rng.normal(size=k).tolist(), rng.normal(size=k).tolist()
+        hull = hull_2d(xs, ys)
+        px, py = rng.normal(size=2).tolist()
+        expected = _python_signed_distance(xs, ys, hull, px, py)
+        assert signed_distance_2d(xs, ys, hull, px, py) == expected
+        inside += expected > 0
+        outside += expected < 0
+    assert inside > 300 and outside > 300

@@ -15,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hexapod_envs.stability._compiled import fasm_from_feet
+from hexapod_envs.stability._compiled import fasm_from_feet, hull_2d, signed_distance_2d
 
 
 @njit(cache=True)
@@ -101,10 +101,11 @@ def upu_measure(
 ):
     """One step's measurements of the 3-UPU hexapod (see HexapodDitchCrossingEnv._measure).
 
-    Returns (foot forces (6, 3) world frame [N], loaded (6,), soles (6, 3) [m], CoG (3,) [m],
-    FASM status, margin [deg], edge i, edge j, actuator power Σ|F v| [W]). The foot sites stay
-    parallel to the torso, so its rotation takes every force reading to the world frame:
-    ground reaction = foot weight - R s.
+    Returns (foot forces (6, 3) world frame [N], loaded (6,), CoG (3,) [m], FASM status,
+    margin [deg], edge i, edge j, static margin [m], actuator power Σ|F v| [W]). The foot sites
+    stay parallel to the torso, so its rotation takes every force reading to the world frame:
+    ground reaction = foot weight - R s. The static margin is the CoG's signed distance to the
+    loaded soles' polygon seen from above (0 without one); a tripod's hull is its triangle.
     """
     n = foot_body.shape[0]
     local = np.empty((n, 3))
@@ -121,4 +122,31 @@ def upu_measure(
     power = np.empty(actuator_force.shape[0])
     for k in range(actuator_force.shape[0]):
         power[k] = abs(actuator_force[k] * actuator_velocity[k])
-    return forces, loaded, soles, cog, status, margin, edge_i, edge_j, numpy_sum(power)
+    static = _static_margin(soles, loaded, cog[0], cog[1])
+    return forces, loaded, cog, status, margin, edge_i, edge_j, static, numpy_sum(power)
+
+
+@njit(cache=True)
+def _static_margin(soles, loaded, px, py):
+    """Signed distance [m] of (px, py) to the loaded soles' support polygon seen from above;
+    0 with fewer than 3 loaded soles or when they lie on a line."""
+    count = 0
+    for i in range(loaded.shape[0]):
+        count += loaded[i]
+    if count < 3:
+        return 0.0
+    xs, ys = np.empty(count), np.empty(count)
+    count = 0
+    for i in range(loaded.shape[0]):
+        if loaded[i]:
+            xs[count], ys[count] = soles[i, 0], soles[i, 1]
+            count += 1
+    if count == 3:  # a tripod (most steps): its hull is the triangle, ordered ccw
+        area2 = (xs[1] - xs[0]) * (ys[2] - ys[0]) - (ys[1] - ys[0]) * (xs[2] - xs[0])
+        if area2 != 0.0:
+            hull = np.array((0, 1, 2)) if area2 > 0 else np.array((0, 2, 1))
+            return signed_distance_2d(xs, ys, hull, px, py)
+    hull = hull_2d(xs, ys)
+    if hull.shape[0] < 3:  # the loaded soles lie on a line: no polygon
+        return 0.0
+    return signed_distance_2d(xs, ys, hull, px, py)

@@ -104,7 +104,6 @@ from ..robots.upu.gait_schedule import (
 from ..robots.upu.model import add_upu
 from ..robots.upu.params import LEG_NAMES, UpuParams
 from ..stability import _compiled as _stability
-from ..stability._geometry import hull_2d, signed_distance_2d
 from ..terrain.ditch import add_ditch
 from ..terrain.flat import add_flat
 from . import _compiled
@@ -509,7 +508,7 @@ class DitchCrossingEnv(HexapodEnv):
         # reaction = -R s + m_foot g (see model.py). The contacts are the per-leg pressure
         # switch (paper §2): the touch sensor's normal contact force, free of the foot's own
         # inertia that the 3-D force sensor also measures.
-        forces, loaded, soles, cog, status, margin, i, j, power = _compiled.upu_measure(
+        forces, loaded, cog, status, margin, i, j, static, power = _compiled.upu_measure(
             d.sensordata,
             self._force_idx,
             d.xmat[self._torso],
@@ -526,23 +525,8 @@ class DitchCrossingEnv(HexapodEnv):
             raise ValueError("foot forces, feet or CoG contain NaN or infinite values")
         self._forces, self._loaded, self._cog, self._power = forces, loaded, cog, power
         self._fasm_deg, self._fasm_edge = margin, ((i, j) if status == _stability.OK else None)
-        self._static_margin = 0.0
-        if loaded.sum() >= 3:
-            pts = soles[loaded].tolist()
-            xs = [q[0] for q in pts]
-            ys = [q[1] for q in pts]
-            px, py = float(cog[0]), float(cog[1])
-            if len(xs) == 3:  # a tripod (most steps): its hull is the triangle, ordered ccw
-                area2 = (xs[1] - xs[0]) * (ys[2] - ys[0]) - (ys[1] - ys[0]) * (xs[2] - xs[0])
-                if area2 != 0.0:
-                    hull = [0, 1, 2] if area2 > 0 else [0, 2, 1]
-                    self._static_margin = signed_distance_2d(xs, ys, hull, px, py)
-                    return
-            try:  # same computation as stability.static_stability_margin, gravity along -z
-                hull = hull_2d(xs, ys)
-            except ValueError:  # loaded feet on a line: no polygon
-                return
-            self._static_margin = signed_distance_2d(xs, ys, hull, px, py)
+        # Same computation as stability.static_stability_margin, gravity along -z.
+        self._static_margin = static
 
     def _is_success(self) -> bool:
         """Every foot past the far edge of the ditch (the finish line), all six loaded."""

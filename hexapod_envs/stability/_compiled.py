@@ -359,3 +359,95 @@ def fasm_from_feet(feet, reactions, cog, loaded):
     if status != OK:  # collinear feet or zero force: no polygon to stand on
         return status, 0.0, -1, -1
     return OK, angles[best], idx[edges[best, 0]], idx[edges[best, 1]]
+
+
+_VELTKAMP = 134217729.0  # 2**27 + 1
+_DBL_MIN = 2.2250738585072014e-308
+
+
+@njit(cache=True)
+def _split(x):
+    t = x * _VELTKAMP
+    hi = t - (t - x)
+    return hi, x - hi
+
+
+@njit(cache=True)
+def _exact_product(x, y):
+    """(x y rounded, its rounding error) exactly: Dekker's product, what fma(x, y, -x y) gives."""
+    z = x * y
+    xh, xl = _split(x)
+    yh, yl = _split(y)
+    return z, ((xh * yh - z) + xh * yl + xl * yh) + xl * yl
+
+
+@njit(cache=True)
+def _fast_two_sum(a, b):
+    """(a + b rounded, its rounding error) for |a| >= |b|."""
+    s = a + b
+    return s, (a - s) + b
+
+
+@njit(cache=True)
+def cpython_hypot(x, y):
+    """CPython's ``math.hypot(x, y)`` to the bit (its vector_norm: lossless power-of-two
+    scaling, exact squares, compensated sum and one differential correction of the root)."""
+    ax, ay = abs(x), abs(y)
+    if math.isinf(ax) or math.isinf(ay):
+        return math.inf
+    if math.isnan(ax) or math.isnan(ay):
+        return math.nan
+    largest = max(ax, ay)
+    if largest == 0.0:
+        return largest
+    _, exponent = math.frexp(largest)
+    if exponent < -1023:  # subnormal: 2**-exponent would overflow
+        return _DBL_MIN * cpython_hypot(ax / _DBL_MIN, ay / _DBL_MIN)
+    scale = math.ldexp(1.0, -exponent)
+    csum, frac1, frac2 = 1.0, 0.0, 0.0
+    for value in (ax, ay):
+        v = value * scale
+        hi, lo = _exact_product(v, v)
+        csum, err = _fast_two_sum(csum, hi)
+        frac1 += lo
+        frac2 += err
+    h = math.sqrt(csum - 1.0 + (frac1 + frac2))
+    hi, lo = _exact_product(-h, h)
+    csum, err = _fast_two_sum(csum, hi)
+    frac1 += lo
+    frac2 += err
+    h += (csum - 1.0 + (frac1 + frac2)) / (2.0 * h)
+    return h / scale
+
+
+@njit(cache=True)
+def signed_distance_2d(xs, ys, hull, px, py):
+    """Signed distance of (px, py) to the boundary of the ccw polygon ``hull`` (indices into
+    xs / ys); > 0 inside: the smallest distance to an edge line. Outside: minus the distance to
+    the polygon (nearest edge segment or vertex). Python's ``min`` / ``max`` semantics and
+    CPython's ``math.hypot`` (:func:`cpython_hypot`), so the result is the former Python's."""
+    m = hull.shape[0]
+    d_in = math.inf
+    for j in range(m):
+        x0, y0 = xs[hull[j]], ys[hull[j]]
+        i1 = hull[j + 1] if j + 1 < m else hull[0]
+        ex, ey = xs[i1] - x0, ys[i1] - y0
+        wx, wy = px - x0, py - y0
+        d = (ex * wy - ey * wx) / cpython_hypot(ex, ey)
+        if d < d_in:
+            d_in = d
+    if d_in >= 0.0:
+        return d_in
+    d_out = math.inf
+    for j in range(m):
+        x0, y0 = xs[hull[j]], ys[hull[j]]
+        i1 = hull[j + 1] if j + 1 < m else hull[0]
+        ex, ey = xs[i1] - x0, ys[i1] - y0
+        wx, wy = px - x0, py - y0
+        t = (ex * wx + ey * wy) / (ex * ex + ey * ey)
+        t = t if t > 0.0 else 0.0
+        t = t if t < 1.0 else 1.0
+        d = cpython_hypot(wx - t * ex, wy - t * ey)
+        if d < d_out:
+            d_out = d
+    return -d_out

@@ -152,22 +152,13 @@ def signed_distance_2d(xs: list[float], ys: list[float], hull: list[int], px: fl
     """Signed distance of (px, py) to the boundary of the ccw polygon ``hull``; > 0 inside.
 
     Inside: the smallest distance to an edge line. Outside: minus the Euclidean distance to the
-    polygon (the nearest edge segment or vertex).
+    polygon (the nearest edge segment or vertex). See
+    :func:`hexapod_envs.stability._compiled.signed_distance_2d`.
     """
-    m = len(hull)
-    edges = []
-    d_in = math.inf
-    for j in range(m):
-        x0, y0 = xs[hull[j]], ys[hull[j]]
-        i1 = hull[(j + 1) % m]
-        ex, ey = xs[i1] - x0, ys[i1] - y0
-        wx, wy = px - x0, py - y0
-        edges.append((ex, ey, wx, wy))
-        d_in = min(d_in, (ex * wy - ey * wx) / math.hypot(ex, ey))
-    if d_in >= 0.0:
-        return d_in
-    d_out = math.inf
-    for ex, ey, wx, wy in edges:
-        t = min(1.0, max(0.0, (ex * wx + ey * wy) / (ex * ex + ey * ey)))
-        d_out = min(d_out, math.hypot(wx - t * ex, wy - t * ey))
-    return -d_out
+    return _compiled.signed_distance_2d(
+        np.asarray(xs, dtype=float),
+        np.asarray(ys, dtype=float),
+        np.asarray(hull, dtype=np.int64),
+        float(px),
+        float(py),
+    )

@@ -5,7 +5,8 @@ The posture controller solves the IK of all six feet at every 2.5 ms control tic
 for the six legs at once, with the same operations in the same order. ``math.atan2``, ``sin``,
 ``cos`` and ``acos`` are the C library's in CPython and in numba alike; ``math.hypot`` is not
 (CPython computes it with its own correctly rounded algorithm, libm's ``hypot`` differs in the
-last bit for about 0.3 % of inputs), so :func:`cpython_hypot` reproduces CPython's. A leg that
+last bit for about 0.3 % of inputs), so the IK uses
+:func:`hexapod_envs.stability._compiled.cpython_hypot`, which reproduces CPython's. A leg that
 is out of reach or outside a joint range is flagged, and the caller asks `LegIK.solve` for its
 clamped pose and the message.
 """
@@ -17,63 +18,7 @@ import math
 import numpy as np
 from numba import njit
 
-_VELTKAMP = 134217729.0  # 2**27 + 1
-_DBL_MIN = 2.2250738585072014e-308
-
-
-@njit(cache=True)
-def _split(x):
-    t = x * _VELTKAMP
-    hi = t - (t - x)
-    return hi, x - hi
-
-
-@njit(cache=True)
-def _exact_product(x, y):
-    """(x y rounded, its rounding error) exactly: Dekker's product, what fma(x, y, -x y) gives."""
-    z = x * y
-    xh, xl = _split(x)
-    yh, yl = _split(y)
-    return z, ((xh * yh - z) + xh * yl + xl * yh) + xl * yl
-
-
-@njit(cache=True)
-def _fast_two_sum(a, b):
-    """(a + b rounded, its rounding error) for |a| >= |b|."""
-    s = a + b
-    return s, (a - s) + b
-
-
-@njit(cache=True)
-def cpython_hypot(x, y):
-    """CPython's ``math.hypot(x, y)`` to the bit (its vector_norm: lossless power-of-two
-    scaling, exact squares, compensated sum and one differential correction of the root)."""
-    ax, ay = abs(x), abs(y)
-    if math.isinf(ax) or math.isinf(ay):
-        return math.inf
-    if math.isnan(ax) or math.isnan(ay):
-        return math.nan
-    largest = max(ax, ay)
-    if largest == 0.0:
-        return largest
-    _, exponent = math.frexp(largest)
-    if exponent < -1023:  # subnormal: 2**-exponent would overflow
-        return _DBL_MIN * cpython_hypot(ax / _DBL_MIN, ay / _DBL_MIN)
-    scale = math.ldexp(1.0, -exponent)
-    csum, frac1, frac2 = 1.0, 0.0, 0.0
-    for value in (ax, ay):
-        v = value * scale
-        hi, lo = _exact_product(v, v)
-        csum, err = _fast_two_sum(csum, hi)
-        frac1 += lo
-        frac2 += err
-    h = math.sqrt(csum - 1.0 + (frac1 + frac2))
-    hi, lo = _exact_product(-h, h)
-    csum, err = _fast_two_sum(csum, hi)
-    frac1 += lo
-    frac2 += err
-    h += (csum - 1.0 + (frac1 + frac2)) / (2.0 * h)
-    return h / scale
+from hexapod_envs.stability._compiled import cpython_hypot
 
 
 @njit(cache=True)
