@@ -1,13 +1,14 @@
-"""Compiled per-step measurements of the heavy-duty envs (private; numba).
+"""Compiled per-step measurements of the envs (private; numba).
 
 Every control step ends with the sensor model: foot forces rotated to the world frame, the
 contact test, the CoG, the FASM over the loaded feet and the actuator power. As a dozen numpy
 calls right after MuJoCo's physics (which leaves the caches cold) it cost 35-50 µs per step,
-about a tenth of the cliff walk's physics. :func:`heavy_duty_measure` does it in one call with
-the same arithmetic in the same order: the rotations are ``np.dot`` calls, i.e. the BLAS routine
-numpy's ``@`` calls (numba binds it through scipy's BLAS; the same bits where the two libraries
-agree, as they do on the machines this was measured on), the power is summed in numpy's
-pairwise order, and the FASM is the stability module's own kernel.
+about a tenth of the cliff walk's physics. :func:`heavy_duty_measure` (the heavy-duty and
+ATHENA envs, through `RobotSensors.support`) and :func:`upu_measure` (the ditch) do it in one
+call with the same arithmetic in the same order: the rotations are ``np.dot`` calls, i.e. the
+BLAS routine numpy's ``@`` calls (numba binds it through scipy's BLAS; the same bits where the
+two libraries agree, as they do on the machines this was measured on), the power is summed in
+numpy's pairwise order, and the FASM and the static margin are the stability module's kernels.
 """
 
 from __future__ import annotations

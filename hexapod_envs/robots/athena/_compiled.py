@@ -1,6 +1,6 @@
 """ATHENA's six-leg inverse kinematics as one compiled call (private; numba).
 
-The posture controller solves the IK of all six feet at every 2.5 ms control tick;
+The posture controller solves the IK of all six feet at every control tick (50 ms);
 :func:`solve_legs` is `LegIK.solve`'s usual case (a reachable point inside the joint ranges)
 for the six legs at once, with the same operations in the same order. ``math.atan2``, ``sin``,
 ``cos`` and ``acos`` are the C library's in CPython and in numba alike; ``math.hypot`` is not
