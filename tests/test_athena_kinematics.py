@@ -174,7 +174,7 @@ def test_compiled_six_leg_ik_is_leg_ik_solve():
     from hexapod_envs.robots.athena._compiled import solve_legs
 
     iks = [kin.leg_ik(leg) for leg in LEG_NAMES]
-    constants = np.array([ik._constants for ik in iks])
+    constants = np.array([ik.packed_constants for ik in iks])
     rng = np.random.default_rng(7)
     standing = kin.forward_kinematics_all(np.tile(ATHENA.standing_posture, (6, 1)))
     flagged = solved = 0

@@ -30,7 +30,7 @@ def _wrap(angle):
 def solve_legs(constants, feet):
     """(joint angles (6, 3) [rad], solved (6,)) for body-frame feet (6, 3) [m].
 
-    ``constants`` (6, 18) holds each leg's `LegIK._constants`. ``solved[i]`` is False where
+    ``constants`` (6, 18) holds each leg's `LegIK.packed_constants`. ``solved[i]`` is False where
     `LegIK.solve` would report a problem (out of reach, or a joint range exceeded by more than
     1e-9 rad); that row's angles are then to be replaced by its clamped pose.
     """

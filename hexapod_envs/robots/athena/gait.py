@@ -293,7 +293,7 @@ class AthenaPostureController:
         self.rng = rng
         self._iks = [leg_ik(leg, params) for leg in LEG_NAMES]
         self._solvers = [ik.solve for ik in self._iks]  # bound once
-        self._ik_constants = np.array([ik._constants for ik in self._iks])  # see _joint_targets
+        self._ik_constants = np.array([ik.packed_constants for ik in self._iks])
         self._gains = _checked_gains(kz, k_alpha, k_beta)
         self.reset()
 

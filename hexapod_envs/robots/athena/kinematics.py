@@ -132,6 +132,12 @@ class LegIK:
             l3 * l3, l4 * l4, 2 * l3 * l4, abs(l3 - l4) + 1e-12, l3 + l4 - 1e-12,
         )  # fmt: skip
 
+    @property
+    def packed_constants(self) -> tuple[float, ...]:
+        """The 18 numbers `solve` reads (hip, mounting angle, links, joint ranges, derived
+        terms), in the order `_compiled.solve_legs` takes them."""
+        return self._constants
+
     def solve(self, x: float, y: float, z: float) -> tuple[float, float, float, str | None]:
         """(theta_2, theta_3, theta_4, problem) for the foot centre at body-frame (x, y, z), m.
 
