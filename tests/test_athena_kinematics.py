@@ -154,18 +154,23 @@ def test_bad_inputs_raise_clear_errors():
 
 
 def test_compiled_hypot_is_cpythons():
-    """cpython_hypot = math.hypot to the bit (libm's hypot is not), edge cases included."""
-    from hexapod_envs.robots.athena._compiled import cpython_hypot
+    """cpython_hypot = math.hypot to the bit (libm's hypot is not): normal, subnormal and
+    mixed magnitudes, zeros of both signs, inf and nan."""
+    from hexapod_envs.stability._compiled import cpython_hypot
 
     rng = np.random.default_rng(5)
-    xs = rng.normal(size=20000) * 10 ** rng.uniform(-4, 2, 20000)
-    ys = rng.normal(size=20000) * 10 ** rng.uniform(-4, 2, 20000)
+    n = 20000
+    xs = rng.normal(size=n) * 10 ** rng.uniform(-4, 2, n)
+    ys = rng.normal(size=n) * 10 ** rng.uniform(-4, 2, n)
+    tiny = rng.uniform(-2.2e-308, 2.2e-308, size=(2, 4000)) * rng.choice([1.0, 1e-6], (2, 4000))
     pairs = list(zip(xs.tolist(), ys.tolist(), strict=True))
-    pairs += [(0.0, 0.0), (-0.0, 3.0), (5e-324, 1e-320), (1e300, 1e300), (3.0, -4.0)]
-    pairs += [(math.inf, 1.0), (math.nan, 1.0), (1.0, -math.inf)]
+    pairs += list(zip(tiny[0].tolist(), tiny[1].tolist(), strict=True))
+    pairs += [(0.0, 0.0), (-0.0, 3.0), (5e-324, 1e-320), (7.5922331158553e-311, -3.1409296e-316)]
+    pairs += [(1e300, 1e300), (1.7976931348623157e308, 1.0), (3.0, -4.0), (1e-310, 1.0)]
     for x, y in pairs:
-        expected = math.hypot(x, y)
-        assert cpython_hypot(x, y) == expected or (math.isnan(expected) and x != x), (x, y)
+        assert cpython_hypot(x, y) == math.hypot(x, y), (x, y)
+    assert cpython_hypot(math.inf, math.nan) == math.inf == math.hypot(math.inf, math.nan)
+    assert math.isnan(cpython_hypot(math.nan, 1.0)) and math.isnan(math.hypot(math.nan, 1.0))
 
 
 def test_compiled_six_leg_ik_is_leg_ik_solve():

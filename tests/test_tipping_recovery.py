@@ -133,6 +133,9 @@ def test_config_errors_name_the_choices():
         RecoveryConfig(reach_model="exact")
     with pytest.raises(ValueError, match="force_gain"):
         RecoveryConfig(force_gain=0.0)
+    for bad in ((0.004, 0.004), 0.004, (0.004, -0.001, 0.004)):
+        with pytest.raises(ValueError, match="max_offset must be 3 finite limits"):
+            RecoveryConfig(max_offset=bad)
     env = gym.make("HexapodStewartTilt-v0", scenario="climb")
     with pytest.raises(ValueError, match="valid:.*reach_model"):
         TippingRecoveryPolicy(env, reach_mode="paper")

@@ -440,11 +440,9 @@ def offset_targets(targets, nominal, offsets, legs):
 
 
 @njit(cache=True)
-def body_sensing(quat, foot_forces, contact_sq):
-    """(rotation body -> world (3, 3), foot forces in the body frame (6, 3) [N], loaded (6,))
-    from the IMU quaternion (w, x, y, z) and the world-frame foot forces: the arithmetic of
-    ``quat_to_matrix``, ``forces_to_body`` and the controller's contact test (|f|² above
-    ``contact_sq``) in one call. The caller checks the quaternion's norm."""
+def rotation_from_quat(quat):
+    """Rotation matrix (body -> world) of the quaternion (w, x, y, z) divided by its norm² (see
+    `body_model.quat_to_matrix`, which checks the norm)."""
     w, x, y, z = quat[0], quat[1], quat[2], quat[3]
     s = 2.0 / (w * w + x * x + y * y + z * z)
     rot = np.empty((3, 3))
@@ -457,6 +455,16 @@ def body_sensing(quat, foot_forces, contact_sq):
     rot[2, 0] = s * (x * z - w * y)
     rot[2, 1] = s * (y * z + w * x)
     rot[2, 2] = 1.0 - s * (x * x + y * y)
+    return rot
+
+
+@njit(cache=True)
+def body_sensing(quat, foot_forces, contact_sq):
+    """(rotation body -> world (3, 3), foot forces in the body frame (6, 3) [N], loaded (6,))
+    from the IMU quaternion (w, x, y, z) and the world-frame foot forces: the arithmetic of
+    ``quat_to_matrix``, ``forces_to_body`` and the controller's contact test (|f|² above
+    ``contact_sq``) in one call. The caller checks the quaternion."""
+    rot = rotation_from_quat(quat)
     forces = np.dot(np.ascontiguousarray(foot_forces), rot)
     loaded = np.empty(forces.shape[0], dtype=np.bool_)
     for i in range(forces.shape[0]):

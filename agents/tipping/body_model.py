@@ -46,18 +46,13 @@ _ALL_LEGS = np.arange(6)
 
 def quat_to_matrix(quat: np.ndarray) -> np.ndarray:
     """Rotation matrix (body -> world) of a unit quaternion (w, x, y, z)."""
-    w, x, y, z = np.asarray(quat, dtype=float).tolist()
-    n = w * w + x * x + y * y + z * z
-    if not n > 0.0:
+    q = np.asarray(quat, dtype=float)
+    if q.shape != (4,):
+        raise ValueError(f"a quaternion is 4 values (w, x, y, z), got shape {q.shape}")
+    w, x, y, z = q.tolist()
+    if not w * w + x * x + y * y + z * z > 0.0:
         raise ValueError(f"quaternion {quat} has zero norm")
-    s = 2.0 / n
-    return np.array(
-        [
-            [1.0 - s * (y * y + z * z), s * (x * y - w * z), s * (x * z + w * y)],
-            [s * (x * y + w * z), 1.0 - s * (x * x + z * z), s * (y * z - w * x)],
-            [s * (x * z - w * y), s * (y * z + w * x), 1.0 - s * (x * x + y * y)],
-        ]
-    )
+    return _compiled.rotation_from_quat(q)
 
 
 @dataclass(frozen=True)

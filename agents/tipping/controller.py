@@ -189,6 +189,12 @@ class RecoveryConfig:
             raise ValueError(f"force_gain must lie in (0, 1], got {self.force_gain}")
         if self.qp_period < 1:
             raise ValueError(f"qp_period must be >= 1, got {self.qp_period}")
+        limits = np.asarray(self.max_offset, dtype=float)
+        if limits.shape != (3,) or not np.all(np.isfinite(limits) & (limits >= 0.0)):
+            raise ValueError(
+                f"max_offset must be 3 finite limits >= 0 (J_x m, J_z m, J_θ rad), "
+                f"got {self.max_offset!r}"
+            )
         if not 0.0 < self.contact_fraction < self.min_normal_fraction:
             raise ValueError(
                 "need 0 < contact_fraction < min_normal_fraction, got "
@@ -352,7 +358,7 @@ class TippingRecoveryController:
         cfg = self.config
         self._filter(reading)
         quat = np.asarray(reading.quat, dtype=float)
-        if not float(quat @ quat) > 0.0:
+        if quat.shape != (4,) or not float(quat @ quat) > 0.0:
             quat_to_matrix(quat)  # raises the error that names the problem
         # quat_to_matrix, forces_to_body and |f|² > threshold, compiled into one call
         rot, forces, loaded = _compiled.body_sensing(

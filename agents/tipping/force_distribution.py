@@ -261,11 +261,17 @@ def tipping_force_matrices(
     cog = np.asarray(cog, dtype=float)
     if moment_rows is None:
         moment_rows = _moment_rows(feet - cog)
+    moment_rows = np.asarray(moment_rows, dtype=float)
+    if moment_rows.shape != (3, 3 * len(feet)):
+        raise ValueError(
+            f"moment_rows must have shape (3, {3 * len(feet)}) for {len(feet)} feet, "
+            f"got {moment_rows.shape}"
+        )
     edges = np.asarray(edges, dtype=np.int64)
     status, bad, ima, couple = _compiled.tipping_terms(feet, cog, edges)
     if status != _compiled.OK:
         raise ValueError(_cog_on_edge(edges[bad]))
-    return _compiled.tipping_products(ima, couple, np.asarray(moment_rows, dtype=float))
+    return _compiled.tipping_products(ima, couple, moment_rows)
 
 
 @dataclass(frozen=True)

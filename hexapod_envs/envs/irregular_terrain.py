@@ -618,6 +618,7 @@ class IrregularTerrainEnv(HexapodEnv):
         reading = s.support(self._contact_force_sq)
         self._forces, self._loaded, self._cog = reading.forces, reading.loaded, reading.cog
         self._fasm_deg, self._fasm_edge = reading.fasm_deg, reading.fasm_edge
+        self._power = reading.power
         self._height = float(self.data.sensordata[self._height_adr])
         self._gyro = s.gyro().copy()
         feet_world = s.foot_positions()
@@ -813,9 +814,7 @@ class IrregularTerrainEnv(HexapodEnv):
     def _extra_info(self, unstable: bool) -> dict:
         stats = None if unstable else self._finished_cycle
         info = {
-            "actuator_power_w": float(
-                np.abs(self.sensors.actuator_forces() * self.sensors.joint_velocities()).sum()
-            ),
+            "actuator_power_w": self._power,
             "zmp": self._zmp.copy(),
             "zmp_margin": self._zmp_margin,
             "torso_contact": self._touched,

@@ -362,7 +362,6 @@ def fasm_from_feet(feet, reactions, cog, loaded):
 
 
 _VELTKAMP = 134217729.0  # 2**27 + 1
-_DBL_MIN = 2.2250738585072014e-308
 
 
 @njit(cache=True)
@@ -390,8 +389,9 @@ def _fast_two_sum(a, b):
 
 @njit(cache=True)
 def cpython_hypot(x, y):
-    """CPython's ``math.hypot(x, y)`` to the bit (its vector_norm: lossless power-of-two
-    scaling, exact squares, compensated sum and one differential correction of the root)."""
+    """CPython 3.11's ``math.hypot(x, y)`` to the bit (its vector_norm: lossless power-of-two
+    scaling, exact squares, compensated sum and one differential correction of the root; for a
+    subnormal larger value, division by it and a plain compensated sum, as 3.11 does)."""
     ax, ay = abs(x), abs(y)
     if math.isinf(ax) or math.isinf(ay):
         return math.inf
@@ -402,7 +402,14 @@ def cpython_hypot(x, y):
         return largest
     _, exponent = math.frexp(largest)
     if exponent < -1023:  # subnormal: 2**-exponent would overflow
-        return _DBL_MIN * cpython_hypot(ax / _DBL_MIN, ay / _DBL_MIN)
+        csum, frac = 1.0, 0.0
+        for value in (ax, ay):
+            v = value / largest
+            v = v * v
+            before = csum
+            csum += v
+            frac += (before - csum) + v
+        return largest * math.sqrt(csum - 1.0 + frac)
     scale = math.ldexp(1.0, -exponent)
     csum, frac1, frac2 = 1.0, 0.0, 0.0
     for value in (ax, ay):
