@@ -434,12 +434,14 @@ def signed_distance_2d(xs, ys, hull, px, py):
     the polygon (nearest edge segment or vertex). Python's ``min`` / ``max`` semantics and
     CPython's ``math.hypot`` (:func:`cpython_hypot`), so the result is the former Python's."""
     m = hull.shape[0]
+    edges = np.empty((m, 4))  # per edge: its vector (ex, ey), (px, py) from its start (wx, wy)
     d_in = math.inf
     for j in range(m):
         x0, y0 = xs[hull[j]], ys[hull[j]]
         i1 = hull[j + 1] if j + 1 < m else hull[0]
         ex, ey = xs[i1] - x0, ys[i1] - y0
         wx, wy = px - x0, py - y0
+        edges[j, 0], edges[j, 1], edges[j, 2], edges[j, 3] = ex, ey, wx, wy
         d = (ex * wy - ey * wx) / cpython_hypot(ex, ey)
         if d < d_in:
             d_in = d
@@ -447,10 +449,7 @@ def signed_distance_2d(xs, ys, hull, px, py):
         return d_in
     d_out = math.inf
     for j in range(m):
-        x0, y0 = xs[hull[j]], ys[hull[j]]
-        i1 = hull[j + 1] if j + 1 < m else hull[0]
-        ex, ey = xs[i1] - x0, ys[i1] - y0
-        wx, wy = px - x0, py - y0
+        ex, ey, wx, wy = edges[j, 0], edges[j, 1], edges[j, 2], edges[j, 3]
         t = (ex * wx + ey * wy) / (ex * ex + ey * ey)
         t = t if t > 0.0 else 0.0
         t = t if t < 1.0 else 1.0
