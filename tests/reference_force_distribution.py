@@ -12,8 +12,13 @@ import math
 
 import numpy as np
 
-from agents.tipping.force_distribution import ForceQp, StabilityCone, _v_unit
+from agents.tipping.force_distribution import ForceQp, StabilityCone
 from hexapod_envs.stability import fit_plane, support_polygon
+
+
+def _v_unit(a):
+    n = math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
+    return (a[0] / n, a[1] / n, a[2] / n)
 
 
 def _v_sub(a, b):

@@ -270,12 +270,15 @@ def qp_problem(
 ):
     """One whole QP build (see ForceDistributor.build): :func:`qp_geometry` and the matrices.
 
-    ``weights`` is S as a (6, 1) column (``unit_weights``: all ones), ``reg`` is 2κW (3k, 3k),
-    ``pyramid`` the (4, 3) friction rows in the tangent frame. Returns (status, detail, normal,
-    A, hull, edges, cone values, d_min, radius, scale, U, f, G, h); past a failed status the
-    last five are placeholders. The products follow the former numpy expressions (see the
+    ``normal`` is made a unit vector unless ``fit_normal``. ``weights`` is S as a (6, 1)
+    column (``unit_weights``: all ones), ``reg`` is 2κW (3k, 3k), ``pyramid`` the (4, 3)
+    friction rows in the tangent frame. Returns (status, detail, normal, A, hull, edges, cone
+    values, d_min, radius, scale, U, f, G, h); past a failed status the last five are
+    placeholders. The products follow the former numpy expressions (see the
     module docstring).
     """
+    if not fit_normal:  # the given normal, made a unit vector
+        normal = np.array(_unit3(normal[0], normal[1], normal[2]))
     status, bad, normal, a_mat, frame, hull, edges, values, d_min, radius, ima, couple = (
         qp_geometry(feet, cog, wrench, normal, fit_normal, cone_ratio, with_cone)
     )

@@ -189,11 +189,6 @@ _NO_NORMAL = np.zeros(3)
 """The placeholder normal of a build that fits the plane through the feet (never written)."""
 
 
-def _v_unit(a):
-    n = math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
-    return (a[0] / n, a[1] / n, a[2] / n)
-
-
 def stability_cone(
     feet: np.ndarray,
     cog: np.ndarray,
@@ -378,10 +373,9 @@ class ForceDistributor:
         if cog.shape != (3,) or b.shape != (6,):
             raise ValueError(f"cog must be (3,) and wrench (6,), got {cog.shape}, {b.shape}")
         fit_normal = normal is None
-        if fit_normal:
-            n = _NO_NORMAL
-        else:
-            n = np.array(_v_unit(np.asarray(normal, dtype=float).tolist()))
+        n = _NO_NORMAL if fit_normal else np.asarray(normal, dtype=float)
+        if n.shape != (3,):
+            raise ValueError(f"normal must be a (3,) vector, got shape {n.shape}")
         status, bad, n, a_mat, hull, edges, values, d_min, radius, scale, u_mat, f_vec, g, h = (
             _compiled.qp_problem(
                 feet,
