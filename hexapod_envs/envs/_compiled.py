@@ -45,6 +45,12 @@ def numpy_sum(a):
 
 
 @njit(cache=True)
+def actuator_power(force, velocity):
+    """Σ |F v| [W] over the actuators, as numpy's ``np.abs(force * velocity).sum()``."""
+    return numpy_sum(np.abs(force * velocity))
+
+
+@njit(cache=True)
 def heavy_duty_measure(
     sensordata,
     force_idx,
@@ -80,10 +86,8 @@ def heavy_duty_measure(
         loaded[i] = f0 * f0 + f1 * f1 + f2 * f2 > contact_force_sq
     cog = subtree_com[torso].copy()
     status, margin, edge_i, edge_j = fasm_from_feet(feet, forces, cog, loaded)
-    power = np.empty(actuators.shape[0])
-    for k in range(actuators.shape[0]):
-        power[k] = abs(actuator_force[actuators[k]] * actuator_velocity[actuators[k]])
-    return forces, loaded, cog, status, margin, edge_i, edge_j, numpy_sum(power)
+    power = actuator_power(actuator_force[actuators], actuator_velocity[actuators])
+    return forces, loaded, cog, status, margin, edge_i, edge_j, power
 
 
 @njit(cache=True)
@@ -120,11 +124,9 @@ def upu_measure(
     forces = foot_weight - np.dot(local, torso_xmat.reshape(3, 3).T)
     cog = torso_com.copy()
     status, margin, edge_i, edge_j = fasm_from_feet(soles, forces, cog, loaded)
-    power = np.empty(actuator_force.shape[0])
-    for k in range(actuator_force.shape[0]):
-        power[k] = abs(actuator_force[k] * actuator_velocity[k])
     static = _static_margin(soles, loaded, cog[0], cog[1])
-    return forces, loaded, cog, status, margin, edge_i, edge_j, static, numpy_sum(power)
+    power = actuator_power(actuator_force, actuator_velocity)
+    return forces, loaded, cog, status, margin, edge_i, edge_j, static, power
 
 
 @njit(cache=True)
