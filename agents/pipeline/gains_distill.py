@@ -351,6 +351,7 @@ def fit_choice(
     import copy
 
     import torch
+    from stable_baselines3.common.torch_layers import create_mlp
 
     torch.manual_seed(seed)
     train, validation, test = (
@@ -364,13 +365,7 @@ def fit_choice(
     mean, std = observations[train].mean(axis=0), observations[train].std(axis=0) + 1e-6
     x = torch.as_tensor((observations - mean) / std, dtype=torch.float32)
     y = torch.as_tensor(costs - costs[:, default : default + 1], dtype=torch.float32)
-    net = torch.nn.Sequential(
-        torch.nn.Linear(x.shape[1], hidden),
-        torch.nn.Tanh(),
-        torch.nn.Linear(hidden, hidden),
-        torch.nn.Tanh(),
-        torch.nn.Linear(hidden, y.shape[1]),
-    )
+    net = torch.nn.Sequential(*create_mlp(x.shape[1], y.shape[1], [hidden, hidden], torch.nn.Tanh))
     optimizer = torch.optim.Adam(net.parameters(), lr=1e-3, weight_decay=1e-4)
 
     def choices(rows: np.ndarray, margin: float) -> np.ndarray:
