@@ -7,7 +7,7 @@ from blas_bits import REASON, numba_blas_matches_numpy
 
 import hexapod_envs  # noqa: F401
 from hexapod_envs.envs._compiled import numpy_sum
-from hexapod_envs.stability import fasm_from_feet
+from hexapod_envs.stability import fasm_from_feet, zmp_margin
 from hexapod_envs.stability._geometry import hull_2d, signed_distance_2d
 
 needs_same_blas = pytest.mark.skipif(not numba_blas_matches_numpy(), reason=REASON)
@@ -113,4 +113,31 @@ def test_ditch_measurements_are_their_numpy_form_to_the_bit():
         soles = d.xpos[base._foot_body][loaded]
         assert base._static_margin == _former_static_margin(soles, cog)
     assert polygons > 0
+    env.close()
+
+
+@needs_same_blas
+def test_torso_frame_zmp_is_its_numpy_form_to_the_bit():
+    """ATHENA's ZMP and margin (RobotSensors.torso_frame_zmp) against the env's former numpy
+    expressions, along random-action episodes on a block bed (loaded feet tilted and lifted)."""
+    env = gym.make("HexapodIrregularTerrain-v0", terrain="blocks")
+    env.reset(seed=1)
+    env.action_space.seed(1)
+    base = env.unwrapped
+    s = base.sensors
+    margins = 0
+    for _ in range(200):
+        _, _, terminated, truncated, info = env.step(0.3 * env.action_space.sample())
+        feet = (s.foot_positions() - s.torso_position()) @ s.torso_rotation()
+        normal = np.where(base._loaded, np.maximum(base._forces[:, 2], 0.0), 0.0)
+        total = float(normal.sum())
+        if total > 0:
+            assert _same(info["zmp"], (normal @ feet[:, :2]) / total)
+            assert info["zmp_margin"] == zmp_margin(feet, normal)
+            margins += info["zmp_margin"] != 0.0
+        else:
+            assert np.isnan(info["zmp"]).all() and info["zmp_margin"] == 0.0
+        if terminated or truncated:
+            env.reset()
+    assert margins > 0
     env.close()

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from hexapod_envs.stability import nesm, nesm_per_edge, zmp, zmp_margin
+from hexapod_envs.stability._geometry import hull_2d, signed_distance_2d
 
 SQUARE = np.array([[1.0, 1.0, 0.0], [-1.0, 1.0, 0.0], [-1.0, -1.0, 0.0], [1.0, -1.0, 0.0]])
 
@@ -83,6 +84,47 @@ def test_zmp_errors():
         zmp_margin(SQUARE, [1.0, np.nan, 1.0, 1.0])
     with pytest.raises(ValueError, match="shape"):
         zmp(np.zeros((4, 4)), np.ones(4))
+
+
+def _python_zmp_margin(feet: np.ndarray, forces: np.ndarray) -> tuple[float, float, float]:
+    """Eqs. (32)-(33) as plain Python (the implementation before the compiled kernel): the
+    loaded feet's force-weighted mean with Python's sums, and its signed distance to their hull."""
+    rows = zip(feet[:, :2].tolist(), forces.tolist(), strict=True)
+    loaded = [(x, y, f) for (x, y), f in rows if f > 1e-6]
+    total = sum(f for _, _, f in loaded)
+    px = sum(x * f for x, _, f in loaded) / total
+    py = sum(y * f for _, y, f in loaded) / total
+    if len(loaded) < 3:
+        return px, py, 0.0
+    xs, ys = [x for x, _, _ in loaded], [y for _, y, _ in loaded]
+    try:
+        hull = hull_2d(xs, ys)
+    except ValueError:
+        return px, py, 0.0
+    margin = signed_distance_2d(xs, ys, hull, px, py)
+    span = max(max(xs) - min(xs), max(ys) - min(ys))
+    return px, py, (0.0 if abs(margin) <= 1e-12 * span else margin)
+
+
+def test_zmp_and_margin_are_the_plain_python_to_the_bit():
+    """The compiled kernel behind `zmp` and `zmp_margin` sums in the feet's order, as Python's
+    ``sum`` does: equal bits on random stances with unloaded, barely loaded and collinear feet."""
+    rng = np.random.default_rng(7)
+    collinear = 0
+    for k in range(3000):
+        n = int(rng.integers(1, 7))
+        feet = rng.normal(scale=0.2, size=(n, 3))
+        if k % 10 == 0:  # feet on a line
+            feet[:, 1] = 0.5 * feet[:, 0]
+            collinear += 1
+        forces = rng.uniform(0.0, 40.0, n) * (rng.uniform(size=n) > 0.3)
+        forces[rng.uniform(size=n) < 0.1] = 1e-7  # at or below min_force: unloaded
+        if not (forces > 1e-6).any():
+            continue
+        px, py, margin = _python_zmp_margin(feet, forces)
+        assert zmp_margin(feet, forces) == margin
+        assert zmp(feet[:, :2], forces).tolist() == [px, py]
+    assert collinear > 0
 
 
 # ---------------------------------------------------------------------------------------- NESM

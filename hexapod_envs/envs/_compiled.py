@@ -16,7 +16,13 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hexapod_envs.stability._compiled import fasm_from_feet, hull_2d, signed_distance_2d
+from hexapod_envs.stability._compiled import (
+    OK,
+    fasm_from_feet,
+    hull_2d,
+    signed_distance_2d,
+    zmp_margin,
+)
 
 
 @njit(cache=True)
@@ -153,3 +159,38 @@ def _static_margin(soles, loaded, px, py):
     if hull.shape[0] < 3:  # the loaded soles lie on a line: no polygon
         return 0.0
     return signed_distance_2d(xs, ys, hull, px, py)
+
+
+@njit(cache=True)
+def torso_frame_zmp(site_xpos, foot_site, torso_pos, torso_xmat, forces, loaded, min_force):
+    """The ZMP (2,) [m] and its margin [m] in the torso frame (Coelho et al. 2024 eqs. 32-33;
+    see `RobotSensors.torso_frame_zmp`).
+
+    The loaded feet (world frame, relative to the torso, rotated into the torso frame by
+    ``np.dot`` as numpy's ``@``) weigh in with their force's non-negative vertical component.
+    The ZMP is numpy's ``normal @ feet[:, :2] / normal.sum()`` (for that strided view numpy
+    takes one BLAS dot per column, which the kernel repeats), NaN without any weight; the
+    margin is the stability kernel's :func:`~hexapod_envs.stability._compiled.zmp_margin`
+    (summed in the feet's order, as the Python ``zmp_margin``), 0 without weight or without a
+    foot above ``min_force`` [N].
+    """
+    n = foot_site.shape[0]
+    relative = np.empty((n, 3))
+    normal = np.empty(n)
+    for i in range(n):
+        for j in range(3):
+            relative[i, j] = site_xpos[foot_site[i], j] - torso_pos[j]
+        f = forces[i, 2]
+        normal[i] = (f if f > 0.0 else 0.0) if loaded[i] else 0.0  # np.maximum(f, 0.0)
+    feet = np.dot(relative, torso_xmat.reshape(3, 3))
+    total = numpy_sum(normal)
+    if not total > 0.0:
+        return np.full(2, np.nan), 0.0
+    zmp = np.empty(2)
+    column = np.empty(n)
+    for j in range(2):  # numpy's ``normal @ feet[:, :2]``: a contiguous dot per column
+        for i in range(n):
+            column[i] = feet[i, j]
+        zmp[j] = np.dot(normal, column) / total
+    status, _, _, margin = zmp_margin(feet[:, 0], feet[:, 1], normal, min_force)
+    return zmp, (margin if status == OK else 0.0)

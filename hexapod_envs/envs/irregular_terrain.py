@@ -136,7 +136,6 @@ from ..robots.athena.gait import (
 from ..robots.athena.kinematics import standing_foot_positions
 from ..robots.athena.model import add_athena
 from ..robots.athena.params import ATHENA, LEG_NAMES
-from ..stability.zmp import zmp_margin
 from ..terrain.flat import add_flat
 from ..terrain.irregular import PAPER_FRICTION, add_blocks, add_ramp
 from .base import HexapodEnv, JointActionMap
@@ -621,17 +620,7 @@ class IrregularTerrainEnv(HexapodEnv):
         self._power = reading.power
         self._height = float(self.data.sensordata[self._height_adr])
         self._gyro = s.gyro().copy()
-        feet_world = s.foot_positions()
-        # Eqs. (32)-(33) in the torso frame (the paper's relative foot coordinates), weighted by
-        # the vertical component of each foot's ground reaction.
-        feet_torso = (feet_world - s.torso_position()) @ s.torso_rotation()
-        normal = np.where(self._loaded, np.maximum(self._forces[:, 2], 0.0), 0.0)
-        total = float(normal.sum())
-        if total > 0:
-            self._zmp = (normal @ feet_torso[:, :2]) / total
-            self._zmp_margin = zmp_margin(feet_torso, normal)
-        else:
-            self._zmp, self._zmp_margin = np.full(2, np.nan), 0.0
+        self._zmp, self._zmp_margin = s.torso_frame_zmp(self._forces, self._loaded)
 
     def _height_deviation(self) -> float:
         """Torso-height reading minus the standing reference, m (0 without a reading)."""

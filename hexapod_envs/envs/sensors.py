@@ -14,6 +14,7 @@ import numpy as np
 
 from hexapod_envs.envs import _compiled
 from hexapod_envs.stability import _compiled as _stability
+from hexapod_envs.stability.zmp import DEFAULT_MIN_FORCE
 
 
 def _sensor_slice(model: mujoco.MjModel, name: str) -> slice:
@@ -105,6 +106,26 @@ class RobotSensors:
             raise ValueError("foot forces, feet or CoG contain NaN or infinite values")
         edge = (i, j) if status == _stability.OK else None
         return SupportReading(forces, loaded, cog, margin, edge, power)
+
+    def torso_frame_zmp(
+        self, forces: np.ndarray, loaded: np.ndarray, min_force: float = DEFAULT_MIN_FORCE
+    ) -> tuple[np.ndarray, float]:
+        """The ZMP estimate (2,) [m] and its margin [m] in the torso frame (Coelho et al. 2024
+        eqs. 32-33, the paper's relative foot coordinates): the `loaded` feet weighted by the
+        vertical component of their world-frame ground reaction `forces` (n_legs, 3) [N]
+        (clipped at 0). One compiled call with the arithmetic of
+        ``(foot_positions() - torso_position()) @ torso_rotation()`` and
+        `hexapod_envs.stability.zmp_margin`; NaN and 0 without a loaded foot."""
+        d = self.data
+        return _compiled.torso_frame_zmp(
+            d.site_xpos,
+            self._foot_site,
+            d.xpos[self.torso_id],
+            d.xmat[self.torso_id],
+            forces,
+            loaded,
+            min_force,
+        )
 
     def foot_positions(self) -> np.ndarray:
         """(n_legs, 3) foot (sole) points in the world frame [m] (FK of the encoders + IMU)."""

@@ -457,3 +457,42 @@ def signed_distance_2d(xs, ys, hull, px, py):
         if d < d_out:
             d_out = d
     return -d_out
+
+
+@njit(cache=True)
+def zmp_margin(xs, ys, forces, min_force):
+    """(status, ZMP x, ZMP y, margin) of Coelho et al. 2024 eqs. (32)-(33) (see
+    :func:`hexapod_envs.stability.zmp.zmp_margin`): the feet with force > ``min_force`` [N] weigh
+    their (x, y) [m] by it, summed in index order as Python's ``sum``; the margin is the ZMP's
+    signed distance to their hull, 0 with fewer than 3 of them, on a line, or within a relative
+    1e-12 of an edge. Status NOT_FINITE for non-finite forces, ZERO_FORCE if no foot is loaded."""
+    total = 0.0
+    for f in forces:
+        total += f
+    if not math.isfinite(total):
+        return NOT_FINITE, 0.0, 0.0, 0.0
+    count = 0
+    for f in forces:
+        count += f > min_force
+    if count == 0:
+        return ZERO_FORCE, 0.0, 0.0, 0.0
+    lx, ly = np.empty(count), np.empty(count)
+    total = sx = sy = 0.0
+    count = 0
+    for i in range(forces.shape[0]):
+        f = forces[i]
+        if f > min_force:
+            lx[count], ly[count] = xs[i], ys[i]
+            total += f
+            sx += xs[i] * f
+            sy += ys[i] * f
+            count += 1
+    px, py = sx / total, sy / total
+    if count < 3:
+        return OK, px, py, 0.0
+    hull = hull_2d(lx, ly)
+    if hull.shape[0] < 3:  # the loaded feet lie on a line: a polygon without interior
+        return OK, px, py, 0.0
+    margin = signed_distance_2d(lx, ly, hull, px, py)
+    span = max(lx.max() - lx.min(), ly.max() - ly.min())
+    return OK, px, py, (0.0 if abs(margin) <= REL_TOL * span else margin)

@@ -24,37 +24,33 @@ loaded feet are collinear, the support polygon has no interior and the ZMP lies 
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from hexapod_envs.stability._compiled import REL_TOL
-from hexapod_envs.stability._geometry import as_points, hull_2d, signed_distance_2d
+from hexapod_envs.stability import _compiled
+from hexapod_envs.stability._geometry import points_array
 
 DEFAULT_MIN_FORCE = 1e-6  # [N] normal force at or below which a foot counts as unloaded
 
 
-def _loaded(feet, normal_forces, min_force: float):
-    pts = as_points(feet, "feet", dims=(2, 3))
+def _zmp_and_margin(feet, normal_forces, min_force: float) -> tuple[float, float, float]:
+    """(ZMP x, ZMP y, margin) of validated input, from the compiled kernel
+    (:func:`hexapod_envs.stability._compiled.zmp_margin`, which sums in the feet's order)."""
+    pts = points_array(feet, "feet", dims=(2, 3))
+    if not np.isfinite(pts).all():
+        raise ValueError("feet contains NaN or infinite values")
     forces = np.asarray(normal_forces, dtype=float)
     if forces.shape != (len(pts),):
         raise ValueError(
             f"normal_forces must have shape ({len(pts)},) (one per foot), got {forces.shape}"
         )
-    values = forces.tolist()
-    if not math.isfinite(sum(values)):
+    status, px, py, margin = _compiled.zmp_margin(pts[:, 0], pts[:, 1], forces, float(min_force))
+    if status == _compiled.NOT_FINITE:
         raise ValueError("normal_forces contains NaN or infinite values")
-    loaded = [(p[0], p[1], f) for p, f in zip(pts, values, strict=True) if f > min_force]
-    if not loaded:
+    if status == _compiled.ZERO_FORCE:
         raise ValueError(
             f"no foot carries a normal force above min_force={min_force} N: the ZMP is undefined"
         )
-    return loaded
-
-
-def _weighted_mean(loaded) -> tuple[float, float]:
-    total = sum(f for _, _, f in loaded)
-    return sum(x * f for x, _, f in loaded) / total, sum(y * f for _, y, f in loaded) / total
+    return px, py, margin
 
 
 def zmp(feet, normal_forces, min_force: float = DEFAULT_MIN_FORCE) -> np.ndarray:
@@ -72,7 +68,8 @@ def zmp(feet, normal_forces, min_force: float = DEFAULT_MIN_FORCE) -> np.ndarray
     Raises:
         ValueError: no loaded foot, shape mismatch, or non-finite input.
     """
-    return np.array(_weighted_mean(_loaded(feet, normal_forces, min_force)))
+    px, py, _ = _zmp_and_margin(feet, normal_forces, min_force)
+    return np.array([px, py])
 
 
 def zmp_margin(feet, normal_forces, min_force: float = DEFAULT_MIN_FORCE) -> float:
@@ -88,16 +85,4 @@ def zmp_margin(feet, normal_forces, min_force: float = DEFAULT_MIN_FORCE) -> flo
         normal_forces: (k,) normal contact forces [N].
         min_force: feet at or below this force [N] are unloaded.
     """
-    loaded = _loaded(feet, normal_forces, min_force)
-    px, py = _weighted_mean(loaded)
-    if len(loaded) < 3:
-        return 0.0
-    xs = [x for x, _, _ in loaded]
-    ys = [y for _, y, _ in loaded]
-    try:
-        hull = hull_2d(xs, ys)
-    except ValueError:  # loaded feet collinear: a polygon without interior
-        return 0.0
-    margin = signed_distance_2d(xs, ys, hull, px, py)
-    span = max(max(xs) - min(xs), max(ys) - min(ys))
-    return 0.0 if abs(margin) <= REL_TOL * span else margin
+    return _zmp_and_margin(feet, normal_forces, min_force)[2]
