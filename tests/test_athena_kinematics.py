@@ -195,3 +195,41 @@ def test_compiled_six_leg_ik_is_leg_ik_solve():
             else:
                 flagged += 1
     assert solved > 1000 and flagged > 100
+
+
+def test_compiled_tick_is_the_controllers_numpy_tick():
+    """tick_legs writes the Bezier swing and straight stance feet of the former numpy tick
+    (``weights @ control points``, ``start + u delta``) to the bit, and solves them as
+    solve_legs does; u covers the ticks of several phase lengths and random fractions."""
+    from hexapod_envs.robots.athena._compiled import solve_legs, tick_legs
+
+    constants = np.array([kin.leg_ik(leg).packed_constants for leg in LEG_NAMES])
+    standing = kin.forward_kinematics_all(np.tile(ATHENA.standing_posture, (6, 1)))
+    rng = np.random.default_rng(3)
+    fractions = [k / n for n in (10, 20, 40) for k in range(1, n + 1)] + list(rng.uniform(size=200))
+    for k, u in enumerate(fractions):
+        swing, stance = (np.array([0, 2, 4]), np.array([1, 3, 5]))[:: 1 if k % 2 else -1]
+        points = standing[swing, None, :] + rng.normal(scale=0.03, size=(3, 4, 3))
+        start = standing[stance] + rng.normal(scale=0.01, size=(3, 3))
+        delta = rng.normal(scale=0.03, size=(3, 3))
+        command = standing.copy()
+        angles, solved = tick_legs(constants, command, u, swing, points, stance, start, delta)
+        v = 1.0 - u
+        expected = standing.copy()
+        expected[swing] = np.array([v**3, 3 * v * v * u, 3 * v * u * u, u**3]) @ points
+        expected[stance] = start + u * delta
+        assert command.tobytes() == expected.tobytes()
+        ref_angles, ref_solved = solve_legs(constants, expected)
+        assert angles.tobytes() == ref_angles.tobytes() and (solved == ref_solved).all()
+
+
+def test_compiled_closed_form_is_foot_position_closed_form():
+    """feet_closed_form (all six legs, one compiled call) gives eq. (12)'s Python numbers to the
+    bit, over the joint ranges and beyond."""
+    rng = np.random.default_rng(11)
+    for _ in range(300):
+        q = rng.uniform(-2.5, 2.5, size=(6, 3))
+        expected = [kin.foot_position_closed_form(leg, q[i]) for i, leg in enumerate(LEG_NAMES)]
+        assert kin.feet_closed_form(q).tobytes() == np.array(expected).tobytes()
+    with pytest.raises(ValueError, match=r"shape \(6, 3\)"):
+        kin.feet_closed_form(np.zeros((5, 3)))

@@ -62,3 +62,41 @@ def solve_legs(constants, feet):
             and lo4 - 1e-9 <= t4 <= hi4 + 1e-9
         )
     return angles, solved
+
+
+@njit(cache=True)
+def tick_legs(constants, command, u, swing, swing_points, stance, stance_start, stance_delta):
+    """One control tick of the posture controller: write the commanded feet (body frame, m) at
+    phase fraction ``u`` into ``command`` (6, 3) and return :func:`solve_legs` of it.
+
+    The swing rows ``swing`` follow their cubic Bezier curves (control points (k, 4, 3), eqs.
+    20-21), the stance rows ``stance`` their straight lines ``start + u delta`` (eq. 31); the
+    arithmetic is the Python controller's: the Bernstein weights with CPython's ``pow``
+    (``math.pow``; ``v**3`` would compile to two multiplications), each leg's curve a BLAS
+    ``np.dot`` as numpy's stacked ``@``.
+    """
+    v = 1.0 - u
+    weights = np.array((math.pow(v, 3.0), 3 * v * v * u, 3 * v * u * u, math.pow(u, 3.0)))
+    for k in range(swing.shape[0]):
+        command[swing[k]] = np.dot(weights, swing_points[k])
+    for k in range(stance.shape[0]):
+        for j in range(3):
+            command[stance[k], j] = stance_start[k, j] + u * stance_delta[k, j]
+    return solve_legs(constants, command)
+
+
+@njit(cache=True)
+def feet_closed_form(q, theta1, l1, l2, l3, l4):
+    """(6, 3) body-frame feet [m] of joint angles ``q`` (6, 3) [rad]: eq. (12) written out, the
+    arithmetic of `kinematics.foot_position_closed_form` per row (``theta1``, ``l1``: each leg's
+    mounting angle [rad] and hip distance [m]; ``l2``-``l4``: link lengths [m])."""
+    n = q.shape[0]
+    feet = np.empty((n, 3))
+    for i in range(n):
+        t2, t3, t4 = q[i, 0], q[i, 1], q[i, 2]
+        t1, a1 = theta1[i], l1[i]
+        reach = l4 * math.cos(t3 + t4) + l3 * math.cos(t3) + l2
+        feet[i, 0] = math.cos(t1 + t2) * reach + a1 * math.cos(t1)
+        feet[i, 1] = math.sin(t1 + t2) * reach + a1 * math.sin(t1)
+        feet[i, 2] = l4 * math.sin(t3 + t4) + l3 * math.sin(t3)
+    return feet

@@ -58,7 +58,7 @@ import numpy as np
 from ...checks import check_number
 from ...stability.plane_fit import fit_plane
 from . import _compiled
-from .kinematics import foot_position_closed_form, forward_kinematics_all, leg_ik
+from .kinematics import feet_closed_form, forward_kinematics_all, leg_ik
 from .params import ATHENA, LEG_NAMES, TRIPODS, AthenaParams
 
 START_FROM = ("measured", "commanded", "measured_height")
@@ -198,9 +198,9 @@ class PostureEstimate:
 class _Plan:
     """One phase's foot paths: Bezier control points of the swing legs, lines of the stance legs."""
 
-    swing: slice | list[int]  # rows of the swing legs (see _rows)
+    swing: np.ndarray  # rows of the swing legs
     swing_points: np.ndarray  # (3, 4, 3) control points per swing leg
-    stance: slice | list[int]  # rows of the stance legs
+    stance: np.ndarray  # rows of the stance legs
     stance_start: np.ndarray  # (3, 3) p_{i,0}
     stance_delta: np.ndarray  # (3, 3) p_{i,f} - p_{i,0}
 
@@ -400,15 +400,21 @@ class AthenaPostureController:
             self._waited = 0
             self._begin_phase(q, contact, forces, height)
         u = (self._tick + 1) / self.ticks_per_phase
-        v = 1.0 - u
         plan = self._plan
-        # cubic_bezier for the three swing legs at once, and eq. (31)'s straight stance lines.
-        self._command[plan.swing] = np.array([v**3, 3 * v * v * u, 3 * v * u * u, u**3]) @ (
-            plan.swing_points
+        # cubic_bezier for the three swing legs, eq. (31)'s straight stance lines and the IK, in
+        # one compiled call.
+        solution = _compiled.tick_legs(
+            self._ik_constants,
+            self._command,
+            u,
+            plan.swing,
+            plan.swing_points,
+            plan.stance,
+            plan.stance_start,
+            plan.stance_delta,
         )
-        self._command[plan.stance] = plan.stance_start + u * plan.stance_delta
         self._tick = (self._tick + 1) % self.ticks_per_phase
-        return self._joint_targets()
+        return self._joint_targets(solution)
 
     def _begin_phase(
         self, q: np.ndarray, contact: np.ndarray, forces: np.ndarray, height: float
@@ -421,12 +427,7 @@ class AthenaPostureController:
             start = self._command.copy()
         else:
             # Eq. (12) on the encoder angles (the closed form of the DH chain: same numbers).
-            measured = np.array(
-                [
-                    foot_position_closed_form(leg, q[i], self.params)
-                    for i, leg in enumerate(LEG_NAMES)
-                ]
-            )
+            measured = feet_closed_form(q, self.params)
             if self.start_from == "measured":
                 start = measured
             else:
@@ -445,11 +446,11 @@ class AthenaPostureController:
         rotation = posture_rotation(ka * d_pitch, kb * d_roll)
         stance_end = [stance_end_point(start[i], stride, kz * d_z, rotation) for i in stance]
         self._plan = _Plan(
-            swing=_rows(swing),
+            swing=np.array(swing),
             swing_points=np.array(
                 [swing_control_points(start[i], stride, self.swing_height, kz * d_z) for i in swing]
             ),
-            stance=_rows(stance),
+            stance=np.array(stance),
             stance_start=start[list(stance)],
             stance_delta=np.array(stance_end) - start[list(stance)],
         )
@@ -492,12 +493,15 @@ class AthenaPostureController:
             return triples[int(self.rng.integers(len(triples)))]
         return max(triples, key=lambda t: triangle_area_xy(feet[list(t)]))
 
-    def _joint_targets(self) -> np.ndarray:
+    def _joint_targets(self, solution: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
         """IK of the commanded feet; unreachable points get the nearest reachable pose.
 
         The six legs are solved in one compiled call (`_compiled.solve_legs`, `LegIK.solve`'s
-        arithmetic); a leg it flags goes through `LegIK.solve` for its clamped pose."""
-        angles, solved = _compiled.solve_legs(self._ik_constants, self._command)
+        arithmetic; or `solution`, its result already computed); a leg it flags goes through
+        `LegIK.solve` for its clamped pose."""
+        if solution is None:
+            solution = _compiled.solve_legs(self._ik_constants, self._command)
+        angles, solved = solution
         clamped = []
         for i in np.flatnonzero(~solved).tolist():
             t2, t3, t4, problem = self._solvers[i](*self._command[i].tolist())
@@ -506,15 +510,6 @@ class AthenaPostureController:
                 clamped.append(LEG_NAMES[i])
         self.clamped_legs = tuple(clamped)
         return angles
-
-
-def _rows(legs: tuple[int, ...]) -> slice | list[int]:
-    """Index of the rows ``legs``: a slice when they are evenly spaced (the tripods are rows
-    0, 2, 4 and 1, 3, 5), which numpy assigns through about three times faster than a list."""
-    step = legs[1] - legs[0] if len(legs) > 1 else 1
-    if step > 0 and list(legs) == list(range(legs[0], legs[-1] + 1, step)):
-        return slice(legs[0], legs[-1] + 1, step)
-    return list(legs)
 
 
 def _checked_gains(kz: float, k_alpha: float, k_beta: float) -> tuple[float, float, float]:

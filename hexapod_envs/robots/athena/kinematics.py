@@ -22,6 +22,7 @@ from math import acos, atan2, cos, hypot, sin
 
 import numpy as np
 
+from . import _compiled
 from .params import ATHENA, JOINT_NAMES, LEG_NAMES, AthenaParams
 
 
@@ -75,6 +76,24 @@ def foot_position_closed_form(leg: str, q: np.ndarray, params: AthenaParams = AT
             params.l4 * math.sin(t3 + t4) + params.l3 * math.sin(t3),
         ]
     )
+
+
+def feet_closed_form(q: np.ndarray, params: AthenaParams = ATHENA) -> np.ndarray:
+    """(6, 3) body-frame feet [m] for (6, 3) joint angles (rows `LEG_NAMES`): eq. (12) of every
+    leg in one compiled call, `foot_position_closed_form`'s numbers to the bit (what the posture
+    controller reads from the encoders at every phase start)."""
+    theta1, l1 = _closed_form_constants(params)
+    q = np.ascontiguousarray(_robot_array(q, "joint angles"))
+    return _compiled.feet_closed_form(q, theta1, l1, params.l2, params.l3, params.l4)
+
+
+@functools.lru_cache(maxsize=16)
+def _closed_form_constants(params: AthenaParams) -> tuple[np.ndarray, np.ndarray]:
+    """Each leg's mounting angle [rad] and hip distance [m], as `foot_position_closed_form`
+    computes them."""
+    theta1 = np.array([params.mounting_angle(leg) for leg in LEG_NAMES])
+    l1 = np.array([params.hip_distance(leg) for leg in LEG_NAMES])
+    return theta1, l1
 
 
 def forward_kinematics_all(q: np.ndarray, params: AthenaParams = ATHENA) -> np.ndarray:
