@@ -479,9 +479,9 @@ class AthenaPostureController:
         self, feet: np.ndarray, contact: np.ndarray, stance: tuple[int, ...]
     ) -> tuple[int, ...]:
         """Indices of the three feet that define the ground plane (eq. 24), () if none."""
-        in_contact = [int(i) for i in np.flatnonzero(contact)]
-        if all(contact[i] for i in stance) and self.rng is None:
+        if self.rng is None and all(contact[i] for i in stance):
             return tuple(stance)
+        in_contact = [int(i) for i in np.flatnonzero(contact)]
         triples = [
             t
             for t in itertools.combinations(in_contact, 3)
