@@ -3,7 +3,8 @@
 For each robot the script sweeps candidate physics settings - the physics timestep (the env's
 ``physics_dt`` kwarg: the current default, about 1.25x, 2x, 2.5x and 4x of it, always a whole
 fraction of ``control_dt``), the integrator (implicitfast, the envs' choice, against Euler and
-RK4) and the constraint solver's tolerance / iterations - and prints, per setting,
+RK4), the constraint solver (Newton, the envs' choice, against conjugate gradient and
+projected Gauss-Seidel) and its tolerance / iterations - and prints, per setting,
 
 - speed: simulated seconds per wall second of ``env.step`` with zero actions and with uniform
   random actions, per env (episodes of the training task distribution, as the PPO configs use;
@@ -40,10 +41,10 @@ The env defaults are not changed: settings are applied to the envs this script m
 How a setting is applied (`make_env`): the timestep through the ``physics_dt`` kwarg (the env
 checks that it divides ``control_dt``; ATHENA also needs a multiple of 5 substeps, so its "x1.25"
 and "x2.5" are the nearest allowed timesteps, 3.33 and 5 ms; the table prints the timestep
-used); the integrator and solver options through the env's ``integrator``, ``solver_iterations``,
-``solver_ls_iterations`` and ``solver_tolerance`` settings, so that a model rebuilt at reset
-(ATHENA on blocks, a sampled task) gets them too; every reset here is followed by
-`check_options`, which raises if the model does not carry the setting.
+used); the integrator and solver options through the env's ``integrator``, ``solver``,
+``solver_iterations``, ``solver_ls_iterations`` and ``solver_tolerance`` settings, so that a
+model rebuilt at reset (ATHENA on blocks, a sampled task) gets them too; every reset here is
+followed by `check_options`, which raises if the model does not carry the setting.
 
 Convergence (``--finer``): the default against half and a quarter of its timestep, on the same
 rows. A finer step is the better-resolved physics, so a row that it moves beyond the tolerance is
@@ -74,6 +75,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run as a script 
 
 import hexapod_envs  # noqa: E402, F401  (registers the env ids)
 from hexapod_envs.envs.base import INTEGRATOR_IDS as INTEGRATORS  # noqa: E402
+from hexapod_envs.envs.base import SOLVER_IDS as SOLVERS  # noqa: E402
 
 
 @dataclasses.dataclass(frozen=True)
@@ -85,6 +87,8 @@ class PhysicsSetting:
 
     factor: float = 1.0
     integrator: str = "implicitfast"
+    solver: str | None = None
+    """MuJoCo constraint solver (None: the env's default)."""
     iterations: int | None = None
     ls_iterations: int | None = None
     tolerance: float | None = None
@@ -92,12 +96,16 @@ class PhysicsSetting:
     def __post_init__(self):
         if self.integrator not in INTEGRATORS:
             raise ValueError(f"integrator must be one of {sorted(INTEGRATORS)}")
+        if self.solver is not None and self.solver not in SOLVERS:
+            raise ValueError(f"solver must be one of {sorted(SOLVERS)}")
         if not self.factor > 0:
             raise ValueError(f"factor must be > 0, got {self.factor}")
 
     @property
     def label(self) -> str:
         parts = [f"dt x{self.factor:g}", self.integrator]
+        if self.solver is not None:
+            parts.append(self.solver)
         for name, short in (("iterations", "it"), ("ls_iterations", "ls"), ("tolerance", "tol")):
             value = getattr(self, name)
             if value is not None:
@@ -137,6 +145,9 @@ def candidate_settings(quick: bool, finer: bool = False) -> list[PhysicsSetting]
         PhysicsSetting(1.0, tolerance=1e-6),
         PhysicsSetting(1.0, iterations=3),
         PhysicsSetting(2.0, tolerance=1e-6),
+        PhysicsSetting(1.0, solver="newton"),
+        PhysicsSetting(1.0, solver="cg"),
+        PhysicsSetting(1.0, solver="pgs"),
     ]
 
 
@@ -177,6 +188,8 @@ def check_options(env: gym.Env, setting: PhysicsSetting) -> None:
     base = env.unwrapped
     opt = base.model.opt
     wanted = {"integrator": int(INTEGRATORS[setting.integrator]), "timestep": base.physics_dt}
+    if setting.solver is not None:
+        wanted["solver"] = int(SOLVERS[setting.solver])
     for name in ("iterations", "ls_iterations", "tolerance"):
         if getattr(setting, name) is not None:
             wanted[name] = getattr(setting, name)
@@ -193,6 +206,8 @@ def setting_kwargs(env_id: str, setting: PhysicsSetting) -> dict:
         "solver_ls_iterations": setting.ls_iterations,
         "solver_tolerance": setting.tolerance,
     }
+    if setting.solver is not None:
+        kwargs["solver"] = setting.solver
     if setting.factor != 1.0:
         kwargs["physics_dt"] = physics_dt_for(env_id, setting.factor)
     return kwargs

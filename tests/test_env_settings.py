@@ -4,6 +4,7 @@ import dataclasses
 import math
 
 import gymnasium as gym
+import mujoco
 import numpy as np
 import pytest
 
@@ -173,6 +174,22 @@ def test_meaningless_values_are_named(env_id, kwargs):
     (name,) = kwargs
     with pytest.raises(ValueError, match=name):
         gym.make(env_id, **kwargs)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_physics_options_reach_every_model_the_env_builds(env_id):
+    """integrator and solver land in model.opt, also after a reset that draws a new task (the
+    block bed, a cliff, a ditch rebuild the model); a bad choice lists the valid ones."""
+    env = gym.make(env_id, integrator="euler", solver="cg", task_distribution="train")
+    for seed in range(2):
+        env.reset(seed=seed)
+        opt = env.unwrapped.model.opt
+        assert opt.integrator == mujoco.mjtIntegrator.mjINT_EULER
+        assert opt.solver == mujoco.mjtSolver.mjSOL_CG
+    env.close()
+    assert gym.make(env_id).unwrapped.model.opt.solver == mujoco.mjtSolver.mjSOL_NEWTON
+    with pytest.raises(ValueError, match=r"solver must be one of \['cg', 'newton', 'pgs'\]"):
+        gym.make(env_id, solver="lbfgs")
 
 
 # --- task distributions ---------------------------------------------------------------------

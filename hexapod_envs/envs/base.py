@@ -95,6 +95,13 @@ class ObservationLayout:
         return {name: observation[..., sl] for name, sl in self.slices.items()}
 
 
+SOLVER_IDS = {
+    "newton": mujoco.mjtSolver.mjSOL_NEWTON,
+    "cg": mujoco.mjtSolver.mjSOL_CG,
+    "pgs": mujoco.mjtSolver.mjSOL_PGS,
+}
+"""MuJoCo constraint solvers by the names of the ``solver`` setting."""
+
 INTEGRATOR_IDS = {
     "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
     "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
@@ -111,15 +118,17 @@ def set_physics_options(
     iterations: int | None = None,
     ls_iterations: int | None = None,
     tolerance: float | None = None,
+    solver: str = "newton",
 ) -> None:
     """The solver options of an env: `timestep` [s], the `integrator` (`INTEGRATOR_IDS`), the
-    constraint solver's `iterations`, `ls_iterations` and `tolerance` (None: MuJoCo's 100, 50
-    and 1e-8), and elliptic friction cones with a high impedance ratio (the default pyramidal
-    cone lets a loaded foot creep down a slope at several cm/s, far below its friction limit).
-    The envs pass their settings of the same names (``physics_dt``, ``integrator``,
-    ``solver_*``)."""
+    constraint `solver` (`SOLVER_IDS`) and its `iterations`, `ls_iterations` and `tolerance`
+    (None: MuJoCo's 100, 50 and 1e-8), and elliptic friction cones with a high impedance ratio
+    (the default pyramidal cone lets a loaded foot creep down a slope at several cm/s, far
+    below its friction limit). The envs pass their settings of the same names (``physics_dt``,
+    ``integrator``, ``solver``, ``solver_*``)."""
     spec.option.timestep = timestep
     spec.option.integrator = INTEGRATOR_IDS[integrator]
+    spec.option.solver = SOLVER_IDS[solver]
     for name, value in (
         ("iterations", iterations),
         ("ls_iterations", ls_iterations),
@@ -262,6 +271,7 @@ class HexapodEnv(gym.Env):
             s.solver_iterations,
             s.solver_ls_iterations,
             s.solver_tolerance,
+            s.solver,
         )
         spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
         spec.visual.headlight.diffuse = [0.65, 0.65, 0.65]

@@ -27,6 +27,9 @@ physical parameters sampled at every reset from the env's training or held-out t
 
 RENDER_MODES = ("human", "rgb_array", "depth_array")
 
+SOLVERS = ("newton", "cg", "pgs")
+"""``solver`` values: MuJoCo's constraint solvers (`hexapod_envs.envs.base.SOLVER_IDS`)."""
+
 RENAMED = {
     "progress_weight": "forward_weight",
 }
@@ -256,6 +259,8 @@ class EnvSettings(_Checked):
     """MuJoCo timestep [s]; control_dt must be a whole multiple of it."""
     integrator: str = choice("implicitfast", ("implicitfast", "implicit", "euler", "rk4"))
     """MuJoCo integrator."""
+    solver: str = choice("newton", SOLVERS)
+    """MuJoCo's constraint solver (Newton, conjugate gradient, projected Gauss-Seidel)."""
     solver_iterations: int | None = number(None, strict=True, integer=True, optional=True)
     """Constraint solver iterations (None: MuJoCo's default, 100)."""
     solver_ls_iterations: int | None = number(None, strict=True, integer=True, optional=True)
