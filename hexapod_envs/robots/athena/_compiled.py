@@ -1,4 +1,6 @@
-"""ATHENA's six-leg inverse kinematics as one compiled call (private; numba).
+"""ATHENA's six-leg kinematics as compiled calls (private; numba): the IK (`solve_legs`), a
+posture-controller tick (`tick_legs`: its feet and their IK) and eq. (12) for all legs
+(`feet_closed_form`).
 
 The posture controller solves the IK of all six feet at every control tick (50 ms);
 :func:`solve_legs` is `LegIK.solve`'s usual case (a reachable point inside the joint ranges)
