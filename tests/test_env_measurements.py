@@ -31,6 +31,14 @@ def test_numpy_sum_is_numpys_pairwise_order(n):
         numpy_sum(np.ones(129))
 
 
+def _seeded_env(env_id: str, seed: int, **kwargs):
+    """(env, its unwrapped env) reset and with its action space seeded by `seed`."""
+    env = gym.make(env_id, **kwargs)
+    env.reset(seed=seed)
+    env.action_space.seed(seed)
+    return env, env.unwrapped
+
+
 def _same(a, b) -> bool:
     a, b = np.asarray(a), np.asarray(b)
     return a.shape == b.shape and a.tobytes() == b.tobytes()
@@ -48,10 +56,7 @@ def _same(a, b) -> bool:
 def test_support_reading_is_the_sensor_accessors_to_the_bit(env_id, kwargs):
     """RobotSensors.support = foot_forces, the contact test, cog, fasm_from_feet and Σ|F v|
     (numpy's pairwise sum), along a random-action episode."""
-    env = gym.make(env_id, **kwargs)
-    env.reset(seed=3)
-    env.action_space.seed(3)
-    base = env.unwrapped
+    env, base = _seeded_env(env_id, 3, **kwargs)
     s = base.sensors
     threshold = base._contact_force_sq
     polygons = 0
@@ -91,10 +96,7 @@ def _former_static_margin(soles: np.ndarray, cog: np.ndarray) -> float:
 def test_ditch_measurements_are_their_numpy_form_to_the_bit():
     """HexapodDitchCrossing-v0's compiled measurements against the former expressions: forces =
     foot weight - s Rᵀ, the touch switches, the soles' FASM, Σ|F v| and the static margin."""
-    env = gym.make("HexapodDitchCrossing-v0")
-    env.reset(seed=1)
-    env.action_space.seed(1)
-    base = env.unwrapped
+    env, base = _seeded_env("HexapodDitchCrossing-v0", 1)
     d = base.data
     polygons = 0
     for _ in range(60):
@@ -120,10 +122,7 @@ def test_ditch_measurements_are_their_numpy_form_to_the_bit():
 def test_torso_frame_zmp_is_its_numpy_form_to_the_bit():
     """ATHENA's ZMP and margin (RobotSensors.torso_frame_zmp) against the env's former numpy
     expressions, along random-action episodes on a block bed (loaded feet tilted and lifted)."""
-    env = gym.make("HexapodIrregularTerrain-v0", terrain="blocks")
-    env.reset(seed=1)
-    env.action_space.seed(1)
-    base = env.unwrapped
+    env, base = _seeded_env("HexapodIrregularTerrain-v0", 1, terrain="blocks")
     s = base.sensors
     margins = 0
     for _ in range(200):

@@ -467,13 +467,12 @@ def zmp_margin(xs, ys, forces, min_force):
     signed distance to their hull, 0 with fewer than 3 of them, on a line, or within a relative
     1e-12 of an edge. Status NOT_FINITE for non-finite forces, ZERO_FORCE if no foot is loaded."""
     total = 0.0
-    for f in forces:
-        total += f
-    if not math.isfinite(total):
-        return NOT_FINITE, 0.0, 0.0, 0.0
     count = 0
     for f in forces:
+        total += f
         count += f > min_force
+    if not math.isfinite(total):
+        return NOT_FINITE, 0.0, 0.0, 0.0
     if count == 0:
         return ZERO_FORCE, 0.0, 0.0, 0.0
     lx, ly = np.empty(count), np.empty(count)

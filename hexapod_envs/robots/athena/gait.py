@@ -403,7 +403,7 @@ class AthenaPostureController:
         plan = self._plan
         # cubic_bezier for the three swing legs, eq. (31)'s straight stance lines and the IK, in
         # one compiled call.
-        solution = _compiled.tick_legs(
+        angles, solved = _compiled.tick_legs(
             self._ik_constants,
             self._command,
             u,
@@ -414,7 +414,7 @@ class AthenaPostureController:
             plan.stance_delta,
         )
         self._tick = (self._tick + 1) % self.ticks_per_phase
-        return self._joint_targets(solution)
+        return self._clamp_unsolved(angles, solved)
 
     def _begin_phase(
         self, q: np.ndarray, contact: np.ndarray, forces: np.ndarray, height: float
@@ -493,15 +493,15 @@ class AthenaPostureController:
             return triples[int(self.rng.integers(len(triples)))]
         return max(triples, key=lambda t: triangle_area_xy(feet[list(t)]))
 
-    def _joint_targets(self, solution: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
-        """IK of the commanded feet; unreachable points get the nearest reachable pose.
+    def _joint_targets(self) -> np.ndarray:
+        """IK of the commanded feet; unreachable points get the nearest reachable pose. The six
+        legs are solved in one compiled call (`_compiled.solve_legs`, `LegIK.solve`'s
+        arithmetic)."""
+        return self._clamp_unsolved(*_compiled.solve_legs(self._ik_constants, self._command))
 
-        The six legs are solved in one compiled call (`_compiled.solve_legs`, `LegIK.solve`'s
-        arithmetic; or `solution`, its result already computed); a leg it flags goes through
-        `LegIK.solve` for its clamped pose."""
-        if solution is None:
-            solution = _compiled.solve_legs(self._ik_constants, self._command)
-        angles, solved = solution
+    def _clamp_unsolved(self, angles: np.ndarray, solved: np.ndarray) -> np.ndarray:
+        """The compiled IK's `angles` with each leg it flagged (not `solved`) replaced by
+        `LegIK.solve`'s clamped pose; `clamped_legs` names those out of reach."""
         clamped = []
         for i in np.flatnonzero(~solved).tolist():
             t2, t3, t4, problem = self._solvers[i](*self._command[i].tolist())
