@@ -19,7 +19,7 @@ from numba import njit
 from hexapod_envs.stability._compiled import (
     OK,
     fasm_from_feet,
-    hull_2d,
+    hull_distance,
     signed_distance_2d,
     zmp_margin,
 )
@@ -155,10 +155,7 @@ def _static_margin(soles, loaded, px, py):
         if area2 != 0.0:
             hull = np.array((0, 1, 2)) if area2 > 0 else np.array((0, 2, 1))
             return signed_distance_2d(xs, ys, hull, px, py)
-    hull = hull_2d(xs, ys)
-    if hull.shape[0] < 3:  # the loaded soles lie on a line: no polygon
-        return 0.0
-    return signed_distance_2d(xs, ys, hull, px, py)
+    return hull_distance(xs, ys, px, py)
 
 
 @njit(cache=True)

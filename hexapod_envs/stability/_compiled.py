@@ -460,6 +460,16 @@ def signed_distance_2d(xs, ys, hull, px, py):
 
 
 @njit(cache=True)
+def hull_distance(xs, ys, px, py):
+    """Signed distance of (px, py) to the convex hull of the points (xs, ys) (see
+    :func:`signed_distance_2d`); 0 when the points lie on a line: no polygon."""
+    hull = hull_2d(xs, ys)
+    if hull.shape[0] < 3:
+        return 0.0
+    return signed_distance_2d(xs, ys, hull, px, py)
+
+
+@njit(cache=True)
 def zmp_margin(xs, ys, forces, min_force):
     """(status, ZMP x, ZMP y, margin) of Coelho et al. 2024 eqs. (32)-(33) (see
     :func:`hexapod_envs.stability.zmp.zmp_margin`): the feet with force > ``min_force`` [N] weigh
@@ -489,9 +499,6 @@ def zmp_margin(xs, ys, forces, min_force):
     px, py = sx / total, sy / total
     if count < 3:
         return OK, px, py, 0.0
-    hull = hull_2d(lx, ly)
-    if hull.shape[0] < 3:  # the loaded feet lie on a line: a polygon without interior
-        return OK, px, py, 0.0
-    margin = signed_distance_2d(lx, ly, hull, px, py)
+    margin = hull_distance(lx, ly, px, py)
     span = max(lx.max() - lx.min(), ly.max() - ly.min())
     return OK, px, py, (0.0 if abs(margin) <= REL_TOL * span else margin)
