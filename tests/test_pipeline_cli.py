@@ -505,3 +505,18 @@ def test_reward_exclude_takes_the_named_terms_out_of_the_reward():
     env.reset(seed=0)
     with pytest.raises(UserError, match="reward_alivee"):
         env.step(np.zeros(18))
+
+
+def test_a_settings_note_names_the_model_of_its_env_not_the_template(run, tmp_path):
+    """``ppo:models/{env_id}/...`` differing from its training env is told per env, with the
+    path of the model that differs (the report must not show an unexpanded template)."""
+    models = tmp_path / "models"
+    shutil.copytree(run[0] / "final", models / "HexapodCliffWalk-v0")
+    settings = read_settings(models / "HexapodCliffWalk-v0")
+    settings["reward"]["forward_weight"] = 3.0
+    (models / "HexapodCliffWalk-v0" / "env_settings.yaml").write_text(yaml.safe_dump(settings))
+    assert evaluate(tmp_path / "rep", f"ppo:{models}/{{env_id}}") == 0
+    metrics = json.loads((tmp_path / "rep" / "metrics.json").read_text())
+    expected = f"HexapodCliffWalk-v0: ppo:{models}/HexapodCliffWalk-v0 was trained on an env"
+    assert [n for n in metrics["notes"] if n.startswith(expected)]
+    assert f"- **note:** {expected}" in (tmp_path / "rep" / "report.md").read_text()

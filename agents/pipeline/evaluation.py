@@ -351,7 +351,7 @@ def prepare(
             files = getattr(getattr(policy, "learned", policy), "files", None)
             run.model_dir = getattr(files, "directory", None)
             note, harmless = _settings_note(
-                envs[key], suite_env, name, run.model_dir, policy, extra
+                envs[key], suite_env, result.label(name), run.model_dir, policy, extra
             )
             if note:
                 run.notes.append(note)
