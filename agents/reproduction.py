@@ -756,7 +756,8 @@ STEWART_EQ15 = {
 at which the platform stops [deg]. The paper gives neither (its judgment times, 4.9-8.8 s after
 the tilt starts, fit a few deg/s). Eq. 15 forecasts the time for the margin to fall from xi_f to
 0 at its current rate, which in our model is 0.85-1.0 times the tilt rate, so the paper's t_s of
-0.74-2.31 s (with kappa 0.7) need 6-20 deg/s. Measured with the default controller (seed 0):
+0.74-2.31 s (with kappa 0.7) need 6-20 deg/s. Measured with the default controller (seed 0)
+under the Newton solver (Gauss-Seidel since: 2.24 s, 37.1-37.2 deg, side 2.32 s, 21.1 deg):
 
 - climb / descend: 6 deg/s t_s 2.73 s, 6.5: 2.59 s, 7: 2.24 s (margin 37.3 deg 0.5 s after
   landing with a stop at 15 deg, 35.5 at 17, 34.0 at 18); at 8 and 10 deg/s the fitted margin
@@ -819,7 +820,7 @@ NOTES = (
     "final tilt; with a rate and a stop per scenario that exercise eq. 15 (STEWART_EQ15: climb "
     "and descend 7 deg/s up to 15 deg, side 6 deg/s up to 30 deg) t_s is 2.24 s (climb, descend) "
     "and 2.32 s (side), inside the tolerance of 0.5-2.5 s (paper 0.74-2.31 s), and rows 7 hold "
-    "too (37.3 / 37.3 / 21.1 deg after landing, never below xi_f afterwards). The paper's "
+    "too (37.1 / 37.2 / 21.1 deg after landing, never below xi_f afterwards). The paper's "
     "shortest times (0.74-1.48 s) are not reached with recovery intact: at 8-10 deg/s the fitted "
     "margin acceleration turns positive and eq. 15 has no root (3 s clamp); sideways at 7 deg/s "
     "(t_s 1.98 s) the margin falls to 7 deg after landing; at 20 deg/s t_s is the 0.5 s lower "
