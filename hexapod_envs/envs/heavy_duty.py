@@ -57,7 +57,7 @@ class HeavyDutySettings(EnvSettings):
     solver: str = choice("pgs", SOLVERS)
     """MuJoCo's constraint solver. Projected Gauss-Seidel: 1.24x Newton's speed on this robot
     with every physics fidelity row holding (benchmarks/physics_settings.py); "newton" is the
-    setting the agents before it were trained with."""
+    default before 2026-11-25."""
     action_mode: str = choice("residual", ACTION_MODES)
     residual_scale: float = number(0.25)
     """Residual action 1 = this fraction of each joint's half range."""
