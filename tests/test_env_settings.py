@@ -12,11 +12,11 @@ import hexapod_envs  # noqa: F401
 from hexapod_envs.envs.base import SOLVER_IDS
 from hexapod_envs.envs.cliff_walk import CLIFF_TEST, CLIFF_TRAIN, CliffTaskRanges
 from hexapod_envs.envs.ditch_crossing import DITCH_TEST, DITCH_TRAIN
+from hexapod_envs.envs.heavy_duty import HeavyDutySettings
 from hexapod_envs.envs.irregular_terrain import TERRAIN_TEST, TERRAIN_TRAIN
 from hexapod_envs.envs.stewart_tilt import TILT_TEST, TILT_TRAIN
 
 ENV_IDS = sorted(k for k in gym.registry if k.startswith("Hexapod"))
-HEAVY_DUTY_IDS = ("HexapodCliffWalk-v0", "HexapodStewartTilt-v0")
 
 
 def _settings_class(env_id):
@@ -189,7 +189,8 @@ def test_physics_options_reach_every_model_the_env_builds(env_id):
         assert opt.integrator == mujoco.mjtIntegrator.mjINT_EULER
         assert opt.solver == mujoco.mjtSolver.mjSOL_CG
     env.close()
-    default = "pgs" if env_id in HEAVY_DUTY_IDS else "newton"  # the sweep's choice per robot
+    heavy_duty = issubclass(_settings_class(env_id), HeavyDutySettings)
+    default = "pgs" if heavy_duty else "newton"  # the sweep's choice per robot
     assert gym.make(env_id).unwrapped.model.opt.solver == SOLVER_IDS[default]
     with pytest.raises(ValueError, match=r"solver must be one of \['cg', 'newton', 'pgs'\]"):
         gym.make(env_id, solver="lbfgs")
