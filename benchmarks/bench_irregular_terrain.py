@@ -110,20 +110,26 @@ def main() -> None:
     if args.posture_only:
         print_posture_step()
         return
-    print(f"{'terrain':8s} {'mode':9s} {'raw mj_step/s':>14s} {'env steps/s':>12s} {'env/raw':>8s}")
+    print(
+        f"{'terrain':8s} {'mode':9s} {'raw mj_step/s':>14s} {'env steps/s':>12s} {'env/raw':>8s} "
+        f"{'env/sensing last':>17s}"
+    )
     for terrain in ("ramp", "blocks", "flat"):
         for mode in ("residual", "gains", "joint"):
-            raw, env_rate = env_vs_raw(ENV_ID, steps=1200, terrain=terrain, action_mode=mode)
-            print(f"{terrain:8s} {mode:9s} {raw:14.0f} {env_rate:12.0f} {env_rate / raw:8.2f}")
+            r = env_vs_raw(ENV_ID, steps=1200, terrain=terrain, action_mode=mode)
+            print(
+                f"{terrain:8s} {mode:9s} {r.raw:14.0f} {r.env:12.0f} {r.env / r.raw:8.2f} "
+                f"{r.env / r.raw_sensing_last:17.2f}"
+            )
     try:  # context: a Gymnasium MuJoCo env measured the same way in the same run
-        raw, env_rate = env_vs_raw("Ant-v5", steps=1200)
-        print(f"{'Ant-v5':8s} {'(gym)':9s} {raw:14.0f} {env_rate:12.0f} {env_rate / raw:8.2f}")
+        r = env_vs_raw("Ant-v5", steps=1200)
+        print(f"{'Ant-v5':8s} {'(gym)':9s} {r.raw:14.0f} {r.env:12.0f} {r.env / r.raw:8.2f}")
     except Exception as exc:  # pragma: no cover - Ant needs gymnasium's mujoco extras
         print(f"Ant-v5 not measured: {exc}")
     probe = gym.make(ENV_ID).unwrapped  # the default step and substeps
     n, dt_ms, control_ms = probe.n_substeps, probe.physics_dt * 1e3, probe.control_dt * 1e3
     probe.close()
-    physics_us = n / env_vs_raw(ENV_ID, steps=1200, terrain="ramp", action_mode="joint")[0] * 1e6
+    physics_us = n / env_vs_raw(ENV_ID, steps=1200, terrain="ramp", action_mode="joint").raw * 1e6
     print(
         f"\nphysics per {control_ms:g} ms control step ({n} x {dt_ms:g} ms mj_step, ramp): "
         f"{physics_us:6.0f} us"

@@ -3,18 +3,33 @@
 from __future__ import annotations
 
 import time
+from typing import NamedTuple
 
 import gymnasium as gym
 import mujoco
 import numpy as np
 
 
-def replay_step_rate(env: gym.Env, steps: int, seed: int = 0) -> tuple[float, float]:
-    """(raw mj_step rate, env physics rate) over the same motion.
+class ReplayRates(NamedTuple):
+    """Physics steps per wall second over one motion (see `replay_step_rate`)."""
+
+    raw: float
+    """Bare `mj_step` calls with every sensor evaluated at every step (MuJoCo's default)."""
+    raw_sensing_last: float
+    """The same steps as the hexapod envs run them (`HexapodEnv._step_sensing_last`): one
+    call for all but the last step of a control period, without sensors, then the last."""
+    env: float
+    """`env.step` with its substeps counted."""
+
+
+def replay_step_rate(env: gym.Env, steps: int, seed: int = 0) -> ReplayRates:
+    """Raw and env physics rates over the same motion.
 
     The env runs `steps` zero actions from reset(seed); its controls are recorded and then
-    replayed on a fresh copy of the model from the same start state with bare mj_step calls
-    (one call per physics step), so both figures cover identical contact situations.
+    replayed twice on a copy of the start state with bare mj_step calls: one call per physics
+    step with the sensors evaluated at every step (MuJoCo's default, the issues' "raw"), and
+    as the env runs them (ATHENA's env senses five times per control period, the replay once),
+    so all figures cover identical contact situations.
     """
     base = env.unwrapped
     substeps = getattr(base, "n_substeps", None) or getattr(base, "frame_skip", 1)
@@ -33,22 +48,35 @@ def replay_step_rate(env: gym.Env, steps: int, seed: int = 0) -> tuple[float, fl
             controls = controls[: k + 1]
             break
     n = len(controls)
-    data = start_state
-    t0 = time.perf_counter()
-    for k in range(n):
-        data.ctrl[:] = controls[k]
-        for _ in range(substeps):
-            mujoco.mj_step(base.model, data)
-    raw = n * substeps / (time.perf_counter() - t0)
-    return raw, n * substeps / elapsed
+    model, opt = base.model, base.model.opt
+    sensors_on = opt.disableflags
+    sensors_off = sensors_on | int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+    rates = []
+    for skip_sensors in (False, True):
+        data = mujoco.MjData(model)
+        mujoco.mj_copyData(data, model, start_state)
+        t0 = time.perf_counter()
+        for k in range(n):
+            data.ctrl[:] = controls[k]
+            if skip_sensors:  # as the env steps: one call, then one sensing step
+                opt.disableflags = sensors_off
+                mujoco.mj_step(model, data, nstep=substeps - 1)
+                opt.disableflags = sensors_on
+                mujoco.mj_step(model, data)
+            else:
+                for _ in range(substeps):
+                    mujoco.mj_step(model, data)
+        rates.append(n * substeps / (time.perf_counter() - t0))
+    opt.disableflags = sensors_on
+    return ReplayRates(rates[0], rates[1], n * substeps / elapsed)
 
 
-def env_vs_raw(env_id: str, steps: int = 3000, repeats: int = 3, **kwargs) -> tuple[float, float]:
-    """Best of `repeats` (raw mj_step rate, env physics rate) for one env id (see replay)."""
+def env_vs_raw(env_id: str, steps: int = 3000, repeats: int = 3, **kwargs) -> ReplayRates:
+    """Best of `repeats` replays (`replay_step_rate`) of one env id, per figure."""
     env = gym.make(env_id, **kwargs)
     runs = [replay_step_rate(env, steps) for _ in range(repeats)]
     env.close()
-    return max(r[0] for r in runs), max(r[1] for r in runs)
+    return ReplayRates(*(max(r[i] for r in runs) for i in range(3)))
 
 
 def per_call_us(fn, *args, repeat: int = 20000) -> float:

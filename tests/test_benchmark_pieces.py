@@ -7,9 +7,19 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the benchmarks package
 
+import gymnasium as gym  # noqa: E402
+
+import hexapod_envs  # noqa: E402, F401
 from benchmarks.bench_irregular_terrain import env_piece_costs  # noqa: E402
+from benchmarks.common import replay_step_rate  # noqa: E402
 
 
 def test_irregular_terrain_env_pieces_run():
     costs = env_piece_costs()
     assert len(costs) == 7 and all(math.isfinite(us) and us > 0 for us in costs.values())
+
+
+def test_replay_measures_raw_physics_both_ways_and_the_env():
+    with gym.make("HexapodCliffWalk-v0") as env:
+        rates = replay_step_rate(env, steps=5)
+    assert len(rates) == 3 and all(math.isfinite(r) and r > 0 for r in rates)

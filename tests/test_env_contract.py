@@ -7,8 +7,10 @@ from gymnasium.utils.env_checker import check_env as gym_check_env
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import hexapod_envs  # noqa: F401
+from hexapod_envs.envs import base
 
 ENV_IDS = sorted(k for k in gym.registry if k.startswith("Hexapod"))
+IRREGULAR = "HexapodIrregularTerrain-v0"
 
 
 def test_env_ids_registered():
@@ -37,6 +39,32 @@ def test_same_seed_same_trajectory(env_id):
         return np.concatenate(trace)
 
     np.testing.assert_array_equal(rollout(), rollout())
+
+
+@pytest.mark.parametrize(
+    ("env_id", "kwargs"), [(e, {}) for e in ENV_IDS] + [(IRREGULAR, {"terrain": "blocks"})]
+)
+def test_sensing_in_the_last_substep_only_leaves_every_step_unchanged(env_id, kwargs, monkeypatch):
+    """The envs skip the sensors in all but the last physics step of a control period (ATHENA:
+    of each contact check); observations, rewards and infos equal those of sensing every step."""
+
+    def rollout():
+        env = gym.make(env_id, **kwargs)
+        obs, _ = env.reset(seed=5)
+        env.action_space.seed(5)
+        trace = [obs]
+        for _ in range(60):
+            obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+            numbers = [v for v in info.values() if isinstance(v, (int, float, np.ndarray))]
+            trace.append(np.concatenate([obs, [reward], *map(np.ravel, numbers)]))
+            if terminated or truncated:
+                break
+        env.close()
+        return np.concatenate(trace)
+
+    skipping = rollout()
+    monkeypatch.setattr(base, "_SENSORS_OFF", 0)  # "disable nothing": sensors at every step
+    np.testing.assert_array_equal(skipping, rollout())
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)

@@ -33,6 +33,8 @@ __all__ = [
     "check_choice",
 ]
 
+_SENSORS_OFF = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+
 DEFAULT_CAMERA = {"distance": 14.0, "elevation": -20.0, "azimuth": 135.0, "trackbodyid": 1}
 
 
@@ -282,6 +284,9 @@ class HexapodEnv(gym.Env):
         spec.visual.global_.offheight = max(self._render_size[1], 480)
         self.model = spec.compile()
         self.data = mujoco.MjData(self.model)
+        self._sensors_every_step = bool(
+            self.model.nhistory or self.model.sensor_interval.any() or self.model.sensor_delay.any()
+        )
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
@@ -532,7 +537,28 @@ class HexapodEnv(gym.Env):
 
     def _run_physics(self) -> None:
         """One control period of MuJoCo steps (an env may split it to sample contacts)."""
-        mujoco.mj_step(self.model, self.data, nstep=self.n_substeps)
+        self._step_sensing_last(self.n_substeps)
+
+    def _step_sensing_last(self, nstep: int) -> None:
+        """`nstep` MuJoCo steps, evaluating the sensors in the last one only.
+
+        Sensors never act on the dynamics, and the env reads `data.sensordata` only after the
+        steps, so the state and the final readings are bit-identical to evaluating them every
+        step, while the skipped evaluations (the foot-force and accelerometer sensors need an
+        extra dynamics pass, ATHENA's rangefinders cast rays) cost 5-10 % of a physics step.
+        A model whose sensors keep a history (delay, interval) needs every step evaluated.
+        """
+        m, d = self.model, self.data
+        if nstep > 1 and not self._sensors_every_step:
+            opt = m.opt
+            flags = opt.disableflags
+            opt.disableflags = flags | _SENSORS_OFF
+            try:
+                mujoco.mj_step(m, d, nstep=nstep - 1)
+            finally:
+                opt.disableflags = flags
+            nstep = 1
+        mujoco.mj_step(m, d, nstep=nstep)
 
     # --- rendering -----------------------------------------------------------------------
     def render(self):

@@ -600,12 +600,12 @@ class IrregularTerrainEnv(HexapodEnv):
 
     def _run_physics(self) -> None:
         """One control period of physics, looking for torso-terrain contact every 10 ms."""
-        m, d = self.model, self.data
         chunk = self.n_substeps // _CONTACT_CHECKS
         touched = False
+        sensordata = self.data.sensordata
         for _ in range(_CONTACT_CHECKS):
-            mujoco.mj_step(m, d, nstep=chunk)
-            touched = touched or d.sensordata[self._torso_contact_adr] > 0.0
+            self._step_sensing_last(chunk)
+            touched = touched or sensordata[self._torso_contact_adr] > 0.0
         self._touched_in_physics = bool(touched)
 
     # --- measurements --------------------------------------------------------------------
