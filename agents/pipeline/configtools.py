@@ -100,6 +100,8 @@ def _convert(tp: Any, value: Any, where: str) -> Any:
                 return _convert(arg, value, where)
             except ConfigError as exc:
                 errors.append(str(exc))
+        if len(errors) == 1:  # an optional value or section: its own error says what is wrong
+            raise ConfigError(errors[0])
         raise ConfigError(f"{where}: expected {_describe(tp)}, got {value!r}")
     if dataclasses.is_dataclass(tp):
         return from_mapping(tp, value, where)

@@ -286,6 +286,18 @@ class HybridConfig(HybridSettings):
     zero_init_action_net: bool = True
     """Zero the action mean's last layer so that training starts from the analytical controller
     (SB3's policy_kwargs have no such option: ortho_init only scales that layer by 0.01)."""
+    mask_overridden: bool = False
+    """Give the steps whose learned action the safety override discarded no advantage, so that
+    PPO learns only from actions that acted (`agents.pipeline.override_mask`); needs the
+    override (``mode: safety`` or ``safety_filter: true``)."""
+
+    def __post_init__(self):
+        super().__post_init__()
+        if self.mask_overridden and not self.overrides:
+            raise ValueError(
+                "hybrid.mask_overridden needs the safety override: set hybrid.mode=safety or "
+                "hybrid.safety_filter=true (in residual mode every learned action acts)"
+            )
 
 
 @dataclass

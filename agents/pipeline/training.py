@@ -164,7 +164,7 @@ def new_model(config: TrainConfig, venv: Any) -> Any:
         seed=config.train.seed,
         device=config.train.device,
         verbose=config.logging.verbose,
-        **config.ppo.sb3_kwargs(),
+        **_ppo_kwargs(config),
     )
     hybrid_zero = config.hybrid is not None and config.hybrid.zero_init_action_net
     if hybrid_zero or config.policy.zero_init_action_net:
@@ -172,6 +172,21 @@ def new_model(config: TrainConfig, venv: Any) -> Any:
 
         zero_init_action_net(model)
     return model
+
+
+def _masks_overridden(config: TrainConfig) -> bool:
+    return config.hybrid is not None and config.hybrid.mask_overridden
+
+
+def _ppo_kwargs(config: TrainConfig) -> dict[str, Any]:
+    """SB3 PPO's keyword arguments: the ``ppo`` section's, with the override-masking rollout
+    buffer when ``hybrid.mask_overridden`` (`override_mask`)."""
+    kwargs = config.ppo.sb3_kwargs()
+    if _masks_overridden(config):
+        from .override_mask import masked_ppo_kwargs
+
+        kwargs.update(masked_ppo_kwargs(config.ppo.normalize_advantage))
+    return kwargs
 
 
 def untrained_model(config: TrainConfig) -> tuple[Any, dict[str, Any] | None]:
@@ -320,7 +335,7 @@ def _load_checkpoint(
             env=venv,
             device=config.train.device,
             verbose=config.logging.verbose,
-            **ppo.sb3_kwargs(),
+            **_ppo_kwargs(config),
         )
     except BaseException:
         for env in (venv, eval_env):
@@ -357,6 +372,10 @@ def _learn(
 
     saver = ModelSaver(run_dir, config, command, env_settings)
     callbacks = [EpisodeStatsCallback(new_accumulator)]
+    if _masks_overridden(config):
+        from .override_mask import RecordOverrides
+
+        callbacks.append(RecordOverrides())
     if config.checkpoint.freq > 0:
         callbacks.append(CheckpointEvery(config.checkpoint.freq, saver))
     if eval_env is not None:
