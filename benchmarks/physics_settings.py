@@ -3,8 +3,8 @@
 For each robot the script sweeps candidate physics settings - the physics timestep (the env's
 ``physics_dt`` kwarg: the current default, about 1.25x, 2x, 2.5x and 4x of it, always a whole
 fraction of ``control_dt``), the integrator (implicitfast, the envs' choice, against Euler and
-RK4), the constraint solver (Newton, the envs' choice, against conjugate gradient and
-projected Gauss-Seidel) and its tolerance / iterations - and prints, per setting,
+RK4), the constraint solver (Newton, conjugate gradient and projected Gauss-Seidel) and its
+tolerance / iterations, and the collision midphase on and off - and prints, per setting,
 
 - speed: simulated seconds per wall second of ``env.step`` with zero actions and with uniform
   random actions, per env (episodes of the training task distribution, as the PPO configs use;
@@ -41,8 +41,9 @@ The env defaults are not changed: settings are applied to the envs this script m
 How a setting is applied (`make_env`): the timestep through the ``physics_dt`` kwarg (the env
 checks that it divides ``control_dt``; ATHENA also needs a multiple of 5 substeps, so its "x1.25"
 and "x2.5" are the nearest allowed timesteps, 3.33 and 5 ms; the table prints the timestep
-used); the integrator and solver options through the env's ``integrator``, ``solver``,
-``solver_iterations``, ``solver_ls_iterations`` and ``solver_tolerance`` settings, so that a
+used); the integrator, solver and collision options through the env's ``integrator``,
+``solver``, ``solver_iterations``, ``solver_ls_iterations``, ``solver_tolerance`` and
+``midphase`` settings, so that a
 model rebuilt at reset (ATHENA on blocks, a sampled task) gets them too; every reset here is
 followed by `check_options`, which raises if the model does not carry the setting.
 
@@ -92,6 +93,8 @@ class PhysicsSetting:
     iterations: int | None = None
     ls_iterations: int | None = None
     tolerance: float | None = None
+    midphase: bool | None = None
+    """MuJoCo's collision midphase on or off (None: the env's default, `midphase_pays`)."""
 
     def __post_init__(self):
         if self.integrator not in INTEGRATORS:
@@ -110,6 +113,8 @@ class PhysicsSetting:
             value = getattr(self, name)
             if value is not None:
                 parts.append(f"{short} {value:g}")
+        if self.midphase is not None:
+            parts.append(f"midphase {'on' if self.midphase else 'off'}")
         return ", ".join(parts)
 
     @property
@@ -148,6 +153,8 @@ def candidate_settings(quick: bool, finer: bool = False) -> list[PhysicsSetting]
         PhysicsSetting(1.0, solver="newton"),
         PhysicsSetting(1.0, solver="cg"),
         PhysicsSetting(1.0, solver="pgs"),
+        PhysicsSetting(1.0, midphase=True),
+        PhysicsSetting(1.0, midphase=False),
     ]
 
 
@@ -193,6 +200,10 @@ def check_options(env: gym.Env, setting: PhysicsSetting) -> None:
     for name in ("iterations", "ls_iterations", "tolerance"):
         if getattr(setting, name) is not None:
             wanted[name] = getattr(setting, name)
+    if setting.midphase is not None:
+        off = bool(opt.disableflags & mujoco.mjtDisableBit.mjDSBL_MIDPHASE)
+        if off == setting.midphase:
+            raise RuntimeError(f"the midphase is {'off' if off else 'on'}, expected the opposite")
     for name, value in wanted.items():
         if not math.isclose(float(getattr(opt, name)), float(value), rel_tol=1e-12):
             raise RuntimeError(f"model.opt.{name} = {getattr(opt, name)}, expected {value}")
@@ -208,6 +219,8 @@ def setting_kwargs(env_id: str, setting: PhysicsSetting) -> dict:
     }
     if setting.solver is not None:
         kwargs["solver"] = setting.solver
+    if setting.midphase is not None:
+        kwargs["midphase"] = setting.midphase
     if setting.factor != 1.0:
         kwargs["physics_dt"] = physics_dt_for(env_id, setting.factor)
     return kwargs

@@ -1,6 +1,7 @@
 """Invariants every registered hexapod env must satisfy (docs/architecture.md)."""
 
 import gymnasium as gym
+import mujoco
 import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env as gym_check_env
@@ -41,30 +42,57 @@ def test_same_seed_same_trajectory(env_id):
     np.testing.assert_array_equal(rollout(), rollout())
 
 
-@pytest.mark.parametrize(
-    ("env_id", "kwargs"), [(e, {}) for e in ENV_IDS] + [(IRREGULAR, {"terrain": "blocks"})]
-)
+def _random_rollout(env_id, steps=60, **kwargs):
+    """Observations, rewards and numeric infos of `steps` seeded random actions, flattened."""
+    env = gym.make(env_id, **kwargs)
+    obs, _ = env.reset(seed=5)
+    env.action_space.seed(5)
+    trace = [obs]
+    for _ in range(steps):
+        obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
+        numbers = [v for v in info.values() if isinstance(v, (int, float, np.ndarray))]
+        trace.append(np.concatenate([obs, [reward], *map(np.ravel, numbers)]))
+        if terminated or truncated:
+            break
+    env.close()
+    return np.concatenate(trace)
+
+
+SPEED_ONLY_CASES = [(e, {}) for e in ENV_IDS] + [(IRREGULAR, {"terrain": "blocks"})]
+
+
+@pytest.mark.parametrize(("env_id", "kwargs"), SPEED_ONLY_CASES)
 def test_sensing_in_the_last_substep_only_leaves_every_step_unchanged(env_id, kwargs, monkeypatch):
     """The envs skip the sensors in all but the last physics step of a control period (ATHENA:
     of each contact check); observations, rewards and infos equal those of sensing every step."""
-
-    def rollout():
-        env = gym.make(env_id, **kwargs)
-        obs, _ = env.reset(seed=5)
-        env.action_space.seed(5)
-        trace = [obs]
-        for _ in range(60):
-            obs, reward, terminated, truncated, info = env.step(env.action_space.sample())
-            numbers = [v for v in info.values() if isinstance(v, (int, float, np.ndarray))]
-            trace.append(np.concatenate([obs, [reward], *map(np.ravel, numbers)]))
-            if terminated or truncated:
-                break
-        env.close()
-        return np.concatenate(trace)
-
-    skipping = rollout()
+    skipping = _random_rollout(env_id, **kwargs)
     monkeypatch.setattr(base, "_SENSORS_OFF", 0)  # "disable nothing": sensors at every step
-    np.testing.assert_array_equal(skipping, rollout())
+    np.testing.assert_array_equal(skipping, _random_rollout(env_id, **kwargs))
+
+
+@pytest.mark.parametrize(("env_id", "kwargs"), SPEED_ONLY_CASES)
+def test_the_collision_midphase_changes_no_step(env_id, kwargs):
+    """``midphase`` is chosen per env by speed alone: both ways give the same episode."""
+    on = _random_rollout(env_id, midphase=True, **kwargs)
+    np.testing.assert_array_equal(on, _random_rollout(env_id, midphase=False, **kwargs))
+
+
+@pytest.mark.parametrize(
+    ("env_id", "kwargs", "default"),
+    [
+        ("HexapodCliffWalk-v0", {}, False),
+        ("HexapodStewartTilt-v0", {}, False),
+        (IRREGULAR, {}, False),
+        (IRREGULAR, {"terrain": "blocks"}, True),
+        ("HexapodDitchCrossing-v0", {}, True),
+    ],
+)
+def test_the_midphase_setting_reaches_the_model(env_id, kwargs, default):
+    for setting, expected in ((None, default), (True, True), (False, False)):
+        with gym.make(env_id, midphase=setting, **kwargs) as env:
+            env.reset(seed=0)
+            flags = env.unwrapped.model.opt.disableflags
+            assert bool(flags & mujoco.mjtDisableBit.mjDSBL_MIDPHASE) != expected, setting
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)

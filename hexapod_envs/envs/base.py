@@ -121,13 +121,15 @@ def set_physics_options(
     ls_iterations: int | None = None,
     tolerance: float | None = None,
     solver: str = "newton",
+    midphase: bool = True,
 ) -> None:
     """The solver options of an env: `timestep` [s], the `integrator` (`INTEGRATOR_IDS`), the
     constraint `solver` (`SOLVER_IDS`) and its `iterations`, `ls_iterations` and `tolerance`
     (None: MuJoCo's 100, 50 and 1e-8), and elliptic friction cones with a high impedance ratio
     (the default pyramidal cone lets a loaded foot creep down a slope at several cm/s, far
-    below its friction limit). The envs pass their settings of the same names (``physics_dt``,
-    ``integrator``, ``solver``, ``solver_*``)."""
+    below its friction limit). `midphase` False disables the collision midphase. The envs pass
+    their settings of the same names (``physics_dt``, ``integrator``, ``solver``, ``solver_*``,
+    ``midphase``)."""
     spec.option.timestep = timestep
     spec.option.integrator = INTEGRATOR_IDS[integrator]
     spec.option.solver = SOLVER_IDS[solver]
@@ -140,6 +142,8 @@ def set_physics_options(
             setattr(spec.option, name, value)
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
     spec.option.impratio = 10.0
+    if not midphase:
+        spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_MIDPHASE)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -274,6 +278,7 @@ class HexapodEnv(gym.Env):
             s.solver_ls_iterations,
             s.solver_tolerance,
             s.solver,
+            self.midphase_pays() if s.midphase is None else s.midphase,
         )
         spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
         spec.visual.headlight.diffuse = [0.65, 0.65, 0.65]
@@ -400,6 +405,12 @@ class HexapodEnv(gym.Env):
     def _build_spec(self, spec: mujoco.MjSpec) -> None:  # pragma: no cover - abstract
         """Add the terrain and the robot to `spec`."""
         raise NotImplementedError
+
+    def midphase_pays(self) -> bool:
+        """Whether the collision midphase makes this env's physics faster (the default of the
+        ``midphase`` setting): it pays where a body has many geoms, such as a terrain of
+        hundreds of boxes, and costs where every body has few."""
+        return True
 
     def _bind_model(self) -> None:  # pragma: no cover - abstract
         """Resolve the ids the env reads in the compiled model (sensors, actuators, qpos)."""

@@ -424,6 +424,11 @@ class IrregularTerrainEnv(HexapodEnv):
         self._build_model()
 
     # --- model ---------------------------------------------------------------------------
+    def midphase_pays(self) -> bool:
+        """On the block bed (hundreds of boxes: without the midphase the physics runs at 0.8x),
+        not on the ramp or flat ground (1.13x without; `benchmarks/physics_settings.py`)."""
+        return self.terrain == "blocks"
+
     def _build_spec(self, spec: mujoco.MjSpec) -> None:
         """Terrain (blocks drawn from `_terrain_rng`) and the robot at its start pose."""
         pos, quat = self._add_terrain(spec, self._terrain_rng)

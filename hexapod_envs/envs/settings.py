@@ -267,6 +267,10 @@ class EnvSettings(_Checked):
     """Line-search iterations of the solver (None: MuJoCo's default, 50)."""
     solver_tolerance: float | None = number(None, optional=True)
     """Constraint solver tolerance (None: MuJoCo's default, 1e-8)."""
+    midphase: bool | None = choice(None, (None, False, True), optional=True)
+    """MuJoCo's collision midphase (bounding-volume trees that cull geom pairs before the
+    narrow phase). It finds the same contacts either way (bit-identical episodes in every env),
+    so only speed decides: None takes the env's measured choice (`HexapodEnv.midphase_pays`)."""
     settle_time: float = number(0.5)
     """Physics run in `reset` before the episode starts, the robot resting on its feet [s]."""
     contact_threshold: float = number(0.02, high=1.0)
