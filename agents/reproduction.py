@@ -831,8 +831,8 @@ NOTES = (
     "give its final tilt) the rows hold: 36.2 / 36.2 / 26.0 deg and >= 26 deg to the end.",
     "7c / 7d (stability cone): at the paper's lambda = 0.5 the force-distribution QP is "
     "infeasible on every supported step of the climb and descend cases (1054 of 1054) and on "
-    "326-327 of 723 sideways; the controller's default ladder therefore runs at lambda 0.65 "
-    "(climb, descend) or drops the cone (313 steps sideways). With the cone at 0.5 only "
+    "286 of 723 sideways; the controller's default ladder therefore runs at lambda 0.65 "
+    "(climb, descend) or drops the cone (315 steps sideways). With the cone at 0.5 only "
     "(infeasible steps solved without the cone, 7d) every case still recovers: the cone is not "
     "what holds the robot up in our model. With the platform stopping at 25 deg the side cases "
     "stay at lambda 0.5 throughout. The cone's base is centred on the support polygon's "

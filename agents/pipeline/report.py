@@ -337,8 +337,9 @@ def _bullet(name: str, reference: str, aggs: dict[str, dict], verdicts: list[Ver
 
 
 HOW_TO_READ = [
-    "- **FASM** (force-angle stability measure, Papadopoulos & Rey): the smallest angle between "
-    "the net force on the centre of mass and the tipping axes of the support polygon [deg]. "
+    "- **FASM** (force-angle stability measure, Papadopoulos & Rey): over the edges of the "
+    "support polygon, the smallest angle between the net force on the centre of mass and the "
+    "perpendicular from the centre of mass to the edge [deg]. "
     "Large is stable; it falls as the robot leans towards a tipping edge.",
     "- **0** means fewer than three feet are loaded (no support polygon, e.g. during a tripod "
     "switch or in the air) or the force points at a tipping edge; **negative** values mean the "
