@@ -76,7 +76,7 @@ def env_vs_raw(env_id: str, steps: int = 3000, repeats: int = 3, **kwargs) -> Re
     env = gym.make(env_id, **kwargs)
     runs = [replay_step_rate(env, steps) for _ in range(repeats)]
     env.close()
-    return ReplayRates(*(max(r[i] for r in runs) for i in range(3)))
+    return ReplayRates(*map(max, zip(*runs, strict=True)))
 
 
 def per_call_us(fn, *args, repeat: int = 20000) -> float:

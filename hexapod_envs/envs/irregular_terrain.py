@@ -425,8 +425,9 @@ class IrregularTerrainEnv(HexapodEnv):
 
     # --- model ---------------------------------------------------------------------------
     def midphase_pays(self) -> bool:
-        """On the block bed (hundreds of boxes: without the midphase the physics runs at 0.8x),
-        not on the ramp or flat ground (1.13x without; `benchmarks/physics_settings.py`)."""
+        """On the block bed (hundreds of boxes: without the midphase raw `mj_step` runs at
+        0.81x), not on the ramp or flat ground (1.13x without; benchmarks/README.md, "Latest
+        figures")."""
         return self.terrain == "blocks"
 
     def _build_spec(self, spec: mujoco.MjSpec) -> None:
