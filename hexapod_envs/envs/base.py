@@ -203,7 +203,7 @@ class HexapodEnv(gym.Env):
     here, `_extra_info` for the env's own).
 
     Hooks with a default here: `_apply_task`, `_set_initial_state`, `_start_episode`,
-    `_run_physics`, `_end_step`, `_is_tipped_over`, `_is_tipping`, `_extra_info`,
+    `_run_physics`, `midphase_pays`, `_end_step`, `_is_tipped_over`, `_is_tipping`, `_extra_info`,
     `_reference_description`. Hooks every env defines: `_setup`, `_build_spec`, `_bind_model`,
     `_observation_pieces`, `_apply_action`, `_measure` (sets ``_forces``, ``_loaded``,
     ``_fasm_deg``, ``_fasm_edge``, ``_cog``), `_is_success`, `_reward_terms`,
