@@ -99,13 +99,32 @@ def test_one_vocabulary_across_envs():
 
 def test_task_ranges_are_settings_a_user_can_widen():
     wide = CliffTaskRanges(
-        cliff_x=(3.0, 6.0), edge_y=(-1.3, -0.7), drop=(1.0, 5.0), friction=(0.5, 1.5)
+        cliff_x=(3.0, 6.0),
+        edge_y=(-1.3, -0.7),
+        drop=(1.0, 5.0),
+        friction=(0.5, 1.5),
+        payload_mass=(0.0, 0.0),
+        payload_offset=0.0,
     )
     env = gym.make("HexapodCliffWalk-v0", task_distribution="train", train_ranges=wide)
     xs = [env.reset(seed=k)[1]["task"]["cliff_x"] for k in range(12)]
     assert max(xs) > CLIFF_TRAIN.cliff_x[1] and all(3.0 <= x <= 6.0 for x in xs)
     with pytest.raises(ValueError, match="drop"):
-        CliffTaskRanges(cliff_x=(3.0, 4.0), edge_y=(-1.0, -0.8), drop=(2.0, 1.0), friction=(1, 1))
+        dataclasses.replace(wide, drop=(2.0, 1.0))
+
+
+@pytest.mark.parametrize("env_id", ["HexapodCliffWalk-v0", "HexapodStewartTilt-v0"])
+def test_the_heavy_duty_payload_is_a_task_range(env_id):
+    env = gym.make(
+        env_id,
+        task_distribution="test",
+        test_ranges={"payload_mass": [100.0, 200.0], "payload_offset": 0.0},
+    )
+    tasks = [env.reset(seed=k)[1]["task"] for k in range(8)]
+    assert all(100.0 <= t["payload_mass"] <= 200.0 for t in tasks)
+    assert all(t["payload_offset_x"] == t["payload_offset_y"] == 0.0 for t in tasks)
+    with pytest.raises(ValueError, match="payload_offset must be >= 0"):
+        gym.make(env_id, train_ranges={"payload_offset": -0.1})
 
 
 def test_task_ranges_take_a_mapping_as_a_yaml_config_gives_them():

@@ -47,14 +47,20 @@ import numpy as np
 
 from ..terrain.cliff import CLIFF_SIDES, add_cliff
 from ..terrain.flat import add_flat
-from .heavy_duty import HeavyDutyEnv, HeavyDutySettings
-from .settings import TaskRanges, choice, number, option
+from .heavy_duty import (
+    TEST_PAYLOAD,
+    TRAIN_PAYLOAD,
+    HeavyDutyEnv,
+    HeavyDutySettings,
+    HeavyDutyTaskRanges,
+)
+from .settings import choice, number, option
 
 TERRAINS = ("cliff", "flat")
 
 
 @dataclasses.dataclass(frozen=True)
-class CliffTaskRanges(TaskRanges):
+class CliffTaskRanges(HeavyDutyTaskRanges):
     """Ranges of one task distribution (uniform draws; `side` is drawn from `sides`).
 
     Held-out test ranges (the defaults of `CLIFF_TEST`) extrapolate beyond training: the cliff
@@ -69,10 +75,10 @@ class CliffTaskRanges(TaskRanges):
 
 
 CLIFF_TRAIN = CliffTaskRanges(
-    cliff_x=(2.8, 3.4), edge_y=(-1.3, -0.9), drop=(1.0, 3.0), friction=(0.8, 1.2)
+    cliff_x=(2.8, 3.4), edge_y=(-1.3, -0.9), drop=(1.0, 3.0), friction=(0.8, 1.2), **TRAIN_PAYLOAD
 )
 CLIFF_TEST = CliffTaskRanges(
-    cliff_x=(3.4, 4.0), edge_y=(-0.9, -0.7), drop=(3.0, 5.0), friction=(0.6, 0.8)
+    cliff_x=(3.4, 4.0), edge_y=(-0.9, -0.7), drop=(3.0, 5.0), friction=(0.6, 0.8), **TEST_PAYLOAD
 )
 
 
@@ -152,7 +158,7 @@ class CliffWalkEnv(HeavyDutyEnv):
             "cliff_drop": float(rng.uniform(*r.drop)),
             "cliff_edge_y": float(rng.uniform(*r.edge_y)),
             "friction": float(rng.uniform(*r.friction)),
-            **self._sample_payload(rng, distribution),
+            **self._sample_payload(rng, r),
         }
 
     def _set_terrain(self, task: dict) -> bool:

@@ -24,7 +24,7 @@ from ..robots.heavy_duty.gait import TripodGait, TripodGaitParams
 from ..robots.heavy_duty.model import add_heavy_duty
 from .base import HexapodEnv, JointActionMap
 from .sensors import RobotSensors
-from .settings import SOLVERS, EnvSettings, RewardScales, choice, number, option
+from .settings import SOLVERS, EnvSettings, RewardScales, TaskRanges, choice, number, option
 
 XI_F_DEG = 20.0
 """Tipping threshold ξ_f of Zhang et al. 2024 §3 [deg]."""
@@ -45,6 +45,31 @@ class HeavyDutyRewardScales(RewardScales):
     stability_weight: float = number(1.0)
     tip_over_penalty: float = number(100.0)
     effort_weight: float = number(0.05)
+
+
+@dataclasses.dataclass(frozen=True, kw_only=True)
+class HeavyDutyTaskRanges(TaskRanges):
+    """What every heavy-duty scenario's task ranges hold: the payload on the body, a point mass
+    at an offset from the body's CoG (the scenarios' range dataclasses extend this one)."""
+
+    payload_mass: tuple[float, float]
+    """Payload mass range [kg] (uniform)."""
+    payload_offset: float
+    """Largest offset of the payload from the body's CoG in x and in y [m] (uniform in ±)."""
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.payload_mass[0] < 0 or self.payload_offset < 0:
+            raise ValueError(
+                f"{type(self).__name__}: payload_mass and payload_offset must be >= 0, got "
+                f"{self.payload_mass!r} and {self.payload_offset!r}"
+            )
+
+
+TRAIN_PAYLOAD = {"payload_mass": (0.0, 500.0), "payload_offset": 0.15}
+"""The training payload: up to 500 kg (a tenth of the robot), up to 0.15 m off centre."""
+TEST_PAYLOAD = {"payload_mass": (500.0, 800.0), "payload_offset": 0.25}
+"""The held-out payload: heavier (extrapolated) and farther off centre."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -196,17 +221,14 @@ class HeavyDutyEnv(HexapodEnv):
         }
 
     # --- task distribution -----------------------------------------------------------------
-    PAYLOAD_RANGES = {"train": ((0.0, 500.0), 0.15), "test": ((500.0, 800.0), 0.25)}
-    """Payload on the body per distribution: (mass range [kg], max CoG offset in x and y [m]).
-    The test payload is heavier (extrapolated) and may sit farther off centre."""
-
     NO_PAYLOAD = {"payload_mass": 0.0, "payload_offset_x": 0.0, "payload_offset_y": 0.0}
     """The paper's scenarios carry no payload (task keys as `_sample_payload`'s)."""
 
-    def _sample_payload(self, rng: np.random.Generator, distribution: str) -> dict:
-        (m_lo, m_hi), off = self.PAYLOAD_RANGES[distribution]
+    @staticmethod
+    def _sample_payload(rng: np.random.Generator, ranges: HeavyDutyTaskRanges) -> dict:
+        off = ranges.payload_offset
         return {
-            "payload_mass": float(rng.uniform(m_lo, m_hi)),
+            "payload_mass": float(rng.uniform(*ranges.payload_mass)),
             "payload_offset_x": float(rng.uniform(-off, off)),
             "payload_offset_y": float(rng.uniform(-off, off)),
         }

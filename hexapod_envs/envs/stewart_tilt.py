@@ -53,8 +53,14 @@ import numpy as np
 from ..robots.heavy_duty import LEG_NAMES, TRIPODS, joints_for_foot, within_limits
 from ..terrain.stewart import add_stewart_platform
 from ..terrain.stewart_kinematics import DEFAULT_PLATFORM
-from .heavy_duty import HeavyDutyEnv, HeavyDutySettings
-from .settings import TaskRanges, choice, number, option
+from .heavy_duty import (
+    TEST_PAYLOAD,
+    TRAIN_PAYLOAD,
+    HeavyDutyEnv,
+    HeavyDutySettings,
+    HeavyDutyTaskRanges,
+)
+from .settings import choice, number, option
 
 SCENARIOS = ("climb", "descend", "side", "random")
 STANCES = {"LF-LR-RM": TRIPODS[0], "LM-RF-RR": TRIPODS[1]}
@@ -75,14 +81,14 @@ CASES = tuple((scenario, stance) for scenario in ("climb", "descend", "side") fo
 
 
 @dataclasses.dataclass(frozen=True)
-class TiltTaskRanges(TaskRanges):
+class TiltTaskRanges(HeavyDutyTaskRanges):
     """Ranges of one task distribution. Each reset holds a random tripod and tilts either about
     one of the six paper cases' axes (probability `case_probability`) or about an arbitrary
     horizontal axis, at a rate drawn uniformly from one of `rates_deg_s` (chosen at random).
 
     Held-out test ranges (`TILT_TEST`): tilt rates interleaved with and beyond training (4-8 and
     12-20 deg/s against 1-4 and 8-12), where the time budget of Zhang et al. 2024 eq. 15 binds;
-    lower platform friction; a heavier payload (see `HeavyDutyEnv.PAYLOAD_RANGES`).
+    lower platform friction; a heavier payload farther off centre.
     """
 
     rates_deg_s: tuple[tuple[float, float], ...]
@@ -97,8 +103,12 @@ class TiltTaskRanges(TaskRanges):
             )
 
 
-TILT_TRAIN = TiltTaskRanges(rates_deg_s=((1.0, 4.0), (8.0, 12.0)), friction=(1.2, 1.8))
-TILT_TEST = TiltTaskRanges(rates_deg_s=((4.0, 8.0), (12.0, 20.0)), friction=(0.9, 1.2))
+TILT_TRAIN = TiltTaskRanges(
+    rates_deg_s=((1.0, 4.0), (8.0, 12.0)), friction=(1.2, 1.8), **TRAIN_PAYLOAD
+)
+TILT_TEST = TiltTaskRanges(
+    rates_deg_s=((4.0, 8.0), (12.0, 20.0)), friction=(0.9, 1.2), **TEST_PAYLOAD
+)
 
 
 def tilt_axis(scenario: str, stance: tuple[str, ...]) -> np.ndarray:
@@ -281,7 +291,7 @@ class StewartTiltEnv(HeavyDutyEnv):
             "tilt_axis_y": float(axis[1]),
             "tilt_rate_deg": float(rng.uniform(*band)),
             "platform_friction": float(rng.uniform(*r.friction)),
-            **self._sample_payload(rng, distribution),
+            **self._sample_payload(rng, r),
         }
 
     def _set_terrain(self, task: dict) -> bool:
