@@ -1,5 +1,7 @@
 """Invariants every registered hexapod env must satisfy (docs/architecture.md)."""
 
+import copy
+
 import gymnasium as gym
 import mujoco
 import numpy as np
@@ -211,6 +213,33 @@ def test_mujoco_warning_counts_as_instability(env_id):
     obs, reward, terminated, truncated, info = env.step(np.zeros(env.action_space.shape))
     assert info["sim_unstable"] and truncated and not terminated and reward == 0.0
     assert np.all(np.isfinite(obs))
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_instability_while_settling_is_flagged_at_reset(env_id, monkeypatch):
+    env = gym.make(env_id).unwrapped
+    monkeypatch.setattr(env, "_simulate", lambda: False)  # every settle period unstable
+    assert env.reset(seed=0)[1]["sim_unstable"]
+
+
+@pytest.mark.parametrize(("env_id", "kwargs"), SPEED_ONLY_CASES)
+def test_a_deep_copy_steps_and_observes_on_its_own(env_id, kwargs):
+    """`copy.deepcopy` of a reset env (look-ahead and common-random-number rollouts step such
+    twins): the twin's observations equal a fresh env's stepped alike; the original is intact."""
+    space = gym.make(env_id, **kwargs).action_space
+    space.seed(9)
+    actions = [space.sample() for _ in range(5)]
+
+    def fresh():
+        env = gym.make(env_id, **kwargs).unwrapped
+        env.reset(seed=3)
+        return env
+
+    original = fresh()
+    twin, alike = copy.deepcopy(original), fresh()
+    for a in actions:
+        np.testing.assert_array_equal(twin.step(a)[0], alike.step(a)[0])
+    np.testing.assert_array_equal(original.step(actions[0])[0], fresh().step(actions[0])[0])
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)

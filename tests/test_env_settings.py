@@ -320,3 +320,9 @@ def test_settings_are_one_frozen_record_that_rebuilds_the_env(env_id):
     o2, i2 = again.reset(seed=9)
     np.testing.assert_array_equal(o1, o2)
     assert i1["task"] == i2["task"]
+
+
+@pytest.mark.parametrize("bad", ["yes", 1, 0.0])
+def test_a_flag_setting_takes_a_bool_or_none_only(bad):
+    with pytest.raises(ValueError, match=r"midphase must be one of \[False, None, True\]"):
+        gym.make("HexapodCliffWalk-v0", midphase=bad)

@@ -50,6 +50,12 @@ def test_masking_without_an_override_is_refused():
         load_train_config(STEWART, ["hybrid.mask_overridden=true"])
 
 
+def test_masking_per_gait_cycle_is_refused():
+    overrides = ["hybrid.mode=safety", "hybrid.mask_overridden=true", "env.decision=gait_cycle"]
+    with pytest.raises(ValueError, match="needs env.decision: step"):
+        load_train_config(STEWART, overrides)
+
+
 def _action_net(run):
     config = load_train_config(data=yaml.safe_load((run / "config.yaml").read_text()))
     env = gym.make("HexapodStewartTilt-v0")

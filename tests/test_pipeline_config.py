@@ -361,3 +361,8 @@ def test_zoo_cannot_express_a_linear_schedule_to_a_nonzero_value():
     )
     with pytest.raises(ValueError, match="non-zero final value"):
         zoo_hyperparams(config)
+
+
+def test_an_optional_choice_names_null_among_its_choices():
+    with pytest.raises(ConfigError, match=r"'forkserver' \| 'spawn' \| 'fork' \| null"):
+        load_train_config(CONFIGS / "cliff_walk_ppo.yaml", ["vec_env.start_method=x"])

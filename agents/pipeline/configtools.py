@@ -92,16 +92,15 @@ def _convert(tp: Any, value: Any, where: str) -> Any:
         args = get_args(tp)
         if value is None and type(None) in args:
             return None
+        options = [arg for arg in args if arg is not type(None)]
         errors = []
-        for arg in args:
-            if arg is type(None):
-                continue
+        for arg in options:
             try:
                 return _convert(arg, value, where)
             except ConfigError as exc:
                 errors.append(str(exc))
-        if len(errors) == 1:  # an optional value or section: its own error says what is wrong
-            raise ConfigError(errors[0])
+        if len(options) == 1 and dataclasses.is_dataclass(options[0]):
+            raise ConfigError(errors[0])  # an optional section: its own error says what is wrong
         raise ConfigError(f"{where}: expected {_describe(tp)}, got {value!r}")
     if dataclasses.is_dataclass(tp):
         return from_mapping(tp, value, where)

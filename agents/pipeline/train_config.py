@@ -322,6 +322,11 @@ class TrainConfig:
                 f"ppo.batch_size={self.ppo.batch_size} exceeds the rollout size "
                 f"ppo.n_steps x vec_env.n_envs = {rollout}"
             )
+        if self.hybrid is not None and self.hybrid.mask_overridden and self.env.decision != "step":
+            raise ValueError(
+                "hybrid.mask_overridden needs env.decision: step (one learner step per gait "
+                "cycle spans control steps with and without the override)"
+            )
 
 
 def load_train_config(

@@ -95,13 +95,16 @@ def env_spec(config: TrainConfig) -> EnvSpec:
 def _probe(
     spec: EnvSpec,
 ) -> tuple[Callable[[], EpisodeAccumulator], dict[str, Any] | None]:
-    """Make one env in this process: clear errors early; read its time step, metric specs and
-    the robot's tipping threshold ξ (the time below it is logged). Returns a factory of episode
+    """Make one env in this process: clear errors early; read its time step (None when a
+    learner step is a gait cycle), metric specs and the robot's tipping threshold ξ (the time
+    below it is logged). Returns a factory of episode
     accumulators for the training and evaluation callbacks, and the env's resolved settings
     (recorded with the run, see `env_settings`)."""
     env = spec.make()
     try:
         dt, specs = env_time_step(env), metric_specs(env)
+        if spec.decision == "gait_cycle":
+            dt = None  # a learner step is a gait cycle, not control_dt: no durations or energy
         xi = getattr(env.unwrapped, "tipping_threshold_deg", XI_F_DEG)
         settings = resolved_settings(env)
     finally:

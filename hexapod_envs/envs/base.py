@@ -9,6 +9,7 @@ the common `info` keys (`hexapod_envs.info_keys`). A concrete env supplies the h
 
 from __future__ import annotations
 
+import copy
 import dataclasses
 import math
 from collections.abc import Callable, Mapping
@@ -289,13 +290,30 @@ class HexapodEnv(gym.Env):
         spec.visual.global_.offheight = max(self._render_size[1], 480)
         self.model = spec.compile()
         self.data = mujoco.MjData(self.model)
-        self._sensors_every_step = bool(
-            self.model.nhistory or self.model.sensor_interval.any() or self.model.sensor_delay.any()
+        m = self.model
+        self._sensors_every_step = bool(  # attributes of MuJoCo >= 3.3's sensor histories
+            getattr(m, "nhistory", 0)
+            or np.any(getattr(m, "sensor_interval", 0))
+            or np.any(getattr(m, "sensor_delay", 0))
         )
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
         self._bind_model()
+
+    def __deepcopy__(self, memo: dict) -> HexapodEnv:
+        """A deep copy (MuJoCo model and data, controllers, RNG) that observes itself: the
+        observation readers close over ``self`` and `copy.deepcopy` shares functions, so the
+        copy's layout is rebuilt from its own `_observation_pieces`. Look-ahead and
+        common-random-number rollouts step such copies (`hexapod_envs.wrappers.GainsPerCycle`)."""
+        cls = type(self)
+        new = cls.__new__(cls)
+        memo[id(self)] = new
+        for key, value in self.__dict__.items():
+            if key != "observation_layout":
+                new.__dict__[key] = copy.deepcopy(value, memo)
+        new.observation_layout = ObservationLayout(new._observation_pieces())
+        return new
 
     @property
     def observation_structure(self) -> dict[str, slice]:
@@ -343,8 +361,9 @@ class HexapodEnv(gym.Env):
         mujoco.mj_resetData(self.model, self.data)
         self._set_initial_state()
         mujoco.mj_forward(self.model, self.data)
+        settled = True
         for _ in range(self.settle_steps):  # the robot settles onto its feet: not episode time
-            self._simulate()
+            settled = self._simulate() and settled
         self._step_count = 0
         self._tipped = False
         self._start_episode()
@@ -352,7 +371,9 @@ class HexapodEnv(gym.Env):
         self._start_cog_x = self._prev_cog_x = float(self._cog[0])
         self._success = self._is_success()
         self._last_obs = self._observation()
-        return self._last_obs, self._info({}, unstable=False)
+        # Unstable while settling: say so at once (MuJoCo's warning counts stay until the next
+        # reset, so the first step truncates as unstable too).
+        return self._last_obs, self._info({}, unstable=not settled)
 
     def step(self, action):
         action = self._validate_action(action)

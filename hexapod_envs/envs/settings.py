@@ -37,9 +37,12 @@ RENAMED = {
 
 
 def check_choice(name: str, value: Any, choices) -> None:
-    """Raise a ValueError naming `name`, the bad value and the valid choices."""
-    if value not in choices:
-        raise ValueError(f"{name} must be one of {sorted(choices)}, got {value!r}")
+    """Raise a ValueError naming `name`, the bad value and the valid choices (a flag among
+    them takes a bool only: 1 is not True here)."""
+    is_flag = any(isinstance(c, bool) for c in choices)
+    if value not in choices or (is_flag and value is not None and not isinstance(value, bool)):
+        valid = sorted(choices, key=repr)
+        raise ValueError(f"{name} must be one of {valid}, got {value!r}")
 
 
 def _check_real(name: str, value: Any, shown: Any) -> float:
