@@ -216,6 +216,19 @@ def test_mujoco_warning_counts_as_instability(env_id):
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
+def test_an_unstable_step_returns_the_last_observation_as_it_was_returned(env_id):
+    env = gym.make(env_id).unwrapped
+    env.reset(seed=0)
+    obs = env.step(np.zeros(env.action_space.shape))[0]
+    kept = obs.copy()
+    obs[:] = 0.0  # a caller editing its observation in place
+    env.data.qvel[:] = 1e12
+    again, *_, info = env.step(np.zeros(env.action_space.shape))
+    assert info["sim_unstable"]
+    np.testing.assert_array_equal(again, kept)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
 def test_instability_while_settling_is_flagged_at_reset(env_id, monkeypatch):
     env = gym.make(env_id).unwrapped
     monkeypatch.setattr(env, "_simulate", lambda: False)  # every settle period unstable

@@ -370,10 +370,12 @@ class HexapodEnv(gym.Env):
         self._measure()
         self._start_cog_x = self._prev_cog_x = float(self._cog[0])
         self._success = self._is_success()
-        self._last_obs = self._observation()
-        # Unstable while settling: say so at once (MuJoCo's warning counts stay until the next
+        obs, info = self._observation(), self._info({}, unstable=not settled)
+        # Unstable while settling: said at once (MuJoCo's warning counts stay until the next
         # reset, so the first step truncates as unstable too).
-        return self._last_obs, self._info({}, unstable=not settled)
+        if self.render_mode == "human":
+            self.render()
+        return obs, info
 
     def step(self, action):
         action = self._validate_action(action)
@@ -381,8 +383,9 @@ class HexapodEnv(gym.Env):
         stable = self._simulate()
         self._step_count += 1
         if not stable:
-            # Keep training runs alive: end the episode with a flag, return the last good obs.
-            return self._last_obs.copy(), 0.0, False, True, self._info({}, unstable=True)
+            # Keep training runs alive: end the episode with a flag and the last good observation
+            # (the buffer it was copied from, which no caller holds).
+            return self._obs_buffer.copy(), 0.0, False, True, self._info({}, unstable=True)
         self._measure()
         # The penalty is paid once, on the step the robot tips over; stepping on after the
         # episode terminated keeps `terminated` True and never pays it again.
@@ -392,10 +395,12 @@ class HexapodEnv(gym.Env):
         terms = self._reward_terms(tipped)
         self._end_step()
         self._prev_cog_x = float(self._cog[0])
-        self._last_obs = self._observation()
+        obs = self._observation()
         reward = float(sum(terms.values()))
         terminated = self._tipped or (self.ends_on_success and self._success)
-        return self._last_obs, reward, terminated, False, self._info(terms, unstable=False)
+        if self.render_mode == "human":
+            self.render()
+        return obs, reward, terminated, False, self._info(terms, unstable=False)
 
     def _info(self, terms: dict[str, float], unstable: bool) -> dict:
         """The common info keys (`hexapod_envs.info_keys`) plus the env's `_extra_info`."""
