@@ -350,9 +350,11 @@ HOW_TO_READ = [
     "differs per robot and is listed per env below. Where the paper judges a robot by another "
     "criterion (the 3-UPU robot: the static margin > 0), its FASM is shown for comparison and "
     "ξ = 0° only marks a net force outside the support polygon.",
-    "- **Success** is the env's `is_success` at the episode's end: the cliff walk and the "
-    "Stewart tilt: no tip-over to the time limit; the irregular terrain: no tip-over and no torso "
-    "contact; the ditch crossing: across the ditch with the static margin above 0.",
+    "- **Success** is the env's `is_success` at the episode's end: the cliff walk: no tip-over "
+    "and, at the time limit, at least half the distance the reference gait covers in that time "
+    "(the env's min_progress); the Stewart tilt: no tip-over to the time limit; the irregular "
+    "terrain: no tip-over and no torso contact; the ditch crossing: across the ditch with the "
+    "static margin above 0.",
     "- **Comparisons** use rates per episode and, for time-integrated quantities (time below ξ, "
     "distance, energy), values per second of episode (share of time below ξ, speed, mean "
     "power), so a policy whose episodes end early cannot look better on a total. Every policy is "
