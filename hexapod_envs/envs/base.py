@@ -371,8 +371,8 @@ class HexapodEnv(gym.Env):
         self._start_cog_x = self._prev_cog_x = float(self._cog[0])
         self._success = self._is_success()
         obs, info = self._observation(), self._info({}, unstable=not settled)
-        # Unstable while settling: said at once (MuJoCo's warning counts stay until the next
-        # reset, so the first step truncates as unstable too).
+        # An unstable settle shows in info["sim_unstable"] now; MuJoCo's warning counts stay
+        # until the next reset, so the first step truncates as unstable too.
         if self.render_mode == "human":
             self.render()
         return obs, info
