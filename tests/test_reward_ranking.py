@@ -136,3 +136,12 @@ def test_every_upright_step_of_random_actions_earns_at_least_zero(env_id):
             break
         assert reward >= -1e-9, {k: v for k, v in info.items() if k.startswith("reward_")}
     env.close()
+
+
+@pytest.mark.parametrize("cap", [1.0, 1.5])
+def test_the_forward_term_counts_speed_up_to_its_cap(cap):
+    env = gym.make("HexapodCliffWalk-v0", reward={"forward_cap": cap}).unwrapped
+    env.reset(seed=0)
+    v_ref = env.gait.gait.body_speed
+    env._prev_cog_x = float(env._cog[0]) - 2.0 * v_ref * env.control_dt  # twice the reference
+    assert env._reward_terms(tipped=False)["forward"] == pytest.approx(cap)

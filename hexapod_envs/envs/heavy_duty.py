@@ -42,6 +42,9 @@ class HeavyDutyRewardScales(RewardScales):
     """Weights of the heavy-duty envs' reward terms (see the env docstrings)."""
 
     forward_weight: float = number(1.0)
+    forward_cap: float = number(1.0, strict=True)
+    """The forward term counts speed up to this multiple of the reference gait's speed (1:
+    faster is not rewarded, so a policy cannot trade stability for a scramble)."""
     stability_weight: float = number(1.0)
     tip_over_penalty: float = number(100.0)
     effort_weight: float = number(0.05)
@@ -117,6 +120,7 @@ class HeavyDutyEnv(HexapodEnv):
             "tip_over": s.reward.tip_over_penalty,
             "effort": s.reward.effort_weight,
         }
+        self._forward_cap = s.reward.forward_cap
         self.weight_n = self.robot.total_mass * 9.81
         self._contact_force_sq = (s.contact_threshold * self.weight_n) ** 2
         self.action_map = JointActionMap(np.tile(self.robot.joint_ranges, (6, 1)))
@@ -302,10 +306,11 @@ class HeavyDutyEnv(HexapodEnv):
         margin = min(max(self._fasm_deg, -self.tipping_threshold_deg), 45.0)
         terms = {}
         if self.walks:
-            # Progress up to the reference gait's speed: faster is not rewarded, so a policy
-            # cannot trade stability for a scramble (PPO did, at 1 m/s with FASM ~ 0).
+            # Progress up to `forward_cap` x the reference gait's speed (default 1: faster is
+            # not rewarded, so a policy cannot trade stability for a scramble; PPO did, at 1 m/s
+            # with FASM ~ 0).
             speed = (float(self._cog[0]) - self._prev_cog_x) / self.control_dt
-            terms["forward"] = w["forward"] * min(max(speed / v_ref, -1.0), 1.0)
+            terms["forward"] = w["forward"] * min(max(speed / v_ref, -1.0), self._forward_cap)
         terms["stability"] = w["stability"] * margin / 45.0
         terms["alive"] = 0.0 if self._tipped else self.step_cost_bound()
         terms["tip_over"] = -w["tip_over"] if tipped else 0.0
