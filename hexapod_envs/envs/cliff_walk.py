@@ -19,7 +19,7 @@ recovery controller, the robot tips over.
 
 | Reward term (info key) | meaning |
 |---|---|
-| reward_forward | forward_weight x clip(CoG speed along x / gait speed, -1, forward_cap) (forward_cap: 1 by default) |
+| reward_forward | forward_weight x clip(CoG speed along x / gait speed, -1, forward_cap) |
 | reward_stability | stability_weight x clip(FASM, -20, 45) / 45 |
 | reward_alive | the largest cost of a step, paid while the robot is up (see below) |
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
