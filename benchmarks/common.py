@@ -9,6 +9,8 @@ import gymnasium as gym
 import mujoco
 import numpy as np
 
+from hexapod_envs.envs.base import step_sensing_last
+
 
 class ReplayRates(NamedTuple):
     """Physics steps per wall second over one motion (see `replay_step_rate`)."""
@@ -16,8 +18,8 @@ class ReplayRates(NamedTuple):
     raw: float
     """Bare `mj_step` calls with every sensor evaluated at every step (MuJoCo's default)."""
     raw_sensing_last: float
-    """The same steps as the hexapod envs run them (`HexapodEnv._step_sensing_last`): one
-    call for all but the last step of a control period, without sensors, then the last."""
+    """The same steps as the hexapod envs run them (`hexapod_envs.envs.base.step_sensing_last`):
+    the sensors evaluated only in the last step of a control period."""
     env: float
     """`env.step` with its substeps counted."""
 
@@ -48,9 +50,7 @@ def replay_step_rate(env: gym.Env, steps: int, seed: int = 0) -> ReplayRates:
             controls = controls[: k + 1]
             break
     n = len(controls)
-    model, opt = base.model, base.model.opt
-    sensors_on = opt.disableflags
-    sensors_off = sensors_on | int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+    model = base.model
     rates = []
     for skip_sensors in (False, True):
         data = mujoco.MjData(model)
@@ -58,16 +58,12 @@ def replay_step_rate(env: gym.Env, steps: int, seed: int = 0) -> ReplayRates:
         t0 = time.perf_counter()
         for k in range(n):
             data.ctrl[:] = controls[k]
-            if skip_sensors:  # as the env steps: one call, then one sensing step
-                opt.disableflags = sensors_off
-                mujoco.mj_step(model, data, nstep=substeps - 1)
-                opt.disableflags = sensors_on
-                mujoco.mj_step(model, data)
+            if skip_sensors:  # as the env steps
+                step_sensing_last(model, data, substeps)
             else:
                 for _ in range(substeps):
                     mujoco.mj_step(model, data)
         rates.append(n * substeps / (time.perf_counter() - t0))
-    opt.disableflags = sensors_on
     return ReplayRates(rates[0], rates[1], n * substeps / elapsed)
 
 

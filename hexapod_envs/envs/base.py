@@ -32,9 +32,31 @@ __all__ = [
     "ObservationLayout",
     "TaskDescription",
     "check_choice",
+    "step_sensing_last",
 ]
 
 _SENSORS_OFF = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+
+
+def step_sensing_last(model: mujoco.MjModel, data: mujoco.MjData, nstep: int) -> None:
+    """`nstep` MuJoCo steps, evaluating the sensors in the last one only.
+
+    Sensors never act on the dynamics, and the envs read `data.sensordata` only after the
+    steps, so the state and the final readings are bit-identical to evaluating them every step,
+    while the skipped evaluations (the foot-force and accelerometer sensors need an extra
+    dynamics pass, ATHENA's rangefinders cast rays) cost 5-10 % of a physics step.
+    """
+    if nstep > 1:
+        opt = model.opt
+        flags = opt.disableflags
+        opt.disableflags = flags | _SENSORS_OFF
+        try:
+            mujoco.mj_step(model, data, nstep=nstep - 1)
+        finally:
+            opt.disableflags = flags
+        nstep = 1
+    mujoco.mj_step(model, data, nstep=nstep)
+
 
 DEFAULT_CAMERA = {"distance": 14.0, "elevation": -20.0, "azimuth": 135.0, "trackbodyid": 1}
 
@@ -577,25 +599,12 @@ class HexapodEnv(gym.Env):
         self._step_sensing_last(self.n_substeps)
 
     def _step_sensing_last(self, nstep: int) -> None:
-        """`nstep` MuJoCo steps, evaluating the sensors in the last one only.
-
-        Sensors never act on the dynamics, and the env reads `data.sensordata` only after the
-        steps, so the state and the final readings are bit-identical to evaluating them every
-        step, while the skipped evaluations (the foot-force and accelerometer sensors need an
-        extra dynamics pass, ATHENA's rangefinders cast rays) cost 5-10 % of a physics step.
-        A model whose sensors keep a history (delay, interval) needs every step evaluated.
-        """
-        m, d = self.model, self.data
-        if nstep > 1 and not self._sensors_every_step:
-            opt = m.opt
-            flags = opt.disableflags
-            opt.disableflags = flags | _SENSORS_OFF
-            try:
-                mujoco.mj_step(m, d, nstep=nstep - 1)
-            finally:
-                opt.disableflags = flags
-            nstep = 1
-        mujoco.mj_step(m, d, nstep=nstep)
+        """`nstep` MuJoCo steps, the sensors evaluated in the last one only (`step_sensing_last`),
+        unless the model's sensors keep a history (delay, interval): those need every step."""
+        if self._sensors_every_step:
+            mujoco.mj_step(self.model, self.data, nstep=nstep)
+        else:
+            step_sensing_last(self.model, self.data, nstep)
 
     # --- rendering -----------------------------------------------------------------------
     def render(self):

@@ -270,7 +270,7 @@ class EnvSettings(_Checked):
     """Line-search iterations of the solver (None: MuJoCo's default, 50)."""
     solver_tolerance: float | None = number(None, optional=True)
     """Constraint solver tolerance (None: MuJoCo's default, 1e-8)."""
-    midphase: bool | None = choice(None, (None, False, True), optional=True)
+    midphase: bool | None = choice(None, (None, False, True))
     """MuJoCo's collision midphase (bounding-volume trees that cull geom pairs before the
     narrow phase). It finds the same contacts either way (bit-identical episodes in every env),
     so only speed decides: None takes the env's measured choice (`HexapodEnv.midphase_pays`)."""
