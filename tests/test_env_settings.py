@@ -177,6 +177,26 @@ def test_a_recorded_settings_file_rebuilds_the_same_settings(env_id):
     record = yaml.safe_load(dump_yaml(resolved_settings(env)))  # env_settings.yaml's content
     assert isinstance(record["train_ranges"], dict)
     assert gym.make(env_id, **record).unwrapped.settings == env.unwrapped.settings
+    # every setting is recorded, not only the ones that differ from a default that may change
+    settings = env.unwrapped.settings
+    assert set(record) == {f.name for f in dataclasses.fields(settings)}
+    assert set(record["reward"]) == {f.name for f in dataclasses.fields(settings.reward)}
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_every_setting_is_checked_and_every_number_is_a_numeric_setting(env_id):
+    """The bad-value tests above find the settings by their metadata (`number`, `choice`...):
+    a field declared without it would be neither validated nor tested."""
+    settings = _settings_class(env_id)
+    numeric = set(settings.numeric_names())
+    for klass in (settings, settings.reward_class):
+        for f in dataclasses.fields(klass):
+            if f.name == "reward":  # the nested section, checked field by field
+                continue
+            assert "check" in f.metadata, f"{klass.__name__}.{f.name} is not validated"
+            default = f.default
+            if isinstance(default, int | float) and not isinstance(default, bool):
+                assert f.name in numeric, f"{klass.__name__}.{f.name} is not a numeric setting"
 
 
 @pytest.mark.parametrize(

@@ -166,11 +166,30 @@ def test_a_gait_cycle_run_trains_per_cycle_and_evaluates_per_step(tmp_path):
     from agents.pipeline.learning_curve import load_learning_curve
 
     assert load_learning_curve(run).unit == "gait cycles"
+    # The learner's episodes (SB3's rollout/ep_len_mean, from the Monitor of the training env)
+    # are 120 env steps long but count a few gait cycles; learning per env step, none of them
+    # would even have ended within the 64 learner steps.
+    from tensorboard.backend.event_processing.event_accumulator import EventAccumulator
+
+    (events,) = (run / "tb").rglob("events.out.tfevents.*")
+    log = EventAccumulator(str(events))
+    log.Reload()
+    assert "rollout/ep_len_mean" in log.Tags()["scalars"]
+    lengths = [e.value for e in log.Scalars("rollout/ep_len_mean")]
+    assert lengths and max(lengths) <= 120 / base_ticks_per_cycle() + 1
     env = gym.make(ENV_ID, action_mode="gains", task_distribution="test")
     policy = PPOPolicy.load(run / "final", env)
     obs, _ = env.reset(seed=0)
     gains = policy(obs)
     assert gains.shape == (3,) and ((gains >= 0.0) & (gains <= 1.0)).all()
+
+
+def base_ticks_per_cycle() -> int:
+    """Control steps per gait cycle of the irregular terrain's default gait."""
+    env = gym.make(ENV_ID, action_mode="gains")
+    ticks = env.unwrapped.ticks_per_cycle
+    env.close()
+    return ticks
 
 
 def test_learning_curves_of_gait_cycle_runs_get_their_own_row(tmp_path):

@@ -105,19 +105,19 @@ def test_controller_is_reset_at_every_env_reset():
 
 
 def test_residual_adds_scale_times_action_and_clips_to_the_space():
+    """env action = clip(analytical + scale x learned), with an analytical action that is not
+    zero (the cliff controller's residual is zero until a recovery, so a stand-in acts)."""
     env = config_env("cliff_walk_hybrid.yaml")
-    core = HybridCore(env, HybridSettings(scale=0.05))
+    base = ScriptedBase(0.3, env.action_space.shape)
+    core = HybridCore(env, HybridSettings(scale=0.05), base=base)
     obs, _ = env.reset(seed=0)
     core.reset()
     learned = np.linspace(-1, 1, 18).astype(np.float32)
     action, override = core(obs, learned)
-    reference = HybridCore(env, HybridSettings(scale=0.05))
-    reference.reset()
-    base = reference.base_action(obs)
-    np.testing.assert_allclose(action, np.clip(base + 0.05 * learned, -1, 1), atol=1e-6)
-    assert not override
-    big, _ = HybridCore(env, HybridSettings(scale=10.0))(obs, np.ones(18))
-    assert np.all(big <= env.action_space.high) and np.all(big >= env.action_space.low)
+    np.testing.assert_allclose(action, np.clip(0.3 + 0.05 * learned, -1, 1), atol=1e-6)
+    assert not override and base.calls == 1 and base.resets == 1
+    big, _ = HybridCore(env, HybridSettings(scale=10.0), base=base)(obs, np.ones(18))
+    np.testing.assert_array_equal(big, env.action_space.high)  # 0.3 + 10 clipped
 
 
 class ScriptedBase:
@@ -206,6 +206,8 @@ def test_wrapper_records_the_override_in_info_on_a_real_tilt():
 
 
 def test_policy_combines_a_learned_policy_like_the_wrapper():
+    """Over an episode into the recovery (whose actions are not zero, from step 308 on this
+    task), the policy's action is the analytical controller's plus scale x the learned one."""
     env = config_env("stewart_tilt_hybrid.yaml")
     learned = ScriptedBase(0.3, env.action_space.shape)
     policy = HybridPolicy(learned, env, HybridSettings(scale=0.05))
@@ -213,7 +215,16 @@ def test_policy_combines_a_learned_policy_like_the_wrapper():
     policy.reset()
     reference = analytical_policy(env)
     reference.reset()
-    np.testing.assert_allclose(policy(obs), np.clip(reference(obs) + 0.015, -1, 1), atol=1e-6)
+    recovering = 0
+    for _ in range(340):
+        base = reference(obs)
+        action = policy(obs)
+        np.testing.assert_allclose(action, np.clip(base + 0.015, -1, 1), atol=1e-6)
+        recovering += bool(np.any(base != 0))
+        obs, _, terminated, truncated, _ = env.step(action)
+        if terminated or truncated:
+            break
+    assert recovering > 0
     assert learned.resets == 1 and policy.last_override is False
 
 

@@ -42,9 +42,11 @@ def train(tmp: Path, name: str, *overrides: str, config: str = STEWART) -> Path:
     return tmp / name
 
 
-def evaluate(out: Path, *policies: str, env_kwargs=None, env="HexapodStewartTilt-v0") -> int:
+def evaluate(
+    out: Path, *policies: str, env_kwargs=None, env="HexapodStewartTilt-v0", steps: int = 250
+) -> int:
     envs = json.dumps([{"id": env, "kwargs": env_kwargs or {}}])
-    argv = ["--episodes", "2", "--max-episode-steps", "250", "--output-dir", str(out)]
+    argv = ["--episodes", "2", "--max-episode-steps", str(steps), "--output-dir", str(out)]
     argv += ["--no-progress", "--set", f"envs={envs}", "--policies", *policies]
     return evaluate_main(argv)
 
@@ -94,13 +96,36 @@ def test_run_dir_loads_as_a_hybrid_policy(runs):
 
 def test_untrained_hybrid_is_the_analytical_controller_in_evaluate(runs, tmp_path):
     """Zero action mean (an untrained hybrid): evaluate.py's ppo:<run dir> gives exactly
-    the analytical controller's episodes (same seeds), with no extra argument."""
-    assert evaluate(tmp_path / "rep", "analytical", f"ppo:{runs['frozen']}") == 0
+    the analytical controller's episodes (same seeds), with no extra argument. The episodes run
+    into the recovery (from 290 steps on at this tilt rate), where the analytical controller's
+    differ from the zero action's."""
+    frozen = f"ppo:{runs['frozen']}"
+    fast_tilt = {"scenario": "climb", "tilt_rate_deg": 4.0}
+    code = evaluate(tmp_path / "rep", "analytical", "zero", frozen, env_kwargs=fast_tilt, steps=340)
+    assert code == 0
     metrics = json.loads((tmp_path / "rep" / "metrics.json").read_text())
     policies = metrics["envs"]["HexapodStewartTilt-v0"]["policies"]
-    hybrid = policies[f"ppo:{runs['frozen']}"]["episodes"]
+    hybrid = policies[frozen]["episodes"]
     assert hybrid == policies["analytical"]["episodes"]
+    assert hybrid != policies["zero"]["episodes"]
     assert len(hybrid) == 2
+
+
+def test_a_new_hybrid_model_starts_at_the_analytical_controller():
+    """train.py's model (`new_model`) has a zero action net when the hybrid section asks for it,
+    so that its step 0 is exactly the analytical controller; SB3's initialisation otherwise."""
+    import torch
+    from stable_baselines3.common.vec_env import DummyVecEnv
+
+    from agents.pipeline.train_config import load_train_config
+    from agents.pipeline.training import new_model
+
+    venv = DummyVecEnv([lambda: gym.make("HexapodStewartTilt-v0")])
+    for zero in (True, False):
+        option = f"hybrid.zero_init_action_net={str(zero).lower()}"
+        net = new_model(load_train_config(STEWART, [*TINY, option]), venv).policy.action_net
+        weights = torch.cat([p.detach().ravel() for p in net.parameters()])
+        assert bool((weights == 0).all()) is zero
 
 
 def test_evaluate_runs_a_hybrid_in_its_trained_action_mode(tmp_path):

@@ -73,3 +73,38 @@ def test_an_always_overridden_policy_learns_nothing_only_when_masked(tmp_path, m
     run = train(tmp_path, "run", *always, f"hybrid.mask_overridden={str(mask).lower()}")
     moved = float(_action_net(run).abs().max())
     assert (moved == 0.0) if mask else (moved > 0.0)
+
+
+class _FlagEveryThirdStep(gym.Wrapper):
+    """Reports ``info["safety_override"]`` on every third step, counted from the env's start."""
+
+    def __init__(self, env):
+        super().__init__(env)
+        self.count = 0
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        self.count += 1
+        return obs, reward, terminated, truncated, {**info, "safety_override": self.count % 3 == 0}
+
+
+def test_the_buffer_flags_exactly_the_overridden_steps():
+    """`RecordOverrides` writes each step's flag into the row SB3 stores that step's action in:
+    with mixed flags, a shifted or a constant record shows."""
+    from stable_baselines3 import PPO
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    from agents.pipeline.override_mask import RecordOverrides, masked_ppo_kwargs
+
+    class KeepFlags(BaseCallback):
+        def _on_step(self) -> bool:
+            return True
+
+        def _on_rollout_end(self) -> None:
+            self.flags = self.model.rollout_buffer.overridden[:, 0].copy()
+
+    env = _FlagEveryThirdStep(gym.make("Pendulum-v1"))
+    model = PPO("MlpPolicy", env, n_steps=32, batch_size=32, n_epochs=1, **masked_ppo_kwargs(True))
+    keep = KeepFlags()
+    model.learn(32, callback=[RecordOverrides(), keep])
+    np.testing.assert_array_equal(keep.flags, [(k + 1) % 3 == 0 for k in range(32)])
