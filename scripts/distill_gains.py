@@ -38,7 +38,10 @@ cores; test: the last 22 beds, the paper's gains 0.16889, the teacher's choices 
 setting's 0.16716 / 0.16857 / 0.16748 (--drop foot_scan: 0.16804 / 0.16818 / 0.16805; --drop
 foot_scan terrain_scan: 0.16951 / 0.16867 / 0.16855), mean of 3 seeds. Whatever it sees, it
 does no better than its fixed setting: the footing does not make the teacher's choice
-predictable for it.
+predictable for it. With --with-deviation (the posture controller's ground-plane estimate for
+the cycle's first phase, `ground_deviation_features`; 2026-11-26) and --drop foot_scan
+terrain_scan: 0.16775 / 0.16824 / 0.16824 against 0.16716 / 0.16857 / 0.16748; with both scans
+0.16963 / 0.16986 / 0.16850: still no better than the fixed setting.
 
 Run (CONFIG: configs/irregular_terrain_gains_blocks_scan.yaml):
     python scripts/distill_gains.py collect --config CONFIG --episodes 56 --workers 2 \
@@ -66,6 +69,7 @@ from agents.pipeline.gains_distill import (  # noqa: E402
     demonstrate,
     distill,
     fit_choice,
+    ground_deviation_features,
     held_out_rows,
 )
 from agents.pipeline.train_config import load_train_config  # noqa: E402
@@ -163,6 +167,7 @@ def choose(args: argparse.Namespace) -> None:
     demos = Demonstrations.load(args.demos)
     with env_spec(load_train_config(args.config, args.set)).make() as env:
         structure = env.unwrapped.observation_structure
+        controller = env.unwrapped.controller
         (width,) = env.observation_space.shape
     if demos.observations.shape[1] != width:
         raise ValueError(
@@ -175,6 +180,10 @@ def choose(args: argparse.Namespace) -> None:
     keep = np.ones(width, dtype=bool)
     for name in args.drop:
         keep[structure[name]] = False
+    observations = demos.observations[:, keep]
+    if args.with_deviation:
+        deviation = ground_deviation_features(demos.observations, structure, controller)
+        observations = np.hstack([observations, deviation])
     beds = np.unique(demos.beds)
     if not 0 < args.test_beds <= len(beds) - 2:
         raise ValueError(
@@ -193,7 +202,7 @@ def choose(args: argparse.Namespace) -> None:
             train = np.isin(demos.beds, chosen) & ~validation
             results.append(
                 fit_choice(
-                    demos.observations[:, keep],
+                    observations,
                     demos,
                     train,
                     validation,
@@ -263,6 +272,11 @@ def main(argv: list[str] | None = None) -> None:
     h.add_argument("--seeds", type=int, default=3)
     h.add_argument("--epochs", type=int, default=150)
     h.add_argument("--drop", nargs="+", default=[], metavar="PIECE", help="observation pieces")
+    h.add_argument(
+        "--with-deviation",
+        action="store_true",
+        help="add the posture controller's ground-plane estimate (ground_deviation_features)",
+    )
     args = parser.parse_args(argv)
     {"collect": collect, "fit": fit, "curve": curve, "choose": choose}[args.command](args)
 

@@ -400,6 +400,37 @@ def fit_choice(
     )
 
 
+def ground_deviation_features(
+    observations: np.ndarray, structure: dict[str, slice], controller
+) -> np.ndarray:
+    """(n, 3) the posture controller's estimate for the phase each row's cycle starts with:
+    torso pitch and roll from the ground plane [rad] (eqs. 24-26,
+    `AthenaPostureController.ground_deviation`) and the height error [m], recomputed from the
+    row's observation (``structure``: the env's `observation_structure`). The gains scale
+    exactly these corrections, so they are the obvious candidate for telling which gains a
+    cycle wants. A cycle starts with an even phase, whose stance tripod is ``TRIPODS[1]``.
+    The feet are eq. (12) on the observed joint angles; the controller's default start
+    ("measured_height") takes its feet's heights from there but their horizontal positions from
+    its commands, which the observation lacks: an approximation within the servos' tracking."""
+    from hexapod_envs.robots.athena.kinematics import feet_closed_form
+    from hexapod_envs.robots.athena.params import LEG_NAMES, TRIPODS
+
+    stance = tuple(LEG_NAMES.index(leg) for leg in TRIPODS[1])
+    rows = np.asarray(observations, dtype=np.float64)
+    angles = rows[:, structure["joint_pos"]].reshape(-1, 6, 3)
+    forces = rows[:, structure["foot_force"]].reshape(-1, 6, 3)
+    heights = rows[:, structure["torso_height"]].reshape(-1)
+    features = np.zeros((len(rows), 3))
+    for k in range(len(rows)):
+        contact = np.linalg.norm(forces[k], axis=1) > controller.contact_threshold
+        feet = feet_closed_form(angles[k], controller.params)
+        _, _, d_pitch, d_roll = controller.ground_deviation(feet, contact, stance)
+        height = heights[k]
+        d_z = height - controller.reference_height if height >= 0 else 0.0
+        features[k] = d_pitch, d_roll, d_z
+    return features
+
+
 def held_out_rows(demos: Demonstrations, fraction: float) -> np.ndarray:
     """(n,) True for the rows of the last ``fraction`` of the beds (at least one bed)."""
     beds = np.unique(demos.beds)

@@ -433,13 +433,7 @@ class AthenaPostureController:
             else:
                 start = self._command.copy()
                 start[:, 2] = measured[:, 2]
-        plane_legs = self._choose_plane_legs(start, contact, stance)
-        if plane_legs:
-            plane = fit_plane(start[list(plane_legs)])
-            normal = plane.normal
-            d_pitch, d_roll = torso_deviation_from_plane(normal)
-        else:
-            normal, d_pitch, d_roll = np.array([0.0, 0.0, 1.0]), 0.0, 0.0
+        plane_legs, normal, d_pitch, d_roll = self.ground_deviation(start, contact, stance)
         d_z = height - self.reference_height if np.isfinite(height) and height >= 0 else 0.0
 
         stride = self.stride / 2 if self._phase_index == 0 else self.stride
@@ -468,6 +462,20 @@ class AthenaPostureController:
             extension=self._extension,
         )
         self._extension = 0.0
+
+    def ground_deviation(
+        self, feet: np.ndarray, contact: np.ndarray, stance: tuple[int, ...]
+    ) -> tuple[tuple[int, ...], np.ndarray, float, float]:
+        """(plane legs, ground normal, delta_pitch, delta_roll [rad]) of eqs. (24)-(26): the
+        plane through three of the body-frame `feet` (6, 3) [m] in `contact` (the `stance`
+        tripod when all of it touches) and the torso's deviation from it; without a usable
+        triple, no plane: legs (), normal (0, 0, 1), no deviation."""
+        plane_legs = self._choose_plane_legs(feet, contact, stance)
+        if not plane_legs:
+            return (), np.array([0.0, 0.0, 1.0]), 0.0, 0.0
+        normal = fit_plane(feet[list(plane_legs)]).normal
+        d_pitch, d_roll = torso_deviation_from_plane(normal)
+        return plane_legs, normal, d_pitch, d_roll
 
     def _searches_ground(self) -> bool:
         """Whether the coming phase extends landing legs that found no ground (`GROUND_SEARCH`)."""
