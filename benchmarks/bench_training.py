@@ -6,7 +6,10 @@ Settings: the policy network and PPO hyperparameters of configs/cliff_walk_ppo.y
 (`--steps` in total, default 4096), VecNormalize on, Monitor wrappers as in train.py. The timer
 covers ``model.learn`` only (worker start-up excluded: the workers are reset and stepped once
 before it, which loads the hexapod's compiled kernels). A row "env only" gives the bare
-single-process stepping rate with random actions for context.
+single-process stepping rate with random actions for context, a row "physics only" the bare
+`mj_step` rate of the same steps (the controls replayed), and the last line the 1-env PPO rate
+the hexapod would reach if its env cost nothing but that physics: the ceiling of the ratio at
+the env's physics step.
 
 Run: python benchmarks/bench_training.py [--steps 4096] [--n-steps 512]
 """
@@ -19,6 +22,7 @@ import sys
 import time
 from pathlib import Path
 
+import mujoco
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -61,21 +65,53 @@ def _warm_up(venv) -> None:
     venv.step(np.array([venv.action_space.sample() for _ in range(venv.num_envs)]))
 
 
-def env_only_rate(spec: EnvSpec, steps: int, seed: int = 0) -> float:
+def env_only_rate(spec: EnvSpec, steps: int, seed: int = 0) -> tuple[float, float]:
+    """(env steps per second, the same steps' bare physics per second) with random actions.
+
+    The physics figure replays each episode's controls from its start state as bare `mj_step`
+    calls (`substeps` per env step), before the next reset can change the task's model: what
+    the env's steps would cost if everything but MuJoCo's physics were free.
+    """
     env = spec.make()
     env.action_space.seed(seed)
     actions = [env.action_space.sample() for _ in range(steps)]
     env.reset(seed=seed)
     env.step(actions[0])  # loads the compiled kernels (start-up, as in `_warm_up`)
     env.reset(seed=seed)
-    start = time.perf_counter()
-    for a in actions:
+    base = env.unwrapped
+    start_state, controls = _copy(base.model, base.data), []
+    env_seconds = physics_seconds = 0.0
+    for k, a in enumerate(actions):
+        start = time.perf_counter()
         _, _, terminated, truncated, _ = env.step(a)
-        if terminated or truncated:
+        env_seconds += time.perf_counter() - start
+        controls.append(base.data.ctrl.copy())
+        if terminated or truncated or k == steps - 1:
+            physics_seconds += _replay_seconds(base, start_state, controls)
+            start = time.perf_counter()
             env.reset()
-    elapsed = time.perf_counter() - start
+            env_seconds += time.perf_counter() - start
+            start_state, controls = _copy(base.model, base.data), []
     env.close()
-    return steps / elapsed
+    return steps / env_seconds, steps / physics_seconds
+
+
+def _copy(model: mujoco.MjModel, data: mujoco.MjData) -> mujoco.MjData:
+    copy = mujoco.MjData(model)
+    mujoco.mj_copyData(copy, model, data)
+    return copy
+
+
+def _replay_seconds(base, start_state: mujoco.MjData, controls: list[np.ndarray]) -> float:
+    """Wall seconds of bare `mj_step` calls replaying `controls` from `start_state`."""
+    substeps = getattr(base, "n_substeps", None) or getattr(base, "frame_skip", 1)
+    data = _copy(base.model, start_state)
+    start = time.perf_counter()
+    for ctrl in controls:
+        data.ctrl[:] = ctrl
+        for _ in range(substeps):
+            mujoco.mj_step(base.model, data)
+    return time.perf_counter() - start
 
 
 def main() -> None:
@@ -85,8 +121,9 @@ def main() -> None:
     args = parser.parse_args()
 
     rates: dict[tuple[str, str], float] = {}
+    physics: dict[str, float] = {}
     for name, spec in ENVS.items():
-        rates[(name, "env only")] = env_only_rate(spec, args.steps)
+        rates[(name, "env only")], physics[name] = env_only_rate(spec, args.steps)
         for n in (1, 2):
             rates[(name, f"PPO, {n} subproc")] = ppo_rate(spec, n, args.steps, args.n_steps)
             print(f"measured {name} with {n} env(s)", file=sys.stderr)
@@ -100,8 +137,22 @@ def main() -> None:
     for _, setting in settings:
         hexapod, ant = rates[("HexapodCliffWalk-v0", setting)], rates[("Ant-v5", setting)]
         print(f"{setting:18s} {hexapod:16.0f} {ant:15.0f} {hexapod / ant:12.2f}")
+    print(
+        f"{'physics only':18s} {physics['HexapodCliffWalk-v0']:16.0f} {physics['Ant-v5']:15.0f}"
+        f" {physics['HexapodCliffWalk-v0'] / rates[('Ant-v5', 'env only')]:12.2f}"
+        "  (bare mj_step of the same steps; the ratio against Ant-v5's env)"
+    )
     one = rates[("HexapodCliffWalk-v0", "PPO, 1 subproc")]
     two = rates[("HexapodCliffWalk-v0", "PPO, 2 subproc")]
+    # With one env, PPO runs the env's step and its own work in turn: 1/one = env step + rest.
+    # Were the hexapod env's step its bare physics and nothing else, PPO would reach `bound`.
+    rest = 1 / one - 1 / rates[("HexapodCliffWalk-v0", "env only")]
+    bound = 1 / (rest + 1 / physics["HexapodCliffWalk-v0"])
+    ant_one = rates[("Ant-v5", "PPO, 1 subproc")]
+    print(
+        f"PPO, 1 subproc, if the hexapod env cost only its bare physics: {bound:.0f} steps/s, "
+        f"hexapod/ant {bound / ant_one:.2f} (the ceiling of the 1-env ratio at this physics step)"
+    )
     cores = len(os.sched_getaffinity(0))
     print(f"Hexapod 2-env / 1-env speed-up: {two / one:.2f} ({cores} usable cores, shared)")
 
