@@ -18,7 +18,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run as a script from anywhere
 
 import hexapod_envs  # noqa: F401
-from benchmarks.common import env_vs_raw, per_call_us, replay_step_rate
+from benchmarks.common import ENV_RAW_TARGET, env_vs_raw, per_call_us, replay_step_rate, verdict
 from hexapod_envs.envs.ditch_crossing import DitchCrossingEnv
 from hexapod_envs.robots.upu.gait_plan import Ditch, plan_ditch_crossing
 from hexapod_envs.robots.upu.params import UpuParams
@@ -61,6 +61,10 @@ def main() -> None:
         f"paired env/raw ratios over 7 replays: median {ratios[3]:.3f} "
         f"(range {ratios[0]:.3f}-{ratios[-1]:.3f}); env/sensing last: median "
         f"{overhead_only[3]:.3f} (range {overhead_only[0]:.3f}-{overhead_only[-1]:.3f})"
+    )
+    print(
+        f"issue 14's target: env/raw >= {ENV_RAW_TARGET} (paired median): "
+        f"{verdict(ratios[3], ENV_RAW_TARGET)}"
     )
 
     env = DitchCrossingEnv()

@@ -23,7 +23,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run as a script from anywhere
 
 import hexapod_envs  # noqa: F401
-from benchmarks.common import env_vs_raw, per_call_us
+from benchmarks.common import ENV_RAW_TARGET, env_vs_raw, per_call_us, verdict
 from hexapod_envs.robots.athena.gait import AthenaPostureController
 from hexapod_envs.robots.athena.kinematics import leg_ik
 from hexapod_envs.stability import fasm_from_feet
@@ -114,13 +114,19 @@ def main() -> None:
         f"{'terrain':8s} {'mode':9s} {'raw mj_step/s':>14s} {'env steps/s':>12s} {'env/raw':>8s} "
         f"{'env/sensing last':>17s}"
     )
+    lowest = 1.0
     for terrain in ("ramp", "blocks", "flat"):
         for mode in ("residual", "gains", "joint"):
             r = env_vs_raw(ENV_ID, steps=1200, terrain=terrain, action_mode=mode)
+            lowest = min(lowest, r.env / r.raw)
             print(
                 f"{terrain:8s} {mode:9s} {r.raw:14.0f} {r.env:12.0f} {r.env / r.raw:8.2f} "
                 f"{r.env / r.raw_sensing_last:17.2f}"
             )
+    print(
+        f"issue 14's target: env/raw >= {ENV_RAW_TARGET} on every row (lowest {lowest:.3f}): "
+        f"{verdict(lowest, ENV_RAW_TARGET)}"
+    )
     try:  # context: a Gymnasium MuJoCo env measured the same way in the same run
         r = env_vs_raw("Ant-v5", steps=1200)
         print(f"{'Ant-v5':8s} {'(gym)':9s} {r.raw:14.0f} {r.env:12.0f} {r.env / r.raw:8.2f}")

@@ -11,6 +11,14 @@ import numpy as np
 
 from hexapod_envs.envs.base import step_sensing_last
 
+ENV_RAW_TARGET = 0.92
+"""Issue 14's target for env steps per wall second against bare `mj_step` over the same motion."""
+
+
+def verdict(value: float, target: float) -> str:
+    """'met' when `value` reaches `target` (a lower bound), else 'missed'."""
+    return "met" if value >= target else "missed"
+
 
 class ReplayRates(NamedTuple):
     """Physics steps per wall second over one motion (see `replay_step_rate`)."""
