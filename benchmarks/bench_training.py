@@ -22,7 +22,6 @@ import sys
 import time
 from pathlib import Path
 
-import mujoco
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -30,7 +29,7 @@ sys.path.insert(0, str(ROOT))  # run as a script from anywhere
 
 from agents.pipeline.envs import EnvSpec, make_vec_env  # noqa: E402
 from agents.pipeline.train_config import load_train_config  # noqa: E402
-from benchmarks.common import verdict  # noqa: E402
+from benchmarks.common import random_action_rates, verdict  # noqa: E402
 
 ENVS = {
     "HexapodCliffWalk-v0": EnvSpec("HexapodCliffWalk-v0", gym_packages=["hexapod_envs"]),
@@ -70,52 +69,12 @@ def _warm_up(venv) -> None:
 
 
 def env_only_rate(spec: EnvSpec, steps: int, seed: int = 0) -> tuple[float, float]:
-    """(env steps per second, the same steps' bare physics per second) with random actions.
-
-    The physics figure replays each episode's controls from its start state as bare `mj_step`
-    calls (`substeps` per env step), before the next reset can change the task's model: what
-    the env's steps would cost if everything but MuJoCo's physics were free.
-    """
+    """(env steps per second, bare physics steps per second) of `random_action_rates`."""
     env = spec.make()
-    env.action_space.seed(seed)
-    actions = [env.action_space.sample() for _ in range(steps)]
-    env.reset(seed=seed)
-    env.step(actions[0])  # loads the compiled kernels (start-up, as in `_warm_up`)
-    env.reset(seed=seed)
-    base = env.unwrapped
-    start_state, controls = _copy(base.model, base.data), []
-    env_seconds = physics_seconds = 0.0
-    for k, a in enumerate(actions):
-        start = time.perf_counter()
-        _, _, terminated, truncated, _ = env.step(a)
-        env_seconds += time.perf_counter() - start
-        controls.append(base.data.ctrl.copy())
-        if terminated or truncated or k == steps - 1:
-            physics_seconds += _replay_seconds(base, start_state, controls)
-            start = time.perf_counter()
-            env.reset()
-            env_seconds += time.perf_counter() - start
-            start_state, controls = _copy(base.model, base.data), []
-    env.close()
-    return steps / env_seconds, steps / physics_seconds
-
-
-def _copy(model: mujoco.MjModel, data: mujoco.MjData) -> mujoco.MjData:
-    copy = mujoco.MjData(model)
-    mujoco.mj_copyData(copy, model, data)
-    return copy
-
-
-def _replay_seconds(base, start_state: mujoco.MjData, controls: list[np.ndarray]) -> float:
-    """Wall seconds of bare `mj_step` calls replaying `controls` from `start_state`."""
-    substeps = getattr(base, "n_substeps", None) or getattr(base, "frame_skip", 1)
-    data = _copy(base.model, start_state)
-    start = time.perf_counter()
-    for ctrl in controls:
-        data.ctrl[:] = ctrl
-        for _ in range(substeps):
-            mujoco.mj_step(base.model, data)
-    return time.perf_counter() - start
+    try:
+        return random_action_rates(env, steps, seed)
+    finally:
+        env.close()
 
 
 def main() -> None:

@@ -92,3 +92,50 @@ def per_call_us(fn, *args, repeat: int = 20000) -> float:
             fn(*args)
         batches.append((time.perf_counter() - start) / (repeat // 20))
     return float(np.median(batches) * 1e6)
+
+
+def random_action_rates(env: gym.Env, steps: int, seed: int = 0) -> tuple[float, float]:
+    """(env steps per second, the same steps' bare physics per second) with random actions.
+
+    The physics figure replays each episode's controls from its start state as bare `mj_step`
+    calls (`substeps` per env step), before the next reset can change the task's model: what
+    the env's steps would cost if everything but MuJoCo's physics were free.
+    """
+    env.action_space.seed(seed)
+    actions = [env.action_space.sample() for _ in range(steps)]
+    env.reset(seed=seed)
+    env.step(actions[0])  # loads the compiled kernels (start-up, not stepping)
+    env.reset(seed=seed)
+    base = env.unwrapped
+    start_state, controls = _copy(base.model, base.data), []
+    env_seconds = physics_seconds = 0.0
+    for k, a in enumerate(actions):
+        start = time.perf_counter()
+        _, _, terminated, truncated, _ = env.step(a)
+        env_seconds += time.perf_counter() - start
+        controls.append(base.data.ctrl.copy())
+        if terminated or truncated or k == steps - 1:
+            physics_seconds += _replay_seconds(base, start_state, controls)
+            start = time.perf_counter()
+            env.reset()
+            env_seconds += time.perf_counter() - start
+            start_state, controls = _copy(base.model, base.data), []
+    return steps / env_seconds, steps / physics_seconds
+
+
+def _copy(model: mujoco.MjModel, data: mujoco.MjData) -> mujoco.MjData:
+    copy = mujoco.MjData(model)
+    mujoco.mj_copyData(copy, model, data)
+    return copy
+
+
+def _replay_seconds(base, start_state: mujoco.MjData, controls: list[np.ndarray]) -> float:
+    """Wall seconds of bare `mj_step` calls replaying `controls` from `start_state`."""
+    substeps = getattr(base, "n_substeps", None) or getattr(base, "frame_skip", 1)
+    data = _copy(base.model, start_state)
+    start = time.perf_counter()
+    for ctrl in controls:
+        data.ctrl[:] = ctrl
+        for _ in range(substeps):
+            mujoco.mj_step(base.model, data)
+    return time.perf_counter() - start
