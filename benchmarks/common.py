@@ -45,8 +45,7 @@ def replay_step_rate(env: gym.Env, steps: int, seed: int = 0) -> ReplayRates:
     substeps = getattr(base, "n_substeps", None) or getattr(base, "frame_skip", 1)
     zero = np.zeros(env.action_space.shape, dtype=env.action_space.dtype)
     env.reset(seed=seed)
-    start_state = mujoco.MjData(base.model)
-    mujoco.mj_copyData(start_state, base.model, base.data)
+    start_state = _copy(base.model, base.data)
     controls = np.empty((steps, base.model.nu))
     elapsed = 0.0
     for k in range(steps):
@@ -61,8 +60,7 @@ def replay_step_rate(env: gym.Env, steps: int, seed: int = 0) -> ReplayRates:
     model = base.model
     rates = []
     for skip_sensors in (False, True):
-        data = mujoco.MjData(model)
-        mujoco.mj_copyData(data, model, start_state)
+        data = _copy(model, start_state)
         t0 = time.perf_counter()
         for k in range(n):
             data.ctrl[:] = controls[k]
@@ -116,6 +114,7 @@ def random_action_rates(env: gym.Env, steps: int, seed: int = 0) -> tuple[float,
         controls.append(base.data.ctrl.copy())
         if terminated or truncated or k == steps - 1:
             physics_seconds += _replay_seconds(base, start_state, controls)
+        if terminated or truncated:
             start = time.perf_counter()
             env.reset()
             env_seconds += time.perf_counter() - start
