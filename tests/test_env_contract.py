@@ -197,13 +197,15 @@ def test_non_real_actions_are_refused(env_id, kind):
 def test_tip_over_penalty_is_paid_once_and_termination_sticks(env_id):
     env = gym.make(env_id).unwrapped
     env.reset(seed=0)
+    upright = env.tip_over_cos
     env.tip_over_cos = 2.0  # every pose counts as tipped over
     action = np.zeros(env.action_space.shape)
     _, _, terminated, _, info = env.step(action)
     assert terminated and info["is_tipped_over"] and info["reward_tip_over"] < 0
+    env.tip_over_cos = upright  # the robot stands again: the episode stays ended
     for _ in range(2):
         _, _, terminated, _, info = env.step(action)
-        assert terminated and info["reward_tip_over"] == 0.0
+        assert terminated and info["is_tipped_over"] and info["reward_tip_over"] == 0.0
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
@@ -214,6 +216,20 @@ def test_mujoco_warning_counts_as_instability(env_id):
     obs, reward, terminated, truncated, info = env.step(np.zeros(env.action_space.shape))
     assert info["sim_unstable"] and truncated and not terminated and reward == 0.0
     assert np.all(np.isfinite(obs))
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_a_warning_alone_marks_the_step_unstable(env_id):
+    """A warning counted on a step whose clock advanced truncates the episode too: the check
+    does not rest on the clock alone (the count is set by hand here; MuJoCo itself also resets
+    the state, clock included, when it meets bad values)."""
+    env = gym.make(env_id).unwrapped
+    env.reset(seed=0)
+    env.data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number = 1
+    time_before = env.data.time
+    *_, truncated, info = env.step(np.zeros(env.action_space.shape))
+    assert env.data.time == pytest.approx(time_before + env.control_dt)
+    assert truncated and info["sim_unstable"]
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)

@@ -66,20 +66,35 @@ def test_zero_residual_reproduces_the_analytical_controller(name):
 
 def test_cliff_safety_filter_walks_the_reference_and_hands_over_to_the_recovery():
     """configs/cliff_walk_hybrid.yaml (safety mode): with a zero learned action the env action
-    is the reference gait (zero) while the FASM is at or above ξ_f, the recovery's action while
-    it is overriding; on the paper's cliff the hand-over happens and the robot does not tip."""
+    is the reference gait (zero) while the recovery is not in control, the recovery's action
+    while it is; it takes control when the observed FASM falls below ξ_f and hands back once
+    it is at ξ_f + the release margin again. On the paper's cliff both hand-overs happen and
+    the robot does not tip."""
     name = "cliff_walk_hybrid.yaml"
     settings = load_train_config(CONFIGS / name).hybrid
     assert settings.mode == "safety"
     env = config_env(name)
-    core = HybridCore(env, HybridSettings(mode="safety", scale=settings.scale))
+    core = HybridCore(
+        env,
+        HybridSettings(
+            mode="safety", scale=settings.scale, release_margin_deg=settings.release_margin_deg
+        ),
+    )
+    fasm_at = env.unwrapped.observation_structure["fasm_margin_deg"]
+    xi, release = core.threshold_deg, core.threshold_deg + settings.release_margin_deg
     obs, _ = env.reset(seed=0)
     core.reset()
     recovery, computed = core.base, []
     core.base = lambda o: computed.append(np.asarray(recovery(o), dtype=np.float32)) or computed[-1]
-    overrides = 0
+    overrides = releases = 0
+    in_control = False
     while True:
+        fasm = float(obs[fasm_at][0])
+        expected = fasm < release if in_control else fasm < xi
+        releases += in_control and not expected
         action, override = core(obs, np.zeros(18, dtype=np.float32))
+        assert override == expected, (fasm, in_control)
+        in_control = override
         if override:
             overrides += 1
             np.testing.assert_array_equal(action, np.clip(computed[-1], -1.0, 1.0))
@@ -88,7 +103,7 @@ def test_cliff_safety_filter_walks_the_reference_and_hands_over_to_the_recovery(
         obs, _, terminated, truncated, info = env.step(action)
         if terminated or truncated:
             break
-    assert overrides > 0 and not info["is_tipped_over"]
+    assert overrides > 0 and releases > 0 and not info["is_tipped_over"]
 
 
 def test_controller_is_reset_at_every_env_reset():

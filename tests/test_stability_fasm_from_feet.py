@@ -46,3 +46,19 @@ def test_non_finite_forces_are_a_clear_error():
     forces[2, 2] = np.nan
     with pytest.raises(ValueError, match="NaN"):
         fasm_from_feet(FEET, forces, np.zeros(3), np.ones(6, bool))
+
+
+def test_a_net_moment_about_the_cog_enters_as_n_r():
+    """Foot forces out of balance about the CoG (horizontal pushes on two feet): f_r and n_r are
+    minus the measured wrench about the CoG, and here the moment moves the margin."""
+    cog = np.array([0.3, -0.2, 0.0])
+    forces = static_forces(FEET, cog)
+    forces[0, 1] += 4000.0
+    forces[3, 0] -= 3000.0
+    f_r = -forces.sum(axis=0)
+    n_r = -np.cross(FEET - cog, forces).sum(axis=0)
+    margin, edge = fasm_from_feet(FEET, forces, cog, np.ones(6, bool))
+    expected = fasm(FEET, cog, f_r, n_r)
+    assert margin == pytest.approx(expected.margin_deg, abs=1e-9)
+    assert edge == expected.edge
+    assert abs(margin - fasm(FEET, cog, f_r).margin_deg) > 0.5

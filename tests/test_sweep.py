@@ -288,3 +288,24 @@ def test_sweep_on_a_two_node_loopback_cluster_uses_both_nodes(tmp_path):
     assert [r["status"] for r in rows] == ["finished", "finished"]
     # One CPU per node and per trial: the two trials can only run on different nodes.
     assert len({r["node_id"] for r in rows}) == 2
+
+
+def test_the_best_evaluation_ranks_by_the_metric_then_the_return():
+    """Highest (mode max) or lowest (mode min) metric; a tie goes to the higher return in either
+    mode; a NaN metric ranks last; no finite value at all: no best."""
+    from agents.pipeline.sweep_summary import _best_row
+
+    nan = float("nan")
+    rows = [
+        {"tip_over_rate": 0.2, "eval_mean_reward": 5.0},
+        {"tip_over_rate": 0.8, "eval_mean_reward": 1.0},
+        {"tip_over_rate": 0.8, "eval_mean_reward": 3.0},
+        {"tip_over_rate": 0.2, "eval_mean_reward": 7.0},
+        {"tip_over_rate": nan, "eval_mean_reward": 9.0},
+    ]
+    assert _best_row(rows, "tip_over_rate", "max") is rows[2]
+    assert _best_row(rows, "tip_over_rate", "min") is rows[3]
+    assert _best_row(rows[4:], "tip_over_rate", "min") is rows[4]
+    assert (
+        _best_row([{"tip_over_rate": nan, "eval_mean_reward": nan}], "tip_over_rate", "max") is None
+    )

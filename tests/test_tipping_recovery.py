@@ -234,7 +234,9 @@ def test_state_machine_judges_plans_lands_and_distributes_forces():
     assert d["supported_legs"] == ("LF", "LR", "RM", "RR")
     assert d["recovery_time"] >= d["t_s"] - 0.02
     np.testing.assert_allclose(BODY.feet(joints)[LEG_NAMES.index("RR")], d["foothold"], atol=0.1)
-    # One more period in support: the QP runs and reports planned beside measured forces.
+    # One more period in support: the QP runs again (the landing period's report cleared) and
+    # reports planned beside measured forces.
+    d["qp_status"] = d["planned_forces"] = d["measured_forces"] = None
     forces = _support_forces(joints, np.array([0.2, 0.0, 1.0]), ("LF", "LR", "RM"), weight)
     forces[LEG_NAMES.index("RR")] = [0.0, 0.0, 0.05 * weight]
     controller.step(_reading(joints, forces), nominal, 0.02 * (k + 1))

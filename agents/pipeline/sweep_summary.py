@@ -59,14 +59,15 @@ def trial_dirs(sweep_dir: str | Path) -> list[Path]:
 
 
 def _best_row(rows: list[dict], metric: str, mode: str) -> dict[str, float] | None:
-    """Best evaluation by `metric` (ties broken by the mean return), NaN rows ignored."""
+    """Best evaluation by `metric` (highest with mode "max", lowest with "min"; ties broken by the
+    higher mean return, whichever the mode), NaN values ranked last."""
     sign = 1.0 if mode == "max" else -1.0
 
     def key(row: dict) -> tuple[float, float]:
         value, reward = row[metric], row["eval_mean_reward"]
         return (
             sign * value if np.isfinite(value) else -np.inf,
-            sign * reward if np.isfinite(reward) else -np.inf,
+            reward if np.isfinite(reward) else -np.inf,
         )
 
     rows = [r for r in rows if np.isfinite(r[metric]) or np.isfinite(r["eval_mean_reward"])]
