@@ -62,6 +62,9 @@ class HybridSettings:
         threshold_deg: ξ [deg]; None: ``env.unwrapped.tipping_threshold_deg`` or 20 (an env
             that declares None, judged by another criterion, needs it for the override).
         release_margin_deg: hysteresis [deg]: the override ends when FASM >= ξ + this.
+        override_cost: training only: reward subtracted on every step the override chose the
+            action (`HybridWrapper`; info ``reward_safety_override``), so that the learned
+            policy is paid to keep the robot out of the recovery; 0: off.
     """
 
     mode: Literal["residual", "safety"] = "residual"
@@ -69,6 +72,7 @@ class HybridSettings:
     safety_filter: bool = False
     threshold_deg: float | None = None
     release_margin_deg: float = 5.0
+    override_cost: float = 0.0
 
     def __post_init__(self):
         if self.mode not in MODES:
@@ -79,6 +83,15 @@ class HybridSettings:
             raise ValueError(
                 f"hybrid release_margin_deg must be a finite number >= 0, got "
                 f"{self.release_margin_deg}"
+            )
+        if not np.isfinite(self.override_cost) or self.override_cost < 0:
+            raise ValueError(
+                f"hybrid override_cost must be a finite number >= 0, got {self.override_cost}"
+            )
+        if self.override_cost and not self.overrides:
+            raise ValueError(
+                "hybrid override_cost needs the safety override: set mode=safety or "
+                "safety_filter=true"
             )
         if self.threshold_deg is not None and not np.isfinite(self.threshold_deg):
             raise ValueError(
@@ -175,7 +188,8 @@ class HybridCore:
 class HybridWrapper(gym.Wrapper):
     """The env seen by a learning agent: actions in [-1, 1] combined by `HybridCore`.
 
-    Observations, rewards and termination are the env's. ``info["safety_override"]`` says
+    Observations, rewards and termination are the env's (the reward less
+    ``settings.override_cost`` on the override's steps). ``info["safety_override"]`` says
     whether the analytical controller alone chose the step's action, ``info["hybrid_action"]``
     is the env action that was applied.
     """
@@ -200,6 +214,10 @@ class HybridWrapper(gym.Wrapper):
         obs, reward, terminated, truncated, info = self.env.step(env_action)
         self._obs = obs
         info = {**info, "safety_override": override, "hybrid_action": env_action}
+        cost = self.core.settings.override_cost
+        if cost:
+            info["reward_safety_override"] = -cost if override else 0.0
+            reward = float(reward) + info["reward_safety_override"]
         return obs, reward, terminated, truncated, info
 
 

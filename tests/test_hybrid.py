@@ -268,3 +268,24 @@ def test_env_without_analytical_controller_is_a_clear_error():
             HybridWrapper(env, HybridSettings())
     finally:
         registry.ANALYTICAL_POLICIES["HexapodStewartTilt-v0"] = saved
+
+
+def test_override_cost_is_a_named_reward_term_of_the_overridden_steps():
+    """With ξ = 90° the override acts at every step: the wrapper's reward is the env's less the
+    cost, named in info; with ξ = -90° it never acts and nothing is charged."""
+    rewards = {}
+    for threshold, cost in ((90.0, 0.0), (90.0, 0.3), (-90.0, 0.3)):
+        settings = HybridSettings(mode="safety", threshold_deg=threshold, override_cost=cost)
+        wrapped = HybridWrapper(config_env("cliff_walk_hybrid.yaml"), settings)
+        wrapped.reset(seed=1)
+        steps = [wrapped.step(np.zeros(18, np.float32)) for _ in range(5)]
+        rewards[threshold, cost] = np.array([s[1] for s in steps])
+        overrides = {s[4]["safety_override"] for s in steps}
+        assert overrides == {threshold > 0}
+        charged = [s[4].get("reward_safety_override") for s in steps]
+        assert charged == [(-cost if threshold > 0 else 0.0) if cost else None] * 5
+    np.testing.assert_allclose(rewards[90.0, 0.3], rewards[90.0, 0.0] - 0.3)
+    with pytest.raises(ValueError, match="override_cost needs the safety override"):
+        HybridSettings(override_cost=0.1)
+    with pytest.raises(ValueError, match="override_cost must be a finite number >= 0"):
+        HybridSettings(mode="safety", override_cost=-1.0)
