@@ -129,7 +129,11 @@ def test_ik_rejects_unreachable_points_and_clamps_on_request():
     assert not kin.is_reachable("LM", far)
     q = kin.inverse_kinematics("LM", far, clamp=True)
     assert np.all(kin.within_limits(q))
-    # Clamped pose points the fully stretched leg at the target.
+    # Clamped pose: the femur points from the CTr joint at the target (the leg-plane angle of
+    # eq. 16), the knee stretched as far as its range allows, the foot near the full reach.
+    dxy, dz = np.hypot(*(far - hip)[:2]), (far - hip)[2]
+    assert q[1] == pytest.approx(math.atan2(dz, dxy - ATHENA.l2), abs=5e-4)
+    assert q[2] == pytest.approx(ATHENA.joint_range("FTi")[1])
     p = kin.forward_kinematics("LM", q)
     assert np.linalg.norm(p - far) == pytest.approx(
         np.linalg.norm(far - hip) - ATHENA.l2 - ATHENA.l3 - ATHENA.l4, abs=0.02

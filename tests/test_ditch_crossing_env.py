@@ -102,6 +102,15 @@ def test_static_margin_is_the_support_polygon_margin_of_the_loaded_feet():
             leg for leg, on in zip(LEG_NAMES, loaded, strict=True) if on
         )
     assert {3, 6} <= seen
+    # Random actions soon leave two feet loaded (no polygon: margin 0), where the robot tips.
+    env.reset(seed=0)
+    env.action_space.seed(0)
+    tipping = set()
+    for _ in range(60):
+        info = env.step(env.action_space.sample())[4]
+        assert info["is_tipping"] == (info["static_margin_m"] <= 0)
+        tipping.add(info["is_tipping"])
+    assert tipping == {True, False}
 
 
 def test_nan_action_is_rejected():

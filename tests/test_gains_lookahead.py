@@ -81,11 +81,12 @@ def test_lookahead_applies_the_cheapest_cycle():
     choice = Lookahead(tuple(candidates))(env)
     costs = {g: CycleCost()(play_cycle(env, g)) for g in candidates}
     assert costs[choice] == min(costs.values())
-    # A huge contact cost makes the contact steps decide first.
-    strict = Lookahead(tuple(candidates), CycleCost(contact=1e6))(env)
-    assert play_cycle(env, strict).contact_steps == min(
-        play_cycle(env, g).contact_steps for g in candidates
-    )
+    # The look-ahead minimises the cost it is given: one that pays for footprint clearance
+    # chooses another candidate here, the cheapest by that cost.
+    clearance = CycleCost(clearance=1000.0, margin=0.5)
+    chosen = Lookahead(tuple(candidates), clearance)(env)
+    by_clearance = {g: clearance(play_cycle(env, g)) for g in candidates}
+    assert by_clearance[chosen] == min(by_clearance.values()) and chosen != choice
     assert Lookahead((PAPER,))(env) == PAPER
     with pytest.raises(ValueError, match="at least one"):
         Lookahead(())

@@ -46,6 +46,16 @@ def test_actuator_lengths_reported_and_within_stroke():
     lengths = info["actuator_lengths"]
     assert lengths.shape == (6,) and np.all((lengths >= 9.0) & (lengths <= 14.0))
     assert info["platform_tilt_deg"] > 5.0
+    # The lengths are the tilted platform's: its roll and pitch give the reported tilt, and a
+    # tilt of this size spreads the six lengths apart (all equal when level).
+    roll, pitch, _ = info["platform_rpy"]
+    tilt = np.degrees(np.arccos(np.cos(roll) * np.cos(pitch)))
+    assert tilt == pytest.approx(info["platform_tilt_deg"], abs=0.01)
+    platform = env.unwrapped.platform
+    np.testing.assert_allclose(
+        lengths, platform.actuator_lengths(platform.neutral_position, info["platform_rpy"])
+    )
+    assert np.ptp(lengths) > 0.1
 
 
 def test_unreachable_platform_pose_is_refused():
