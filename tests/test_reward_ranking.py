@@ -138,6 +138,47 @@ def test_every_upright_step_of_random_actions_earns_at_least_zero(env_id):
     env.close()
 
 
+def _worst_heavy_duty(env):
+    env._prev_cog_x = float(env._cog[0]) + 5.0  # walking backwards far beyond the clip
+    env._fasm_deg = -90.0
+    env._power = 1e12
+
+
+def _worst_athena(env):
+    env._prev_cog_x = float(env._cog[0]) + 5.0
+    env._gyro = np.array([100.0, 100.0, 0.0])
+    env._height = env.reference_height + 1.0
+    env._touched = True
+
+
+def _worst_ditch(env):
+    env._prev_cog_x = float(env._cog[0]) + 5.0
+    env._static_margin = -10.0
+    env._power = 1e12
+
+
+@pytest.mark.parametrize(
+    ("env_id", "worst"),
+    [
+        ("HexapodCliffWalk-v0", _worst_heavy_duty),
+        ("HexapodStewartTilt-v0", _worst_heavy_duty),
+        ("HexapodIrregularTerrain-v0", _worst_athena),
+        ("HexapodDitchCrossing-v0", _worst_ditch),
+    ],
+)
+def test_the_alive_term_pays_exactly_the_worst_step_of_an_upright_robot(env_id, worst):
+    """Every bounded term at its worst at once (backwards beyond the speed clip, the margin or
+    steadiness at its floor, the effort cap, a torso contact): the costs sum to minus the
+    ``alive`` term, so no step of a robot that is up is negative and the bound is not loose."""
+    env = gym.make(env_id).unwrapped
+    env.reset(seed=0)
+    worst(env)
+    terms = env._reward_terms(tipped=False)
+    costs = sum(v for k, v in terms.items() if k != "alive")
+    assert terms["alive"] == pytest.approx(env.step_cost_bound()) and terms["alive"] > 0
+    assert costs == pytest.approx(-terms["alive"], rel=1e-9)
+
+
 @pytest.mark.parametrize("cap", [1.0, 1.5])
 def test_the_forward_term_counts_speed_up_to_its_cap(cap):
     env = gym.make("HexapodCliffWalk-v0", reward={"forward_cap": cap}).unwrapped

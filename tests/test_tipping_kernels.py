@@ -1,6 +1,7 @@
 """The recovery controller's compiled kernels (agents.tipping._compiled) against the numpy
 expressions they replaced, bit for bit (random inputs of the controller's sizes)."""
 
+import mujoco
 import numpy as np
 import pytest
 from blas_bits import REASON, numba_blas_matches_numpy
@@ -28,6 +29,10 @@ def test_body_sensing_is_rotation_forces_and_contact_test(seed):
     expected_rot = quat_to_matrix(quat)
     expected_forces = forces_to_body(forces_world, expected_rot)
     assert _same(rot, expected_rot) and _same(forces, expected_forces)
+    # quat_to_matrix runs the same kernel: the rotation itself is checked against MuJoCo's
+    independent = np.zeros(9)
+    mujoco.mju_quat2Mat(independent, quat / np.linalg.norm(quat))
+    np.testing.assert_allclose(rot, independent.reshape(3, 3), atol=1e-12)
     assert _same(loaded, np.add.reduce(expected_forces * expected_forces, axis=1) > contact_sq)
 
 
