@@ -9,7 +9,7 @@ from __future__ import annotations
 
 FASM_MARGIN_DEG = "fasm_margin_deg"
 """Force-angle stability margin from the measured foot forces [deg]; 0 without a support
-polygon (fewer than two loaded feet), never NaN."""
+polygon (fewer than three loaded feet, or collinear ones), never NaN."""
 FASM_EDGE = "fasm_edge"
 """(leg, leg): the support-polygon edge that sets the FASM, or None without a polygon."""
 STANCE_LEGS = "stance_legs"

@@ -172,3 +172,24 @@ def test_references_must_be_among_the_policies(tmp_path, capsys):
         capsys.readouterr().err
     )
     assert not (tmp_path / "rep").exists()
+
+
+def test_success_and_tip_over_differences_say_when_they_are_not_resolved():
+    """3 of 20 tasks apart is within what the draw of 20 tasks could make: the bullet and the
+    verdict say so; 20 of 20 apart is resolved, and the verdict says that too."""
+    ok, tipped = _record(100, 0.0, 1.0, False), _record(10, 0.1, 0.05, True)
+    result = EnvResult("Env-v0", {}, 100, 0.02, [])
+    result.runs = {
+        "zero": PolicyRun("zero", "zero", [ok] * 17 + [tipped] * 3),
+        "ppo:x": PolicyRun("ppo:x", "x", [ok] * 20),
+    }
+    aggs = {n: aggregate(r.episodes) for n, r in result.runs.items()}
+    (bullet,), _ = verdict_lines(result, aggs)
+    assert "success 20/20 vs 17/20 (not resolved: difference [0, 0.3" in bullet
+    assert "tip-overs 0/20 vs 3/20 (not resolved: difference [-0.3" in bullet
+    assert "lead in successes over `zero` is not resolved" in verdict_paragraph(result, aggs)
+    result.runs["zero"] = PolicyRun("zero", "zero", [tipped] * 20)
+    aggs = {n: aggregate(r.episodes) for n, r in result.runs.items()}
+    (bullet,), _ = verdict_lines(result, aggs)
+    assert "success 20/20 vs 0/20," in bullet and "tip-overs 0/20 vs 20/20." in bullet
+    assert "lead in successes over `zero` is resolved" in verdict_paragraph(result, aggs)

@@ -1,8 +1,9 @@
 """A learned gains policy taught by the one-cycle look-ahead (teacher-student distillation).
 
 The look-ahead of `agents.gains_lookahead` beats the paper's fixed blocks gains by a wide margin
-(pitch- and roll-rate medians -25 % and -19 %, 87 % fewer torso-contact steps on the held-out
-beds), but it needs a copy of the simulator. PPO on the privileged terrain scan
+(pitch- and roll-rate medians -20 % and -13 %, 50 % fewer torso-contact steps on the held-out
+beds at the 2.5 ms default step; -25 %, -19 % and 87 % at 2 ms), but it needs a copy of the
+simulator. PPO on the privileged terrain scan
 (``terrain_scan=True``), with ≤ 2 M env steps, did not find those choices: one decision per
 gait cycle gives a few thousand noisy rewards. The look-ahead gives more per decision: the
 outcome of *every* candidate setting from the same state. Learning from it is the

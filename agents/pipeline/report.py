@@ -24,7 +24,7 @@ from . import figures
 from .episode import POWER_KEY
 from .eval_config import DEFAULT_REFERENCES, PPO_PREFIX
 from .evaluation import EnvResult, SuiteResult
-from .summary import STANDARD_METRICS, Verdict, aggregate, compare
+from .summary import STANDARD_METRICS, Verdict, aggregate, compare, paired_difference_interval
 
 
 # --- tables --------------------------------------------------------------------------------
@@ -252,7 +252,30 @@ def verdict_paragraph(result: EnvResult, aggs: dict[str, dict]) -> str:
     ]
     if others:
         parts.append("Then: " + "; ".join(others) + ".")
+        lead = _success_lead(result, leaders[0], ranked[len(leaders)])
+        if lead:
+            parts.append(lead)
     return " ".join(parts)
+
+
+def _success_lead(result: EnvResult, leader: str, runner_up: str) -> str:
+    """Whether the leader's higher success rate over the runner-up is resolved: the paired
+    interval of the difference over the same tasks ("" without a lead or without pairs)."""
+    episodes = {k: run.episodes for n, run in result.runs.items() for k in (n, result.label(n))}
+    if leader not in episodes or runner_up not in episodes:
+        return ""
+    a = [e.success for e in episodes[leader]]
+    b = [e.success for e in episodes[runner_up]]
+    if sum(x for x in a if x is not None) <= sum(x for x in b if x is not None):
+        return ""
+    interval = paired_difference_interval(a, b, pooled=False)
+    if interval is None:
+        return ""
+    word = "not resolved" if interval[0] <= 0.0 <= interval[1] else "resolved"
+    low, high = (_num(x) for x in interval)
+    return (
+        f"The lead in successes over `{runner_up}` is {word} (paired difference [{low}, {high}])."
+    )
 
 
 def _median_min_fasm(a: dict) -> float:
@@ -297,17 +320,22 @@ def _agg_key(reference: str, result: EnvResult, aggs: dict[str, dict]) -> str | 
     return None
 
 
+def _unresolved(v: Verdict | None) -> str:
+    """ " (not resolved: difference [lo, hi])" for a difference whose interval includes 0."""
+    if v is None or v.outcome == "tie" or v.interval is None or v.resolved:
+        return ""
+    return f" (not resolved: difference [{_num(v.interval[0])}, {_num(v.interval[1])}])"
+
+
 def _bullet(name: str, reference: str, aggs: dict[str, dict], verdicts: list[Verdict]) -> str:
     def fmt(vs: list[Verdict]) -> str:
         return "; ".join(
-            f"{v.label} {_num(v.challenger_value)} vs {_num(v.baseline_value)}"
-            + (
-                f" (not resolved: difference [{_num(v.interval[0])}, {_num(v.interval[1])}])"
-                if v.interval is not None and not v.resolved
-                else ""
-            )
+            f"{v.label} {_num(v.challenger_value)} vs {_num(v.baseline_value)}{_unresolved(v)}"
             for v in vs
         )
+
+    def rate(metric: str) -> Verdict | None:
+        return next((v for v in verdicts if v.metric == metric), None)
 
     rates = [v for v in verdicts if v.metric in ("success", "tipped_over")]
     rest = [v for v in verdicts if v not in rates]
@@ -321,12 +349,14 @@ def _bullet(name: str, reference: str, aggs: dict[str, dict], verdicts: list[Ver
     )
     text = (
         f"- `{name}` vs {words}: success "
-        f"{_fraction(_count(a, 'success'))} vs {_fraction(_count(b, 'success'))}, tip-overs "
-        f"{_fraction(_count(a, 'tipped_over'))} vs {_fraction(_count(b, 'tipped_over'))}."
+        f"{_fraction(_count(a, 'success'))} vs {_fraction(_count(b, 'success'))}"
+        f"{_unresolved(rate('success'))}, tip-overs "
+        f"{_fraction(_count(a, 'tipped_over'))} vs {_fraction(_count(b, 'tipped_over'))}"
+        f"{_unresolved(rate('tipped_over'))}."
     )
     if a["tip_overs"] > b["tip_overs"]:
-        text += " It tips over more often, so its episodes are shorter; the figures below are"
-        text += " per second of episode."
+        text += " It tips over more often, so its episodes are shorter; the time-integrated"
+        text += " figures below are per second of episode."
     if better:
         text += f" Better on {fmt(better)}."
     if worse:
@@ -353,8 +383,9 @@ HOW_TO_READ = [
     "- **Success** is the env's `is_success` at the episode's end: the cliff walk: no tip-over "
     "and, at the time limit, at least half the distance the reference gait covers in that time "
     "(the env's min_progress); the Stewart tilt: no tip-over to the time limit; the irregular "
-    "terrain: no tip-over and no torso contact; the ditch crossing: across the ditch with the "
-    "static margin above 0.",
+    "terrain: no tip-over, no torso contact and at least half the distance the gait's nominal "
+    "speed covers in the elapsed time; the ditch crossing: every foot past the far edge and "
+    "loaded, without a tip-over.",
     "- **Comparisons** use rates per episode and, for time-integrated quantities (time below ξ, "
     "distance, energy), values per second of episode (share of time below ξ, speed, mean "
     "power), so a policy whose episodes end early cannot look better on a total. Every policy is "
