@@ -176,7 +176,7 @@ def test_a_gait_cycle_run_trains_per_cycle_and_evaluates_per_step(tmp_path):
     log.Reload()
     assert "rollout/ep_len_mean" in log.Tags()["scalars"]
     lengths = [e.value for e in log.Scalars("rollout/ep_len_mean")]
-    assert lengths and max(lengths) <= 120 / base_ticks_per_cycle() + 1
+    assert lengths and max(lengths) <= 120 / _ticks_per_cycle() + 1
     env = gym.make(ENV_ID, action_mode="gains", task_distribution="test")
     policy = PPOPolicy.load(run / "final", env)
     obs, _ = env.reset(seed=0)
@@ -184,7 +184,7 @@ def test_a_gait_cycle_run_trains_per_cycle_and_evaluates_per_step(tmp_path):
     assert gains.shape == (3,) and ((gains >= 0.0) & (gains <= 1.0)).all()
 
 
-def base_ticks_per_cycle() -> int:
+def _ticks_per_cycle() -> int:
     """Control steps per gait cycle of the irregular terrain's default gait."""
     env = gym.make(ENV_ID, action_mode="gains")
     ticks = env.unwrapped.ticks_per_cycle
