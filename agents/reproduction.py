@@ -847,8 +847,9 @@ NOTES = (
     "shrinks (0.0445 rad/s at 2.5 ms, 0.0391 at 0.625 ms), and at a quarter of the default step "
     "(rows @physics_dt=0.000625) row 9 holds; the change is -2.5 % at 1.25 ms and -8.4 % at "
     "0.3125 ms (benchmarks/README.md, convergence of the default timesteps).",
-    "11, 11b, 11c (blocks): on the calibrated bed (0.25 m blocks, env default; the paper gives no "
-    "size) posture control touches in 1 of seeds 0-3 (5 steps) and on 10 of 20 beds (rows "
+    "11b, 11c, 11@seeds 0-19 (blocks; row 11 itself holds): on the calibrated bed (0.25 m "
+    "blocks, env default; the paper gives no size) posture control touches in 1 of seeds 0-3 "
+    "(5 steps) and on 10 of 20 beds (rows "
     "@seeds 0-19: 673 steps against the simple controller's 15273), so it keeps the torso off "
     "the blocks on most steps, not on all beds. The paper's pitch/roll-rate rises (+54 % / "
     "+82 %) are not reproduced: on seeds 0-3 posture control lowers both rates (-36 % / -30 %), "
@@ -899,7 +900,7 @@ def markdown(rows: list[dict]) -> str:
             f"| {r['unit']} | {r['tolerance']} | {'yes' if r['holds'] else '**no**'} "
             f"| {r['setting']} |"
         )
-    lines += ["", "## Rows that do not hold, and why (measured)", ""]
+    lines += ["", "## Rows that do not hold, and caveats (measured)", ""]
     lines += [f"- {note}" for note in NOTES]
     return "\n".join(lines) + "\n"
 
