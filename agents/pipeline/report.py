@@ -258,10 +258,16 @@ def verdict_paragraph(result: EnvResult, aggs: dict[str, dict]) -> str:
     return " ".join(parts)
 
 
+def _episodes_by_key(result: EnvResult) -> dict[str, list]:
+    """Each policy's episodes under its name as given and as labelled (``{env_id}`` expanded),
+    the two ways `aggs` may be keyed."""
+    return {k: run.episodes for n, run in result.runs.items() for k in (n, result.label(n))}
+
+
 def _success_lead(result: EnvResult, leader: str, runner_up: str) -> str:
     """Whether the leader's higher success rate over the runner-up is resolved: the paired
     interval of the difference over the same tasks ("" without a lead or without pairs)."""
-    episodes = {k: run.episodes for n, run in result.runs.items() for k in (n, result.label(n))}
+    episodes = _episodes_by_key(result)
     if leader not in episodes or runner_up not in episodes:
         return ""
     a = [e.success for e in episodes[leader]]
@@ -293,8 +299,7 @@ def verdict_lines(
     a policy that tips over more often than its reference is said to, first."""
     lines: list[str] = []
     all_verdicts: list[Verdict] = []
-    # `aggs` is keyed by the policy names as given or as labelled (``{env_id}`` expanded).
-    episodes = {k: run.episodes for n, run in result.runs.items() for k in (n, result.label(n))}
+    episodes = _episodes_by_key(result)
     keys = [k for k in (_agg_key(r, result, aggs) for r in references) if k is not None]
     for i, reference in enumerate(keys):
         for name in aggs:
