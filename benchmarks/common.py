@@ -42,7 +42,7 @@ def replay_step_rate(env: gym.Env, steps: int, seed: int = 0) -> ReplayRates:
     so all figures cover identical contact situations.
     """
     base = env.unwrapped
-    substeps = getattr(base, "n_substeps", None) or getattr(base, "frame_skip", 1)
+    substeps = _substeps(base)
     zero = np.zeros(env.action_space.shape, dtype=env.action_space.dtype)
     env.reset(seed=seed)
     start_state = _copy(base.model, base.data)
@@ -56,21 +56,10 @@ def replay_step_rate(env: gym.Env, steps: int, seed: int = 0) -> ReplayRates:
         if terminated or truncated:
             controls = controls[: k + 1]
             break
-    n = len(controls)
-    model = base.model
-    rates = []
-    for skip_sensors in (False, True):
-        data = _copy(model, start_state)
-        t0 = time.perf_counter()
-        for k in range(n):
-            data.ctrl[:] = controls[k]
-            if skip_sensors:  # as the env steps
-                step_sensing_last(model, data, substeps)
-            else:
-                for _ in range(substeps):
-                    mujoco.mj_step(model, data)
-        rates.append(n * substeps / (time.perf_counter() - t0))
-    return ReplayRates(rates[0], rates[1], n * substeps / elapsed)
+    physics_steps = len(controls) * substeps
+    raw = physics_steps / _replay_seconds(base, start_state, controls)
+    sensing_last = physics_steps / _replay_seconds(base, start_state, controls, sensing_last=True)
+    return ReplayRates(raw, sensing_last, physics_steps / elapsed)
 
 
 def env_vs_raw(env_id: str, steps: int = 3000, repeats: int = 3, **kwargs) -> ReplayRates:
@@ -128,13 +117,25 @@ def _copy(model: mujoco.MjModel, data: mujoco.MjData) -> mujoco.MjData:
     return copy
 
 
-def _replay_seconds(base, start_state: mujoco.MjData, controls: list[np.ndarray]) -> float:
-    """Wall seconds of bare `mj_step` calls replaying `controls` from `start_state`."""
-    substeps = getattr(base, "n_substeps", None) or getattr(base, "frame_skip", 1)
-    data = _copy(base.model, start_state)
+def _substeps(base) -> int:
+    """Physics steps per env step: the hexapod envs' `n_substeps`, Gymnasium's `frame_skip`."""
+    return getattr(base, "n_substeps", None) or getattr(base, "frame_skip", 1)
+
+
+def _replay_seconds(
+    base, start_state: mujoco.MjData, controls, sensing_last: bool = False
+) -> float:
+    """Wall seconds of bare `mj_step` calls replaying `controls` (one row per env step) from
+    `start_state`: every sensor at every step (MuJoCo's default, the issues' "raw"), or with
+    `sensing_last` as the hexapod envs step (`step_sensing_last`)."""
+    model, substeps = base.model, _substeps(base)
+    data = _copy(model, start_state)
     start = time.perf_counter()
     for ctrl in controls:
         data.ctrl[:] = ctrl
-        for _ in range(substeps):
-            mujoco.mj_step(base.model, data)
+        if sensing_last:
+            step_sensing_last(model, data, substeps)
+        else:
+            for _ in range(substeps):
+                mujoco.mj_step(model, data)
     return time.perf_counter() - start
