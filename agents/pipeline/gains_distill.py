@@ -423,12 +423,10 @@ def ground_deviation_features(
     heights = rows[:, structure["torso_height"]].reshape(-1)
     features = np.zeros((len(rows), 3))
     for k in range(len(rows)):
-        contact = np.linalg.norm(forces[k], axis=1) > controller.contact_threshold
         feet = feet_closed_form(angles[k], controller.params)
+        contact = controller.in_contact(forces[k])
         _, _, d_pitch, d_roll = controller.ground_deviation(feet, contact, stance)
-        height = heights[k]
-        d_z = height - controller.reference_height if height >= 0 else 0.0
-        features[k] = d_pitch, d_roll, d_z
+        features[k] = d_pitch, d_roll, controller.height_error(heights[k])
     return features
 
 

@@ -434,7 +434,7 @@ class AthenaPostureController:
                 start = self._command.copy()
                 start[:, 2] = measured[:, 2]
         plane_legs, normal, d_pitch, d_roll = self.ground_deviation(start, contact, stance)
-        d_z = height - self.reference_height if np.isfinite(height) and height >= 0 else 0.0
+        d_z = self.height_error(height)
 
         stride = self.stride / 2 if self._phase_index == 0 else self.stride
         rotation = posture_rotation(ka * d_pitch, kb * d_roll)
@@ -476,6 +476,15 @@ class AthenaPostureController:
         normal = fit_plane(feet[list(plane_legs)]).normal
         d_pitch, d_roll = torso_deviation_from_plane(normal)
         return plane_legs, normal, d_pitch, d_roll
+
+    def height_error(self, height: float) -> float:
+        """The torso-height reading minus the standing reference [m] (the Δz that k_z scales);
+        0 without a reading (NaN or negative)."""
+        return height - self.reference_height if np.isfinite(height) and height >= 0 else 0.0
+
+    def in_contact(self, forces: np.ndarray) -> np.ndarray:
+        """(6,) which feet touch: force magnitude above `contact_threshold` [N]."""
+        return _normal_forces(np.asarray(forces, dtype=float)) > self.contact_threshold
 
     def _searches_ground(self) -> bool:
         """Whether the coming phase extends landing legs that found no ground (`GROUND_SEARCH`)."""
