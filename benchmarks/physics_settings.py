@@ -95,6 +95,10 @@ class PhysicsSetting:
     tolerance: float | None = None
     midphase: bool | None = None
     """MuJoCo's collision midphase on or off (None: the env's default, `midphase_pays`)."""
+    armature: tuple[float, float, float] | None = None
+    """The heavy-duty robot's servo armature, its envs' ``joint_armature`` setting (None: the
+    env's default); a model parameter rather than a physics option, swept because a coarser
+    step needs a heavier one (scripts/heavy_duty_armature_probe.py)."""
 
     def __post_init__(self):
         if self.integrator not in INTEGRATORS:
@@ -115,6 +119,8 @@ class PhysicsSetting:
                 parts.append(f"{short} {value:g}")
         if self.midphase is not None:
             parts.append(f"midphase {'on' if self.midphase else 'off'}")
+        if self.armature is not None:
+            parts.append("armature " + "/".join(f"{a:g}" for a in self.armature))
         return ", ".join(parts)
 
     @property
@@ -223,7 +229,14 @@ def setting_kwargs(env_id: str, setting: PhysicsSetting) -> dict:
         kwargs["midphase"] = setting.midphase
     if setting.factor != 1.0:
         kwargs["physics_dt"] = physics_dt_for(env_id, setting.factor)
+    if setting.armature is not None:
+        if env_id not in HEAVY_DUTY_ENVS:
+            raise ValueError(f"armature applies to the heavy-duty envs {HEAVY_DUTY_ENVS} only")
+        kwargs["joint_armature"] = setting.armature
     return kwargs
+
+
+HEAVY_DUTY_ENVS = ("HexapodCliffWalk-v0", "HexapodStewartTilt-v0")
 
 
 def make_env(env_id: str, setting: PhysicsSetting, **kwargs) -> gym.Env:

@@ -24,7 +24,16 @@ from ..robots.heavy_duty.gait import TripodGait, TripodGaitParams
 from ..robots.heavy_duty.model import add_heavy_duty
 from .base import HexapodEnv, JointActionMap
 from .sensors import RobotSensors
-from .settings import SOLVERS, EnvSettings, RewardScales, TaskRanges, choice, number, option
+from .settings import (
+    SOLVERS,
+    EnvSettings,
+    RewardScales,
+    TaskRanges,
+    choice,
+    number,
+    numbers,
+    option,
+)
 
 XI_F_DEG = 20.0
 """Tipping threshold ξ_f of Zhang et al. 2024 §3 [deg]."""
@@ -80,6 +89,14 @@ class HeavyDutySettings(EnvSettings):
     """Settings of the heavy-duty hexapod envs (the scenario envs extend them)."""
 
     reward_class = HeavyDutyRewardScales
+    physics_dt: float = number(0.002, strict=True)
+    """MuJoCo timestep [s]. 2 ms with the servo armature below: every physics-dependent fidelity
+    row of the former 1 ms model holds at about twice its speed (benchmarks/README.md, "The
+    servo armature and the 2 ms step"); the former physics is ``physics_dt=0.001,
+    joint_armature=(20.0, 20.0, 50.0)``."""
+    joint_armature: tuple[float, float, float] = numbers(HeavyDutyParams().joint_armature, size=3)
+    """Servo rotor inertia reflected to the joints (x [kg], leg length [kg], swing [kg·m²]):
+    `HeavyDutyParams.joint_armature`."""
     tipping_threshold_deg: float = number(XI_F_DEG, high=90.0)
     """ξ_f [deg]: FASM below it means the robot is tipping (the paper's judgment threshold)."""
     solver: str = choice("pgs", SOLVERS)
@@ -112,7 +129,7 @@ class HeavyDutyEnv(HexapodEnv):
         )
         self.action_mode = s.action_mode
         self.residual_scale = s.residual_scale
-        self.robot = HeavyDutyParams()
+        self.robot = HeavyDutyParams(joint_armature=s.joint_armature)
         self.gait = TripodGait(self.robot, s.gait)
         self.weights = {
             "forward": s.reward.forward_weight,

@@ -86,7 +86,7 @@ def add_heavy_duty(
             axis=[1, 0, 0],
             range=list(p.j_theta_range),
             damping=p.foot_damping[2],
-            armature=50.0,
+            armature=p.joint_armature[2],
         )
         hip.add_geom(
             type=mujoco.mjtGeom.mjGEOM_BOX,
@@ -104,7 +104,7 @@ def add_heavy_duty(
             axis=[1, 0, 0],
             range=[p.k_x * p.j_x_range[0], p.k_x * p.j_x_range[1]],
             damping=p.foot_damping[0],
-            armature=20.0,
+            armature=p.joint_armature[0],
         )
         carriage.add_geom(
             type=mujoco.mjtGeom.mjGEOM_CAPSULE,
@@ -122,7 +122,7 @@ def add_heavy_duty(
             axis=[0, 0, -1],
             range=[p.k_z * p.j_z_range[0], p.k_z * p.j_z_range[1]],
             damping=p.foot_damping[1],
-            armature=20.0,
+            armature=p.joint_armature[1],
         )
         shank.add_geom(
             type=mujoco.mjtGeom.mjGEOM_CAPSULE,

@@ -67,6 +67,13 @@ class HeavyDutyParams:
     planned foot forces act (Zhang et al. 2024 §4.3)."""
     foot_damping: tuple[float, float, float] = (1.0e5, 1.5e5, 1.0e6)
     """Joint damping at the foot: [N·s/m], [N·s/m], [N·m·s/rad]."""
+    joint_armature: tuple[float, float, float] = (100.0, 100.0, 250.0)
+    """Rotor inertia of each servo reflected to its joint: x [kg], leg length [kg], swing
+    [kg·m²]. The paper gives none. The legs' fastest motions are the servo damping acting on the
+    light legs; this inertia slows them enough for the 2 ms physics step to reproduce what the
+    former model, (20, 20, 50) at 1 ms, does in every physics-dependent fidelity row
+    (scripts/heavy_duty_armature_probe.py; benchmarks/README.md, "The servo armature and the
+    2 ms step")."""
     force_limit: tuple[float, float, float] = (6.0e4, 1.2e5, 2.0e5)
     """Servo force limits at the foot: [N], [N], [N·m]."""
     friction: float = 0.8
