@@ -2,7 +2,7 @@
 
 Targets (issue 2): env/raw ratio >= 0.9 (Gymnasium's Ant-v5 is measured alongside for context),
 FASM <= 20 us per call. The same rates in simulated seconds per wall second (x the model's
-timestep) show what the raw physics alone reaches at the 1 ms step; issue 14's target for the
+timestep) show what the raw physics alone reaches at the robot's step; issue 14's target for the
 cliff (>= 100 with random actions) is judged on a run with random actions (env and its bare
 physics, `common.random_action_rates`). ``--solver-options`` adds raw rates under MuJoCo's
 other solver options (is any of them a factor of 2?). Run:
