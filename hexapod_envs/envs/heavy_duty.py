@@ -91,7 +91,7 @@ class HeavyDutySettings(EnvSettings):
     reward_class = HeavyDutyRewardScales
     physics_dt: float = number(0.002, strict=True)
     """MuJoCo timestep [s]. 2 ms with the servo armature below: every physics-dependent fidelity
-    row of the former 1 ms model holds at about twice its speed (benchmarks/README.md, "The
+    row of the former 1 ms model holds at about 1.8x its speed (benchmarks/README.md, "The
     servo armature and the 2 ms step"); the former physics is ``physics_dt=0.001,
     joint_armature=(20.0, 20.0, 50.0)``."""
     joint_armature: tuple[float, float, float] = numbers(HeavyDutyParams().joint_armature, size=3)
