@@ -72,8 +72,8 @@ class HeavyDutyParams:
     [kg·m²]. The paper gives none. The legs' fastest motions are the servo damping acting on the
     light legs; this inertia slows them enough for the 2 ms physics step to reproduce what the
     former model, (20, 20, 50) at 1 ms, does in every physics-dependent fidelity row
-    (scripts/heavy_duty_armature_probe.py; benchmarks/README.md, "The servo armature and the
-    2 ms step")."""
+    (scripts/heavy_duty_armature_probe.py). Near a cliff's edge the two models differ at finer
+    steps (benchmarks/README.md, "The servo armature and the 2 ms step")."""
     force_limit: tuple[float, float, float] = (6.0e4, 1.2e5, 2.0e5)
     """Servo force limits at the foot: [N], [N], [N·m]."""
     friction: float = 0.8
