@@ -15,9 +15,12 @@ each row against the former model (the first case) by the sweep's own tolerances
 cliff walk with random actions (`physics_settings.sim_rate`).
 
 Measured 2026-11-27 (idle, 2 workers; benchmarks/README.md, "The servo armature and the 2 ms
-step"): at 2 ms, the armature x5 and x6 hold all 10 rows at about 1.8x the former speed; x1
-and x2 lose the cliff's tip-over (and x1 two Stewart cases), x3 and x4 hold the tip-over but
-not the peak tilt after it, x8 overshoots that peak. x5 is the envs' default since.
+step"): on the first 10 rows, at 2 ms the armature x5 and x6 hold every row at about 1.8x the
+former speed; x1 and x2 lose the cliff's tip-over (and x1 two Stewart cases), x3 and x4 hold
+the tip-over but not the peak tilt after it, x8 overshoots that peak. x5 became the envs'
+default. The 11th row, the reference gait's tip-overs on the 20 test cliffs, added afterwards:
+the former model tips on none, x5 on 2, x6 on 3; no pair at 2 ms holds all 11 (x3 fails only
+the peak tilt after the limit).
 
 Run: python scripts/heavy_duty_armature_probe.py [--workers 2] [MS,SLIDE,HINGE ...]
 """

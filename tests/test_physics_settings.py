@@ -77,3 +77,29 @@ def test_finer_timesteps_for_the_convergence_check():
     assert math.isclose(physics_dt_for("HexapodIrregularTerrain-v0", 0.25), 0.05 / 80)
     # x0.3 of 2.5 ms wants 66.7 substeps; ATHENA takes multiples of 5 only: 65 (nearer than 70)
     assert math.isclose(physics_dt_for("HexapodIrregularTerrain-v0", 0.3), 0.05 / 65)
+
+
+def test_heavy_duty_rows_count_the_reference_tip_overs_on_the_test_cliffs():
+    # The test-cliff row counts the episodes (seeds 0-4 in quick mode) that end in a tip-over,
+    # here counted independently from the env's own termination flag.
+    import gymnasium as gym
+    import numpy as np
+
+    from benchmarks.physics_settings import DEFAULT, heavy_duty_fidelity
+
+    rows = heavy_duty_fidelity(DEFAULT, quick=True)
+    assert len({r.name for r in rows}) == len(rows)
+    (cliffs,) = [r for r in rows if "test tasks" in r.name]
+    env = gym.make("HexapodCliffWalk-v0", task_distribution="test")
+    zero = np.zeros(env.action_space.shape, env.action_space.dtype)
+    tipped = 0
+    for seed in range(5):
+        env.reset(seed=seed)
+        for _ in range(1500):
+            _, _, terminated, truncated, _ = env.step(zero)
+            if terminated or truncated:
+                tipped += terminated
+                break
+    env.close()
+    assert not cliffs.failed and cliffs.value == tipped
+    assert cliffs.compare(tipped + 1, tipped) and not cliffs.compare(tipped + 2, tipped)
