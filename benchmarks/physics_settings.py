@@ -231,13 +231,11 @@ def setting_kwargs(env_id: str, setting: PhysicsSetting) -> dict:
     if setting.factor != 1.0:
         kwargs["physics_dt"] = physics_dt_for(env_id, setting.factor)
     if setting.armature is not None:
-        if env_id not in HEAVY_DUTY_ENVS:
-            raise ValueError(f"armature applies to the heavy-duty envs {HEAVY_DUTY_ENVS} only")
+        heavy_duty = [e for e, _ in ROBOTS["heavy-duty"].speed_envs]
+        if env_id not in heavy_duty:
+            raise ValueError(f"armature applies to the heavy-duty envs {heavy_duty} only")
         kwargs["joint_armature"] = setting.armature
     return kwargs
-
-
-HEAVY_DUTY_ENVS = ("HexapodCliffWalk-v0", "HexapodStewartTilt-v0")
 
 
 def make_env(env_id: str, setting: PhysicsSetting, **kwargs) -> gym.Env:
@@ -332,6 +330,12 @@ class Fidelity:
     compare: Callable[[object, object], bool]
     failed: bool = False
     note: str = ""
+
+
+def holds(row: Fidelity, reference) -> bool:
+    """Whether `row` holds against a reference value of the same row: its run did not fail and
+    its value is within the row's tolerance of the reference."""
+    return not row.failed and bool(row.compare(row.value, reference))
 
 
 def within(tol: float) -> Callable[[object, object], bool]:
@@ -700,7 +704,7 @@ def judge(rows: list[dict]) -> None:
         if r["kind"] == "fidelity":
             f, ref = r["fidelity"], reference.get((r["robot"], r["row"]))
             r["reference"] = ref
-            r["holds"] = ref is not None and not f.failed and bool(f.compare(f.value, ref))
+            r["holds"] = ref is not None and holds(f, ref)
 
 
 def speed_score(rows: list[dict], robot: str, setting: PhysicsSetting) -> float:
@@ -715,7 +719,7 @@ def speed_score(rows: list[dict], robot: str, setting: PhysicsSetting) -> float:
 
 
 # --- report ------------------------------------------------------------------------------------
-def _fmt(value) -> str:
+def format_value(value) -> str:
     if isinstance(value, bool):
         return "yes" if value else "no"
     if value is None:
@@ -723,7 +727,7 @@ def _fmt(value) -> str:
     if isinstance(value, float):
         return f"{value:.4g}"
     if isinstance(value, tuple):
-        return "(" + ", ".join(_fmt(v) for v in value) + ")"
+        return "(" + ", ".join(format_value(v) for v in value) + ")"
     return str(value)
 
 
@@ -773,7 +777,7 @@ def report(rows: list[dict], robot: str, settings: list[PhysicsSetting]) -> dict
             f = r["fidelity"]
             note = f"  {f.note}" if f.note else ""
             flag = "holds" if r["holds"] else "FAILS"
-            print(f"    {r['setting'].label:36s} {_fmt(r['value']):>22s}  {flag}{note}")
+            print(f"    {r['setting'].label:36s} {format_value(r['value']):>22s}  {flag}{note}")
     convergence(fid, settings)
     holding = [
         s

@@ -28,12 +28,14 @@ Run: python scripts/heavy_duty_armature_probe.py [--workers 2] [MS,SLIDE,HINGE .
 from __future__ import annotations
 
 import argparse
+import itertools
 import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from benchmarks import physics_settings as ps  # noqa: E402
+from hexapod_envs.envs.heavy_duty import HeavyDutySettings  # noqa: E402
 
 FORMER_ARMATURE = (20.0, 20.0, 50.0)
 """The servo armature (x, leg length, swing) of the model before 2026-11-27."""
@@ -59,7 +61,7 @@ def case_setting(case: tuple[float, float, float]) -> ps.PhysicsSetting:
     armature."""
     dt_ms, slide, hinge = case
     x, z, swing = FORMER_ARMATURE
-    default_ms = ps.make_env(ps.HEAVY_DUTY_ENVS[0], ps.DEFAULT).unwrapped.physics_dt * 1e3
+    default_ms = HeavyDutySettings().physics_dt * 1e3
     return ps.PhysicsSetting(
         factor=dt_ms / default_ms, armature=(x * slide, z * slide, swing * hinge)
     )
@@ -75,17 +77,11 @@ def measure(case: tuple[float, float, float], seconds: float, reference=None) ->
     return {
         "case": case,
         "rows": [
-            (row.name, row.value, ref, not row.failed and row.compare(row.value, ref))
+            (row.name, row.value, ref, ps.holds(row, ref))
             for row, ref in zip(rows, reference, strict=True)
         ],
         "sim_per_wall": rate["sim_per_wall"],
     }
-
-
-def _value(value) -> str:
-    if isinstance(value, tuple):
-        return "(" + ", ".join(_value(v) for v in value) + ")"
-    return f"{value:.2f}" if isinstance(value, float) else str(value)
 
 
 def main() -> None:
@@ -107,12 +103,14 @@ def main() -> None:
     with ProcessPoolExecutor(args.workers) as pool:
         default = pool.submit(measure, cases[0], args.seconds).result()
         values = [value for _, value, _, _ in default["rows"]]
-        rest = pool.map(measure, cases[1:], [args.seconds] * len(cases), [values] * len(cases))
+        rest = pool.map(
+            measure, cases[1:], itertools.repeat(args.seconds), itertools.repeat(values)
+        )
         results = [default, *rest]
     for result in results:
         dt_ms, slide, hinge = result["case"]
         failed = [
-            f"{name}: {_value(value)} (default {_value(ref)})"
+            f"{name}: {ps.format_value(value)} (default {ps.format_value(ref)})"
             for name, value, ref, holds in result["rows"]
             if not holds
         ]
