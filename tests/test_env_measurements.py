@@ -6,7 +6,7 @@ import pytest
 from blas_bits import REASON, numba_blas_matches_numpy
 
 import hexapod_envs  # noqa: F401
-from hexapod_envs.envs._compiled import numpy_sum
+from hexapod_envs.envs._compiled import clip_action, filtered_residual_targets, numpy_sum
 from hexapod_envs.stability import fasm_from_feet, zmp_margin
 from hexapod_envs.stability._geometry import hull_2d, signed_distance_2d
 
@@ -140,3 +140,66 @@ def test_torso_frame_zmp_is_its_numpy_form_to_the_bit():
             env.reset()
     assert margins > 0
     env.close()
+
+
+@pytest.mark.parametrize(
+    "env_id, kwargs",
+    [
+        ("HexapodCliffWalk-v0", {}),
+        ("HexapodStewartTilt-v0", {"action_mode": "joint"}),
+        ("HexapodIrregularTerrain-v0", {"terrain": "blocks"}),
+    ],
+)
+def test_sensor_pieces_of_the_observation_are_the_sensor_accessors(env_id, kwargs):
+    """RobotSensors.write_observation (one compiled call) = the pieces read one by one."""
+    env, base = _seeded_env(env_id, 2, **kwargs)
+    s = base.sensors
+    assert tuple(base.observation_structure)[: len(s.OBSERVED)] == s.OBSERVED
+    for _ in range(40):
+        obs, *_ = env.step(env.action_space.sample())
+        piece = base.observation_layout.unpack(obs)
+        expected = {
+            "joint_pos": s.joint_positions(),
+            "joint_vel": s.joint_velocities(),
+            "foot_force": base._forces.reshape(-1),
+            "foot_contact": base._loaded.astype(float),
+            "fasm_margin_deg": np.array([base._fasm_deg]),
+            "imu_gyro": s.gyro(),
+            "imu_accel": s.accelerometer(),
+            "imu_quat": s.orientation(),
+        }
+        for name, value in expected.items():
+            assert _same(piece[name], value), name
+    env.close()
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64, np.int64])
+def test_clip_action_is_numpys_clip_and_stops_at_non_finite_values(dtype):
+    rng = np.random.default_rng(0)
+    low, high = -np.ones(18), np.linspace(0.5, 2.0, 18)
+    out = np.empty(18)
+    for _ in range(20):
+        action = (3 * rng.normal(size=18)).astype(dtype)
+        assert clip_action(action, low, high, out)
+        expected = np.minimum(np.maximum(action.astype(np.float64), low), high)
+        assert _same(out, expected)
+    if dtype is not np.int64:
+        for bad in (np.nan, np.inf, -np.inf):
+            action = np.zeros(18, dtype=dtype)
+            action[7] = bad
+            assert not clip_action(action, low, high, out)
+
+
+def test_filtered_residual_targets_is_the_numpy_filter_to_the_bit():
+    rng = np.random.default_rng(1)
+    gain, reference = rng.uniform(0.01, 0.2, 18), rng.normal(size=18)
+    actuators = rng.permutation(20)[:18]
+    alpha = 0.2 / 1.2
+    residual, numpy_residual = np.zeros(18), np.zeros(18)
+    ctrl = np.zeros(20)
+    for _ in range(30):
+        action = rng.uniform(-1, 1, 18)
+        filtered_residual_targets(action, gain, alpha, residual, reference, ctrl, actuators)
+        numpy_residual += alpha * (gain * action - numpy_residual)
+        assert _same(residual, numpy_residual)
+        assert _same(ctrl[actuators], reference + numpy_residual)

@@ -9,6 +9,12 @@ call with the same arithmetic in the same order: the rotations are ``np.dot`` ca
 BLAS routine numpy's ``@`` calls (numba binds it through scipy's BLAS; the same bits where the
 two libraries agree, as they do on the machines this was measured on), the power is summed in
 numpy's pairwise order, and the FASM and the static margin are the stability module's kernels.
+`heavy_duty_measure` writes into the caller's buffers rather than returning new arrays.
+
+The rest of a step's Python is compiled the same way where it is element-wise work on a few
+dozen numbers: the action check and clip (:func:`clip_action`), the residual modes' filter and
+servo targets (:func:`filtered_residual_targets`) and the observation's sensor pieces
+(:func:`sensor_observation`), each with numpy's arithmetic (the tests compare them bit for bit).
 """
 
 from __future__ import annotations
@@ -69,17 +75,22 @@ def heavy_duty_measure(
     actuator_velocity,
     actuators,
     contact_force_sq,
+    forces,
+    loaded,
+    cog,
+    feet,
+    power_terms,
 ):
-    """One step's measurements of a heavy-duty hexapod env (see HeavyDutyHexapodEnv._measure).
+    """One step's measurements of a legged robot's env (see `RobotSensors.support`), written
+    into the caller's buffers: foot forces (n, 3) world frame [N], loaded (n,), CoG (3,) [m],
+    and as scratch the feet (n, 3) and the power terms (one per actuator). A foot's force is
+    minus its force sensor's reading (site frame) rotated by its site's orientation.
 
-    Returns (foot forces (n, 3) world frame [N], loaded (n,), CoG (3,) [m], FASM status,
-    margin [deg], edge i, edge j, actuator power Σ|F v| [W]). A foot's force is minus its
-    force sensor's reading (site frame) rotated by its site's orientation.
+    Returns (FASM status, margin [deg], edge i, edge j, actuator power Σ|F v| [W]). Writing
+    into preallocated arrays instead of returning new ones saves the boxing of three arrays
+    per step.
     """
     n = foot_site.shape[0]
-    forces = np.empty((n, 3))
-    feet = np.empty((n, 3))
-    loaded = np.empty(n, dtype=np.bool_)
     local = np.empty(3)
     for i in range(n):
         site = foot_site[i]
@@ -90,10 +101,43 @@ def heavy_duty_measure(
         f0, f1, f2 = -world[0], -world[1], -world[2]
         forces[i, 0], forces[i, 1], forces[i, 2] = f0, f1, f2
         loaded[i] = f0 * f0 + f1 * f1 + f2 * f2 > contact_force_sq
-    cog = subtree_com[torso].copy()
+    for j in range(3):
+        cog[j] = subtree_com[torso, j]
     status, margin, edge_i, edge_j = fasm_from_feet(feet, forces, cog, loaded)
-    power = actuator_power(actuator_force[actuators], actuator_velocity[actuators])
-    return forces, loaded, cog, status, margin, edge_i, edge_j, power
+    for k in range(actuators.shape[0]):
+        a = actuators[k]
+        power_terms[k] = abs(actuator_force[a] * actuator_velocity[a])
+    return status, margin, edge_i, edge_j, numpy_sum(power_terms)
+
+
+@njit(cache=True)
+def sensor_observation(
+    out, actuator_length, actuator_velocity, actuators, forces, loaded, fasm_deg, sensordata, imu
+):
+    """Write the observation's sensor pieces into ``out`` in the order of
+    `RobotSensors.OBSERVED`: joint positions and velocities (``actuators``' lengths and
+    velocities), foot forces (n, 3) row by row, the loaded flags as 0 / 1, the FASM [deg] and
+    the IMU readings at the ``imu`` addresses of ``sensordata`` (gyro, accelerometer,
+    quaternion)."""
+    k = 0
+    for i in range(actuators.shape[0]):
+        out[k] = actuator_length[actuators[i]]
+        k += 1
+    for i in range(actuators.shape[0]):
+        out[k] = actuator_velocity[actuators[i]]
+        k += 1
+    for i in range(forces.shape[0]):
+        for j in range(3):
+            out[k] = forces[i, j]
+            k += 1
+    for i in range(loaded.shape[0]):
+        out[k] = 1.0 if loaded[i] else 0.0
+        k += 1
+    out[k] = fasm_deg
+    k += 1
+    for i in range(imu.shape[0]):
+        out[k] = sensordata[imu[i]]
+        k += 1
 
 
 @njit(cache=True)
@@ -191,3 +235,27 @@ def torso_frame_zmp(site_xpos, foot_site, torso_pos, torso_xmat, forces, loaded,
         zmp[j] = np.dot(normal, column) / total
     status, _, _, margin = zmp_margin(feet[:, 0], feet[:, 1], normal, min_force)
     return zmp, (margin if status == OK else 0.0)
+
+
+@njit(cache=True)
+def clip_action(action, low, high, out):
+    """``out`` = the ``action`` (any real dtype, as float64) clipped to [``low``, ``high``], as
+    ``np.minimum(np.maximum(action, low), high)``; False (``out`` unfinished) at the first NaN or
+    infinite value."""
+    for i in range(action.shape[0]):
+        x = np.float64(action[i])
+        if not np.isfinite(x):
+            return False
+        x = x if x >= low[i] else low[i]
+        out[i] = x if x <= high[i] else high[i]
+    return True
+
+
+@njit(cache=True)
+def filtered_residual_targets(action, gain, alpha, residual, reference, ctrl, actuators):
+    """The residual action modes' servo targets, in numpy's arithmetic: the residual's low-pass
+    ``residual += alpha * (gain * action - residual)`` (in place), then
+    ``ctrl[actuators] = reference + residual``."""
+    for i in range(action.shape[0]):
+        residual[i] += alpha * (gain[i] * action[i] - residual[i])
+        ctrl[actuators[i]] = reference[i] + residual[i]

@@ -22,6 +22,7 @@ from gymnasium import spaces
 from ..robots.heavy_duty import LEG_NAMES, HeavyDutyParams
 from ..robots.heavy_duty.gait import TripodGait, TripodGaitParams
 from ..robots.heavy_duty.model import add_heavy_duty
+from . import _compiled
 from .base import HexapodEnv, JointActionMap
 from .sensors import RobotSensors
 from .settings import (
@@ -159,6 +160,9 @@ class HeavyDutyEnv(HexapodEnv):
             ]
         )
         self._stand_steps = int(round(self.gait.gait.stand_time / self.control_dt))
+        phases = [2 * np.pi * (k / self._steps_per_cycle) for k in range(self._steps_per_cycle)]
+        self._phase_table = [(np.sin(angle), np.cos(angle)) for angle in phases]
+        """(sin, cos) of the gait clock's phase at each control step of a cycle."""
         self._build_model()
 
     # --- model ---------------------------------------------------------------------------
@@ -197,13 +201,6 @@ class HeavyDutyEnv(HexapodEnv):
         """(18,) reference tripod-gait joint targets at the current time."""
         return self._reference_table[self._gait_step()]
 
-    def _ctrl_from_action(self, action: np.ndarray) -> np.ndarray:
-        """Joint targets; MuJoCo clamps them to the servo ranges (ctrlrange)."""
-        if self.action_mode == "joint":
-            return self.action_map.to_joints(action)
-        self._residual += self._filter_alpha * (self._residual_gain * action - self._residual)
-        return self.reference_joints() + self._residual
-
     # --- episode hooks ---------------------------------------------------------------------
     def _initial_joints(self) -> np.ndarray:
         return self._reference_table[0]
@@ -222,9 +219,22 @@ class HeavyDutyEnv(HexapodEnv):
         self._residual = np.zeros(self.action_space.shape)
 
     def _apply_action(self, action: np.ndarray) -> None:
-        ctrl = self._ctrl_from_action(action)
+        """Joint targets from the action (MuJoCo clamps them to the servo ranges, ctrlrange):
+        the mapped action, or the reference gait plus the filtered residual (one compiled
+        call)."""
         self._before_physics()
-        self.data.ctrl[self._act_ids] = ctrl
+        if self.action_mode == "joint":
+            self.data.ctrl[self._act_ids] = self.action_map.to_joints(action)
+        else:
+            _compiled.filtered_residual_targets(
+                action,
+                self._residual_gain,
+                self._filter_alpha,
+                self._residual,
+                self.reference_joints(),
+                self.data.ctrl,
+                self._act_ids,
+            )
 
     def _before_physics(self) -> None:
         """Hook run before each control period's physics (e.g. driving a platform)."""
@@ -288,25 +298,15 @@ class HeavyDutyEnv(HexapodEnv):
     # --- observation, reward, info ----------------------------------------------------------
     def _observation_pieces(self) -> dict:
         # Readers look the sensors up at call time: a task may rebuild the model (and sensors).
-        pieces = {
-            "joint_pos": (18, lambda: self.sensors.joint_positions()),
-            "joint_vel": (18, lambda: self.sensors.joint_velocities()),
-            "foot_force": (18, lambda: self._forces.reshape(-1)),
-            "foot_contact": (6, lambda: self._loaded),
-            "fasm_margin_deg": (1, lambda: self._fasm_deg),
-            "imu_gyro": (3, lambda: self.sensors.gyro()),
-            "imu_accel": (3, lambda: self.sensors.accelerometer()),
-            "imu_quat": (4, lambda: self.sensors.orientation()),
-        }
+        pieces = {"sensors": self._sensor_pieces()}
         if self.walks:
             pieces["gait_phase"] = (3, self._gait_phase)
         return pieces
 
     def _gait_phase(self) -> tuple[float, float, float]:
         """sin, cos of the gait clock's phase, and 1 once walking."""
-        phase = self._gait_step() / self._steps_per_cycle
-        walking = float(self._step_count >= self._stand_steps)
-        return np.sin(2 * np.pi * phase), np.cos(2 * np.pi * phase), walking
+        sin, cos = self._phase_table[self._gait_step()]
+        return sin, cos, float(self._step_count >= self._stand_steps)
 
     def step_cost_bound(self) -> float:
         """The largest cost one step can carry (the sum of the bounded negative parts of the

@@ -722,14 +722,7 @@ class IrregularTerrainEnv(HexapodEnv):
     def _observation_pieces(self) -> dict:
         # Readers look the sensors up at call time: a task may rebuild the model (and sensors).
         pieces = {
-            "joint_pos": (18, lambda: self._joints),
-            "joint_vel": (18, lambda: self.sensors.joint_velocities()),
-            "foot_force": (18, lambda: self._forces.reshape(-1)),
-            "foot_contact": (6, lambda: self._loaded),
-            "fasm_margin_deg": (1, lambda: self._fasm_deg),
-            "imu_gyro": (3, lambda: self._gyro),
-            "imu_accel": (3, lambda: self.sensors.accelerometer()),
-            "imu_quat": (4, lambda: self.sensors.orientation()),
+            "sensors": self._sensor_pieces(),
             "torso_height": (1, lambda: self._height),
             "gait_phase": (3, self._gait_phase),
         }

@@ -2,7 +2,8 @@
 
 Every robot follows the same naming contract (see robots/*/model.py): per leg `L` a force sensor
 `L_foot_force` on site `L_foot`, actuators named after their joints, and IMU sensors `imu_gyro`,
-`imu_accel`, `imu_quat`. Addresses are resolved once; reading is a few array copies.
+`imu_accel`, `imu_quat`. Addresses are resolved once; reading is a few array copies, and the
+per-step measurements and the observation's sensor pieces are one compiled call each.
 """
 
 from __future__ import annotations
@@ -24,7 +25,8 @@ def _sensor_slice(model: mujoco.MjModel, name: str) -> slice:
 
 
 class SupportReading(NamedTuple):
-    """What an env derives from the feet's sensors each step (see RobotSensors.support)."""
+    """What an env derives from the feet's sensors each step (see RobotSensors.support). The
+    arrays are the sensors' buffers, overwritten by the next `support` call: copy to keep."""
 
     forces: np.ndarray
     """(n_legs, 3) ground reaction on each foot, world frame [N]."""
@@ -43,6 +45,19 @@ class SupportReading(NamedTuple):
 class RobotSensors:
     """Reads one robot's sensors from `data` (foot forces in the world frame, SI units)."""
 
+    OBSERVED = (
+        "joint_pos",
+        "joint_vel",
+        "foot_force",
+        "foot_contact",
+        "fasm_margin_deg",
+        "imu_gyro",
+        "imu_accel",
+        "imu_quat",
+    )
+    """The observation pieces `write_observation` fills, in this order (sizes:
+    `observed_sizes`)."""
+
     def __init__(
         self,
         model: mujoco.MjModel,
@@ -60,7 +75,16 @@ class RobotSensors:
         self._gyro = _sensor_slice(model, "imu_gyro")
         self._accel = _sensor_slice(model, "imu_accel")
         self._quat = _sensor_slice(model, "imu_quat")
+        self._imu = np.concatenate(
+            [np.arange(sl.start, sl.stop) for sl in (self._gyro, self._accel, self._quat)]
+        )
         self.torso_id = model.body(torso).id
+        # `support`'s output buffers and scratch, reused every step.
+        self._forces = np.empty((self.n_legs, 3))
+        self._loaded = np.empty(self.n_legs, dtype=bool)
+        self._cog = np.empty(3)
+        self._feet = np.empty((self.n_legs, 3))
+        self._power_terms = np.empty(len(self._act))
 
     # --- encoders -------------------------------------------------------------------------
     def joint_positions(self) -> np.ndarray:
@@ -87,9 +111,11 @@ class RobotSensors:
     def support(self, contact_force_sq: float) -> SupportReading:
         """Foot forces, contacts (|f|² > ``contact_force_sq`` [N²]), CoG, FASM and actuator power
         in one compiled call: the arithmetic of `foot_forces`, `cog`, `foot_positions`,
-        `hexapod_envs.stability.fasm_from_feet` and Σ|F v| (see hexapod_envs.envs._compiled)."""
+        `hexapod_envs.stability.fasm_from_feet` and Σ|F v| (see hexapod_envs.envs._compiled).
+        The reading's arrays are this object's buffers, overwritten by the next call."""
         d = self.data
-        forces, loaded, cog, status, margin, i, j, power = _compiled.heavy_duty_measure(
+        forces, loaded, cog = self._forces, self._loaded, self._cog
+        status, margin, i, j, power = _compiled.heavy_duty_measure(
             d.sensordata,
             self._force_idx,
             d.site_xmat,
@@ -101,11 +127,42 @@ class RobotSensors:
             d.actuator_velocity,
             self._act,
             contact_force_sq,
+            forces,
+            loaded,
+            cog,
+            self._feet,
+            self._power_terms,
         )
         if status == _stability.NOT_FINITE:
             raise ValueError("foot forces, feet or CoG contain NaN or infinite values")
         edge = (i, j) if status == _stability.OK else None
         return SupportReading(forces, loaded, cog, margin, edge, power)
+
+    def observed_sizes(self) -> dict[str, int]:
+        """Name -> size of the observation pieces `write_observation` fills (`OBSERVED`)."""
+        n_act, n_legs = len(self._act), self.n_legs
+        sizes = (n_act, n_act, 3 * n_legs, n_legs, 1, 3, 3, 4)
+        return dict(zip(self.OBSERVED, sizes, strict=True))
+
+    def write_observation(
+        self, out: np.ndarray, forces: np.ndarray, loaded: np.ndarray, fasm_deg: float
+    ) -> None:
+        """Fill `out` (size: the sum of `observed_sizes`) with the `OBSERVED` pieces in one
+        compiled call: `joint_positions`, `joint_velocities`, the measured foot `forces`
+        (n_legs, 3) [N] row by row, the `loaded` flags as 0 / 1, `fasm_deg` and `gyro`,
+        `accelerometer`, `orientation`."""
+        d = self.data
+        _compiled.sensor_observation(
+            out,
+            d.actuator_length,
+            d.actuator_velocity,
+            self._act,
+            forces,
+            loaded,
+            fasm_deg,
+            d.sensordata,
+            self._imu,
+        )
 
     def torso_frame_zmp(
         self, forces: np.ndarray, loaded: np.ndarray, min_force: float = DEFAULT_MIN_FORCE

@@ -519,6 +519,9 @@ class AthenaPostureController:
     def _clamp_unsolved(self, angles: np.ndarray, solved: np.ndarray) -> np.ndarray:
         """The compiled IK's `angles` with each leg it flagged (not `solved`) replaced by
         `LegIK.solve`'s clamped pose; `clamped_legs` names those out of reach."""
+        if solved.all():  # most ticks
+            self.clamped_legs = ()
+            return angles
         clamped = []
         for i in np.flatnonzero(~solved).tolist():
             t2, t3, t4, problem = self._solvers[i](*self._command[i].tolist())
