@@ -454,24 +454,25 @@ class HexapodEnv(gym.Env):
         return obs, reward, terminated, False, self._info(terms, unstable=False)
 
     def _info(self, terms: dict[str, float], unstable: bool) -> dict:
-        """The common info keys (`hexapod_envs.info_keys`) plus the env's `_extra_info`."""
-        legs = self.sensors.legs
-        edge = None
-        if self._fasm_edge is not None:
-            edge = (legs[self._fasm_edge[0]], legs[self._fasm_edge[1]])
-        info = {f"{keys.REWARD_PREFIX}{name}": value for name, value in terms.items()}
-        info[keys.FASM_MARGIN_DEG] = self._fasm_deg
-        info[keys.FASM_EDGE] = edge
-        info[keys.STANCE_LEGS] = tuple(compress(legs, self._loaded.tolist()))
-        info[keys.IS_TIPPING] = self._is_tipping()
-        info[keys.IS_TIPPED_OVER] = self._tipped
-        info[keys.IS_SUCCESS] = self._success and not unstable
-        info[keys.SIM_UNSTABLE] = unstable
-        info[keys.TIME] = self.time
-        info[keys.COG] = self._cog.copy()
-        info[keys.DISTANCE] = float(self._cog[0]) - self._start_cog_x
-        info[keys.TASK] = dict(self.task)
-        info.update(self._extra_info(unstable))
+        """The common info keys (`hexapod_envs.info_keys`) plus the env's `_extra_info`, then
+        the reward terms (``reward_<term>``)."""
+        legs, edge = self.sensors.legs, self._fasm_edge
+        info = {
+            keys.FASM_MARGIN_DEG: self._fasm_deg,
+            keys.FASM_EDGE: None if edge is None else (legs[edge[0]], legs[edge[1]]),
+            keys.STANCE_LEGS: tuple(compress(legs, self._loaded.tolist())),
+            keys.IS_TIPPING: self._is_tipping(),
+            keys.IS_TIPPED_OVER: self._tipped,
+            keys.IS_SUCCESS: self._success and not unstable,
+            keys.SIM_UNSTABLE: unstable,
+            keys.TIME: self._step_count * self.control_dt,
+            keys.COG: self._cog.copy(),
+            keys.DISTANCE: float(self._cog[0]) - self._start_cog_x,
+            keys.TASK: dict(self.task),
+            **self._extra_info(unstable),
+        }
+        for name, value in terms.items():
+            info[keys.REWARD_PREFIX + name] = value
         return info
 
     # --- hooks every env defines ----------------------------------------------------------

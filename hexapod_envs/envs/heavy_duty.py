@@ -161,8 +161,10 @@ class HeavyDutyEnv(HexapodEnv):
         )
         self._stand_steps = int(round(self.gait.gait.stand_time / self.control_dt))
         phases = [2 * np.pi * (k / self._steps_per_cycle) for k in range(self._steps_per_cycle)]
-        self._phase_table = [(np.sin(angle), np.cos(angle)) for angle in phases]
-        """(sin, cos) of the gait clock's phase at each control step of a cycle."""
+        self._phase_table = np.array(
+            [[(np.sin(a), np.cos(a), walking) for a in phases] for walking in (0.0, 1.0)]
+        )
+        """The gait_phase observation [standing / walking, control step of the cycle]."""
         self._build_model()
 
     # --- model ---------------------------------------------------------------------------
@@ -303,10 +305,9 @@ class HeavyDutyEnv(HexapodEnv):
             pieces["gait_phase"] = (3, self._gait_phase)
         return pieces
 
-    def _gait_phase(self) -> tuple[float, float, float]:
+    def _gait_phase(self) -> np.ndarray:
         """sin, cos of the gait clock's phase, and 1 once walking."""
-        sin, cos = self._phase_table[self._gait_step()]
-        return sin, cos, float(self._step_count >= self._stand_steps)
+        return self._phase_table[int(self._step_count >= self._stand_steps), self._gait_step()]
 
     def step_cost_bound(self) -> float:
         """The largest cost one step can carry (the sum of the bounded negative parts of the
