@@ -227,6 +227,40 @@ def test_compiled_tick_is_the_controllers_numpy_tick():
         assert angles.tobytes() == ref_angles.tobytes() and (solved == ref_solved).all()
 
 
+def test_compiled_phase_plan_is_the_controllers_geometry():
+    """phase_plan gives swing_control_points' control points and stance_end_point's end
+    points (as deltas from the start) to the bit, for random start feet, strides, heights,
+    height corrections and posture rotations."""
+    from hexapod_envs.robots.athena._compiled import phase_plan
+    from hexapod_envs.robots.athena.gait import (
+        posture_rotation,
+        stance_end_point,
+        swing_control_points,
+    )
+
+    standing = kin.forward_kinematics_all(np.tile(ATHENA.standing_posture, (6, 1)))
+    rng = np.random.default_rng(5)
+    for k in range(300):
+        swing, stance = (np.array([0, 2, 4]), np.array([1, 3, 5]))[:: 1 if k % 2 else -1]
+        start = standing + rng.normal(scale=0.02, size=(6, 3))
+        stride, height, correction = (
+            rng.uniform(0.01, 0.1),
+            rng.uniform(0.05, 0.2),
+            rng.normal(0, 0.01),
+        )
+        rotation = posture_rotation(*rng.normal(scale=0.1, size=2))
+        points, stance_start, delta = phase_plan(
+            start, swing, stance, stride, height, correction, rotation
+        )
+        expected = np.array(
+            [swing_control_points(start[i], stride, height, correction) for i in swing]
+        )
+        assert points.tobytes() == expected.tobytes()
+        assert stance_start.tobytes() == start[stance].tobytes()
+        ends = np.array([stance_end_point(start[i], stride, correction, rotation) for i in stance])
+        assert delta.tobytes() == (ends - start[stance]).tobytes()
+
+
 def test_compiled_closed_form_is_foot_position_closed_form():
     """feet_closed_form (all six legs, one compiled call) gives eq. (12)'s Python numbers to the
     bit, over the joint ranges and beyond."""

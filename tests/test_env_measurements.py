@@ -6,7 +6,12 @@ import pytest
 from blas_bits import REASON, numba_blas_matches_numpy
 
 import hexapod_envs  # noqa: F401
-from hexapod_envs.envs._compiled import clip_action, filtered_residual_targets, numpy_sum
+from hexapod_envs.envs._compiled import (
+    clip_action,
+    filtered_residual_targets,
+    numpy_sum,
+    offset_targets,
+)
 from hexapod_envs.stability import fasm_from_feet, zmp_margin
 from hexapod_envs.stability._geometry import hull_2d, signed_distance_2d
 
@@ -203,3 +208,17 @@ def test_filtered_residual_targets_is_the_numpy_filter_to_the_bit():
         numpy_residual += alpha * (gain * action - numpy_residual)
         assert _same(residual, numpy_residual)
         assert _same(ctrl[actuators], reference + numpy_residual)
+
+
+def test_offset_targets_is_the_numpy_sum_to_the_bit():
+    rng = np.random.default_rng(2)
+    actuators = rng.permutation(24)[:18]
+    ctrl = np.zeros(24)
+    for _ in range(30):
+        targets, gain, action = (
+            rng.normal(size=(6, 3)),
+            rng.uniform(0, 0.3, 18),
+            rng.uniform(-1, 1, 18),
+        )
+        offset_targets(targets, gain, action, ctrl, actuators)
+        assert _same(ctrl[actuators], targets.reshape(-1) + gain * action)

@@ -12,8 +12,9 @@ numpy's pairwise order, and the FASM and the static margin are the stability mod
 `heavy_duty_measure` writes into the caller's buffers rather than returning new arrays.
 
 The rest of a step's Python is compiled the same way where it is element-wise work on a few
-dozen numbers: the action check and clip (:func:`clip_action`), the residual modes' filter and
-servo targets (:func:`filtered_residual_targets`) and the observation's sensor pieces
+dozen numbers: the action check and clip (:func:`clip_action`), the residual modes' servo
+targets (:func:`filtered_residual_targets` with the heavy-duty envs' filter,
+:func:`offset_targets` on ATHENA's controller) and the observation's sensor pieces
 (:func:`sensor_observation`), each with numpy's arithmetic (the tests compare them bit for bit).
 """
 
@@ -259,3 +260,13 @@ def filtered_residual_targets(action, gain, alpha, residual, reference, ctrl, ac
     for i in range(action.shape[0]):
         residual[i] += alpha * (gain[i] * action[i] - residual[i])
         ctrl[actuators[i]] = reference[i] + residual[i]
+
+
+@njit(cache=True)
+def offset_targets(targets, gain, action, ctrl, actuators):
+    """``ctrl[actuators] = targets + gain * action`` (``targets`` flattened in C order), in
+    numpy's arithmetic: ATHENA's residual mode, the controller's joint targets plus the scaled
+    action."""
+    flat = targets.reshape(-1)
+    for i in range(action.shape[0]):
+        ctrl[actuators[i]] = flat[i] + gain[i] * action[i]

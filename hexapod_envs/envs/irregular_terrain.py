@@ -138,6 +138,7 @@ from ..robots.athena.model import add_athena
 from ..robots.athena.params import ATHENA, LEG_NAMES
 from ..terrain.flat import add_flat
 from ..terrain.irregular import PAPER_FRICTION, add_blocks, add_ramp
+from . import _compiled
 from .base import HexapodEnv, JointActionMap
 from .sensors import RobotSensors
 from .settings import EnvSettings, RewardScales, TaskRanges, choice, number, numbers, option
@@ -584,18 +585,20 @@ class IrregularTerrainEnv(HexapodEnv):
         )
 
     def _apply_action(self, action: np.ndarray) -> None:
-        self.data.ctrl[self._act_ids] = self._ctrl_from_action(action)
-
-    def _ctrl_from_action(self, action: np.ndarray) -> np.ndarray:
+        """The servo targets: the mapped action ("joint"), or the posture controller's targets
+        (plus the scaled action in "residual" mode, one compiled call)."""
+        ctrl = self.data.ctrl
         if self.action_mode == "joint":
-            return self.action_map.to_joints(action)
+            ctrl[self._act_ids] = self.action_map.to_joints(action)
+            return
         if self.gains_due:
             self.controller.set_gains(*action.tolist())
             self._gains_read_for = self.controller.next_phase_index
-        targets = self.controller.step(self._controller_sensors()).reshape(-1)
+        targets = self.controller.step(self._controller_sensors())
         if self.action_mode == "residual":
-            targets = targets + self._residual_gain * action
-        return targets
+            _compiled.offset_targets(targets, self._residual_gain, action, ctrl, self._act_ids)
+        else:
+            ctrl[self._act_ids] = targets.reshape(-1)
 
     def _controller_sensors(self) -> AthenaSensors:
         return AthenaSensors(

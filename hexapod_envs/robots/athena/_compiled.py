@@ -1,6 +1,6 @@
 """ATHENA's six-leg kinematics as compiled calls (private; numba): the IK (`solve_legs`), a
-posture-controller tick (`tick_legs`: its feet and their IK) and eq. (12) for all legs
-(`feet_closed_form`).
+posture-controller tick (`tick_legs`: its feet and their IK), a phase's foot paths
+(`phase_plan`) and eq. (12) for all legs (`feet_closed_form`).
 
 The posture controller solves the IK of all six feet at every control tick (50 ms);
 :func:`solve_legs` is `LegIK.solve`'s usual case (a reachable point inside the joint ranges)
@@ -102,3 +102,38 @@ def feet_closed_form(q, theta1, l1, l2, l3, l4):
         feet[i, 1] = math.sin(t1 + t2) * reach + a1 * math.sin(t1)
         feet[i, 2] = l4 * math.sin(t3 + t4) + l3 * math.sin(t3)
     return feet
+
+
+@njit(cache=True)
+def phase_plan(start, swing, stance, stride, swing_height, height_correction, rotation):
+    """One phase's foot paths from its start feet ``start`` (6, 3) (body frame, m): the
+    ``swing`` rows' Bezier control points (k, 4, 3) (`gait.swing_control_points`: eqs. 20-22
+    and 27) and the ``stance`` rows' start points and straight-line deltas (k, 3) each
+    (`gait.stance_end_point`: eqs. 28-30, p_f = R (p0 + (-stride, 0, k_z Δz)) minus p0), with
+    their arithmetic: element-wise sums and the rotation as a BLAS ``np.dot`` as numpy's ``@``.
+    """
+    offsets = np.array(
+        (
+            (0.0, 0.0, 0.0),
+            (stride / 4, 0.0, swing_height / 3),
+            (3 * stride / 4, 0.0, swing_height / 3),
+            (stride, 0.0, height_correction),
+        )
+    )
+    swing_points = np.empty((swing.shape[0], 4, 3))
+    for k in range(swing.shape[0]):
+        for r in range(4):
+            for j in range(3):
+                swing_points[k, r, j] = start[swing[k], j] + offsets[r, j]
+    shift = np.array((-stride, 0.0, height_correction))
+    stance_start = np.empty((stance.shape[0], 3))
+    stance_delta = np.empty((stance.shape[0], 3))
+    moved = np.empty(3)
+    for k in range(stance.shape[0]):
+        for j in range(3):
+            stance_start[k, j] = start[stance[k], j]
+            moved[j] = start[stance[k], j] + shift[j]
+        end = np.dot(rotation, moved)
+        for j in range(3):
+            stance_delta[k, j] = end[j] - stance_start[k, j]
+    return swing_points, stance_start, stance_delta

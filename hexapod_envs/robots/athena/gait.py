@@ -81,6 +81,10 @@ with k_alpha or k_beta > 0, so that all gains 0 is the paper's simple control; "
 torso up and nothing lowers it again: the torso rides on the tallest blocks)."""
 
 _TRIPOD_INDICES = tuple(tuple(LEG_NAMES.index(leg) for leg in tripod) for tripod in TRIPODS)
+_TRIPOD_ROWS = tuple(np.array(tripod) for tripod in _TRIPOD_INDICES)
+"""The tripods' rows as index arrays (read-only: the phase plans share them)."""
+for _rows in _TRIPOD_ROWS:
+    _rows.flags.writeable = False
 _MIN_TRIANGLE_AREA = 1e-4  # m², a triple of feet closer to collinear gives no usable plane
 
 
@@ -421,7 +425,6 @@ class AthenaPostureController:
     ) -> None:
         self._phase_index += 1
         stance = _TRIPOD_INDICES[(self._phase_index + 1) % 2]
-        swing = _TRIPOD_INDICES[self._phase_index % 2]
         kz, ka, kb = self._gains
         if self.start_from == "commanded":
             start = self._command.copy()
@@ -438,16 +441,13 @@ class AthenaPostureController:
 
         stride = self.stride / 2 if self._phase_index == 0 else self.stride
         rotation = posture_rotation(ka * d_pitch, kb * d_roll)
-        stance_end = [stance_end_point(start[i], stride, kz * d_z, rotation) for i in stance]
-        self._plan = _Plan(
-            swing=np.array(swing),
-            swing_points=np.array(
-                [swing_control_points(start[i], stride, self.swing_height, kz * d_z) for i in swing]
-            ),
-            stance=np.array(stance),
-            stance_start=start[list(stance)],
-            stance_delta=np.array(stance_end) - start[list(stance)],
+        swing_rows = _TRIPOD_ROWS[self._phase_index % 2]
+        stance_rows = _TRIPOD_ROWS[(self._phase_index + 1) % 2]
+        # swing_control_points and stance_end_point of each leg, in one compiled call.
+        swing_points, stance_start, stance_delta = _compiled.phase_plan(
+            start, swing_rows, stance_rows, stride, self.swing_height, kz * d_z, rotation
         )
+        self._plan = _Plan(swing_rows, swing_points, stance_rows, stance_start, stance_delta)
         self._command = start.copy()
         self._estimate = PostureEstimate(
             phase_index=self._phase_index,
