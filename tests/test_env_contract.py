@@ -194,6 +194,31 @@ def test_non_real_actions_are_refused(env_id, kind):
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
+def test_every_real_dtype_and_layout_of_an_action_steps_as_float64(env_id):
+    """Half, single, double and extended floats, integers and strided views give the step of
+    the same values as float64 (clipped into the action space)."""
+    n = gym.make(env_id).action_space.shape[0]
+
+    def first_step(action):
+        env = gym.make(env_id).unwrapped
+        env.reset(seed=0)
+        obs, reward, *_ = env.step(action)
+        return obs, reward, env.data.ctrl.copy()
+
+    def same(a, b):
+        return all(np.array_equal(x, y) for x, y in zip(a, b, strict=True))
+
+    values = np.resize([-3.0, -0.5, 0.0, 0.25, 2.0], n)  # exact in every float dtype
+    double = first_step(values)
+    for dtype in (np.float16, np.float32, np.longdouble):
+        assert same(first_step(values.astype(dtype)), double), dtype
+    assert same(first_step(np.repeat(values, 2)[::2]), double)  # a strided view
+    counts = np.resize([0, 1, 2], n)
+    for dtype in (np.int8, np.uint8, np.int64):
+        assert same(first_step(counts.astype(dtype)), first_step(counts.astype(float))), dtype
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
 def test_tip_over_penalty_is_paid_once_and_termination_sticks(env_id):
     env = gym.make(env_id).unwrapped
     env.reset(seed=0)

@@ -611,6 +611,8 @@ class HexapodEnv(gym.Env):
             raise ValueError(
                 f"action has shape {a.shape}; this env expects {self._action_low.shape}"
             )
+        if a.dtype != np.float32:  # the action space's dtype; the others as float64 (compiled)
+            a = a.astype(np.float64, copy=False)
         if not _compiled.clip_action(a, self._action_low, self._action_high, self._action):
             bad = np.flatnonzero(~np.isfinite(a)).tolist()
             raise ValueError(f"action contains NaN or inf at indices {bad}")
