@@ -4,7 +4,8 @@ Targets (issue 2): env/raw ratio >= 0.9 (Gymnasium's Ant-v5 is measured alongsid
 FASM <= 20 us per call. The same rates in simulated seconds per wall second (x the model's
 timestep) show what the raw physics alone reaches at the robot's step; issue 14's target for the
 cliff (>= 100 with random actions) is judged on a run with random actions (env and its bare
-physics, `common.random_action_rates`). ``--solver-options`` adds raw rates under MuJoCo's
+physics, `common.random_action_rates`); the env's step is profiled piece by piece inside the
+loop (`common.step_profile`). ``--solver-options`` adds raw rates under MuJoCo's
 other solver options (is any of them a factor of 2?). Run:
 python benchmarks/bench_cliff_walk.py [--solver-options]
 """
@@ -26,6 +27,7 @@ from benchmarks.common import (
     ENV_RAW_TARGET,
     env_vs_raw,
     per_call_us,
+    print_step_profile,
     random_action_rates,
     verdict,
 )
@@ -78,6 +80,8 @@ def main(argv: list[str] | None = None) -> None:
         f"random actions ({sim_rate:.1f}: {verdict(sim_rate, SIM_RATE_TARGET)}), env/raw >= "
         f"{ENV_RAW_TARGET} ({cliff_env_raw:.3f}: {verdict(cliff_env_raw, ENV_RAW_TARGET)})"
     )
+
+    print_step_profile("HexapodCliffWalk-v0")
 
     tripod = np.array([[2.4, 1.9, -1.75], [-2.4, 1.9, -1.75], [0.0, -1.9, -1.75]])
     six = np.array([[x, y, -1.75] for y in (1.9, -1.9) for x in (2.4, 0.0, -2.4)])

@@ -6,13 +6,15 @@ controller step time in µs, with issue 14's target (median <= 15 µs) printed b
 (``--posture-only`` runs just that part). The env/raw figure is measured per terrain in each action
 mode (zero actions: in "residual" and "gains" mode the env runs the Coelho et al. 2024 gait with its
 internal controller, in "joint" mode it holds zero targets), and the per-step costs of the
-pieces that the env adds to the physics are timed on their own, so that a shortfall can be
-attributed. Run: python benchmarks/bench_irregular_terrain.py [--posture-only]
+pieces that the env adds to the physics are timed on their own and inside the step loop
+(`common.step_profile`, where they cost more), so that a shortfall can be attributed.
+Run: python benchmarks/bench_irregular_terrain.py [--posture-only]
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 import time
 from pathlib import Path
@@ -23,7 +25,13 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run as a script from anywhere
 
 import hexapod_envs  # noqa: F401
-from benchmarks.common import ENV_RAW_TARGET, env_vs_raw, per_call_us, verdict
+from benchmarks.common import (
+    ENV_RAW_TARGET,
+    env_vs_raw,
+    per_call_us,
+    print_step_profile,
+    verdict,
+)
 from hexapod_envs.robots.athena.gait import AthenaPostureController
 from hexapod_envs.robots.athena.kinematics import leg_ik
 from hexapod_envs.stability import fasm_from_feet
@@ -43,7 +51,14 @@ def controller_step_us(terrain: str = "ramp", steps: int = 2400) -> tuple[float,
     env.reset(seed=0)
     readings = []
     for _ in range(steps):
-        readings.append(base._controller_sensors())
+        sensors = base._controller_sensors()  # its arrays are the env's per-step buffers
+        readings.append(
+            dataclasses.replace(
+                sensors,
+                joint_angles=sensors.joint_angles.copy(),
+                foot_forces=sensors.foot_forces.copy(),
+            )
+        )
         env.step(np.array([0.8, 0.6, 0.0], np.float32))
     ctrl = AthenaPostureController(base.robot, **base.gait_config, kz=0.8, k_alpha=0.6)
     times, starts = [], []
@@ -144,6 +159,8 @@ def main() -> None:
     print_posture_step()
     for name, us in env_piece_costs().items():
         print(f"env per step, {name:34s} {us:6.1f} us")
+    for terrain in ("ramp", "blocks"):
+        print_step_profile(ENV_ID, terrain=terrain)
 
 
 if __name__ == "__main__":

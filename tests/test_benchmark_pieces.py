@@ -11,7 +11,12 @@ import gymnasium as gym  # noqa: E402
 
 import hexapod_envs  # noqa: E402, F401
 from benchmarks.bench_irregular_terrain import env_piece_costs  # noqa: E402
-from benchmarks.common import random_action_rates, replay_step_rate  # noqa: E402
+from benchmarks.common import (  # noqa: E402
+    STEP_PIECES,
+    random_action_rates,
+    replay_step_rate,
+    step_profile,
+)
 
 
 def test_irregular_terrain_env_pieces_run():
@@ -30,3 +35,14 @@ def test_random_action_rates_replay_every_episode():
     with gym.make("HexapodCliffWalk-v0", max_episode_steps=10) as env:
         rates = random_action_rates(env, 15)
     assert len(rates) == 2 and all(math.isfinite(r) and r > 0 for r in rates)
+
+
+def test_step_profile_times_every_hook_of_the_step_and_restores_them():
+    """Every hook HexapodEnv.step calls is timed (a hook the step stopped calling would read
+    0), across an episode's end, and the env's own methods are back afterwards."""
+    with gym.make("HexapodCliffWalk-v0", max_episode_steps=4) as env:
+        profile = step_profile(env, 10)
+        base = env.unwrapped
+        assert not set(STEP_PIECES) & set(vars(base))
+    assert list(profile) == [name.lstrip("_") for name in STEP_PIECES] + ["rest"]
+    assert all(math.isfinite(us) and us > 0 for us in profile.values())
