@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 import pytest
+from blas_bits import REASON, numba_blas_matches_numpy
 
 from hexapod_envs.robots.athena import kinematics as kin
 from hexapod_envs.robots.athena.params import (
@@ -15,6 +16,8 @@ from hexapod_envs.robots.athena.params import (
     PAPER_LEG_NUMBER,
     TRIPODS,
 )
+
+needs_same_blas = pytest.mark.skipif(not numba_blas_matches_numpy(), reason=REASON)
 
 
 def _random_angles(rng, n):
@@ -227,6 +230,7 @@ def test_compiled_tick_is_the_controllers_numpy_tick():
         assert angles.tobytes() == ref_angles.tobytes() and (solved == ref_solved).all()
 
 
+@needs_same_blas
 def test_compiled_phase_plan_is_the_controllers_geometry():
     """phase_plan gives swing_control_points' control points and stance_end_point's end
     points (as deltas from the start) to the bit, for random start feet, strides, heights,

@@ -188,7 +188,16 @@ def test_clip_action_is_numpys_clip_and_stops_at_non_finite_values(dtype):
         assert clip_action(action, low, high, out)
         expected = np.minimum(np.maximum(action.astype(np.float64), low), high)
         assert _same(out, expected)
-    if dtype is not np.int64:
+    if dtype is not np.int64:  # signed zeros at zero bounds (the gains mode's [0, 1])
+        zeros = np.array([0.0, -0.0])
+        for low, high in ((zeros, zeros + 1), (zeros - 1, zeros), (zeros[::-1], zeros[::-1])):
+            for action in (np.array([-0.0, 0.0]), np.array([0.0, -0.0])):
+                action = action.astype(dtype)
+                out = np.empty(2)
+                assert clip_action(action, low, high, out)
+                expected = np.minimum(np.maximum(action.astype(np.float64), low), high)
+                assert _same(out, expected), (action, low, high)
+        low, high, out = -np.ones(18), np.ones(18), np.empty(18)
         for bad in (np.nan, np.inf, -np.inf):
             action = np.zeros(18, dtype=dtype)
             action[7] = bad

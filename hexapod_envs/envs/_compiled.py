@@ -247,8 +247,8 @@ def clip_action(action, low, high, out):
         x = np.float64(action[i])
         if not np.isfinite(x):
             return False
-        x = x if x >= low[i] else low[i]
-        out[i] = x if x <= high[i] else high[i]
+        x = x if x > low[i] else low[i]  # strict, as numpy's: a signed zero at a zero bound
+        out[i] = x if x < high[i] else high[i]  # takes the bound's sign
     return True
 
 

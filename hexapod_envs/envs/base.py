@@ -465,7 +465,7 @@ class HexapodEnv(gym.Env):
             keys.IS_TIPPED_OVER: self._tipped,
             keys.IS_SUCCESS: self._success and not unstable,
             keys.SIM_UNSTABLE: unstable,
-            keys.TIME: self._step_count * self.control_dt,
+            keys.TIME: self.time,
             keys.COG: self._cog.copy(),
             keys.DISTANCE: float(self._cog[0]) - self._start_cog_x,
             keys.TASK: dict(self.task),

@@ -165,6 +165,7 @@ class HeavyDutyEnv(HexapodEnv):
             [[(np.sin(a), np.cos(a), walking) for a in phases] for walking in (0.0, 1.0)]
         )
         """The gait_phase observation [standing / walking, control step of the cycle]."""
+        self._phase_table.flags.writeable = False
         self._build_model()
 
     # --- model ---------------------------------------------------------------------------

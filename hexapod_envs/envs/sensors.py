@@ -112,7 +112,9 @@ class RobotSensors:
         """Foot forces, contacts (|f|² > ``contact_force_sq`` [N²]), CoG, FASM and actuator power
         in one compiled call: the arithmetic of `foot_forces`, `cog`, `foot_positions`,
         `hexapod_envs.stability.fasm_from_feet` and Σ|F v| (see hexapod_envs.envs._compiled).
-        The reading's arrays are this object's buffers, overwritten by the next call."""
+        The reading's arrays are this object's buffers, overwritten by the next call; they are
+        also the env's measurements of the step, so a call from outside the env's step (with
+        another threshold, say) changes what the env reports for that step."""
         d = self.data
         forces, loaded, cog = self._forces, self._loaded, self._cog
         status, margin, i, j, power = _compiled.heavy_duty_measure(

@@ -82,9 +82,7 @@ torso up and nothing lowers it again: the torso rides on the tallest blocks)."""
 
 _TRIPOD_INDICES = tuple(tuple(LEG_NAMES.index(leg) for leg in tripod) for tripod in TRIPODS)
 _TRIPOD_ROWS = tuple(np.array(tripod) for tripod in _TRIPOD_INDICES)
-"""The tripods' rows as index arrays (read-only: the phase plans share them)."""
-for _rows in _TRIPOD_ROWS:
-    _rows.flags.writeable = False
+"""The tripods' rows as index arrays, shared by the phase plans (never written)."""
 _MIN_TRIANGLE_AREA = 1e-4  # m², a triple of feet closer to collinear gives no usable plane
 
 
