@@ -181,27 +181,27 @@ def test_compiled_hypot_is_cpythons():
 
 
 def test_compiled_six_leg_ik_is_leg_ik_solve():
-    """solve_legs gives LegIK.solve's angles to the bit where it solves, and flags exactly the
-    points LegIK.solve reports a problem for (out of reach, behind the hip, out of range)."""
+    """solve_legs gives LegIK.solve's angles to the bit, the clamped poses included, and flags
+    exactly the points LegIK.solve reports a problem for (out of reach, behind the hip, out of
+    range)."""
     from hexapod_envs.robots.athena._compiled import solve_legs
 
     iks = [kin.leg_ik(leg) for leg in LEG_NAMES]
     constants = np.array([ik.packed_constants for ik in iks])
     rng = np.random.default_rng(7)
     standing = kin.forward_kinematics_all(np.tile(ATHENA.standing_posture, (6, 1)))
-    flagged = solved = 0
+    flagged = solved = unreachable = 0
     for _ in range(400):
         feet = standing + rng.normal(scale=rng.choice([0.01, 0.05, 0.2]), size=(6, 3))
         angles, ok = solve_legs(constants, feet)
         for i, ik in enumerate(iks):
             t2, t3, t4, problem = ik.solve(*feet[i].tolist())
             assert ok[i] == (problem is None)
-            if problem is None:
-                assert angles[i].tolist() == [t2, t3, t4]
-                solved += 1
-            else:
-                flagged += 1
-    assert solved > 1000 and flagged > 100
+            assert angles[i].tobytes() == np.array([t2, t3, t4]).tobytes()
+            solved += problem is None
+            flagged += problem is not None
+            unreachable += problem is not None and "out of reach" in problem
+    assert solved > 1000 and flagged > 100 and unreachable > 50
 
 
 def test_compiled_tick_is_the_controllers_numpy_tick():

@@ -9,8 +9,8 @@ for the six legs at once, with the same operations in the same order. ``math.ata
 (CPython computes it with its own correctly rounded algorithm, libm's ``hypot`` differs in the
 last bit for about 0.3 % of inputs), so the IK uses
 :func:`hexapod_envs.stability._compiled.cpython_hypot`, which reproduces CPython's. A leg that
-is out of reach or outside a joint range is flagged, and the caller asks `LegIK.solve` for its
-clamped pose and the message.
+is out of reach or outside a joint range is flagged, with `LegIK.solve`'s clamped pose (its
+message is `LegIK.solve`'s to give).
 """
 
 from __future__ import annotations
@@ -30,11 +30,13 @@ def _wrap(angle):
 
 @njit(cache=True)
 def solve_legs(constants, feet):
-    """(joint angles (6, 3) [rad], solved (6,)) for body-frame feet (6, 3) [m].
+    """(joint angles (6, 3) [rad], solved (6,)) for body-frame feet (6, 3) [m]: `LegIK.solve`
+    for the six legs, its angles to the bit.
 
     ``constants`` (6, 18) holds each leg's `LegIK.packed_constants`. ``solved[i]`` is False where
-    `LegIK.solve` would report a problem (out of reach, or a joint range exceeded by more than
-    1e-9 rad); that row's angles are then to be replaced by its clamped pose.
+    `LegIK.solve` reports a problem (out of reach, or a joint range exceeded by more than
+    1e-9 rad); that row then holds its nearest pose, as `LegIK.solve` clamps it (the distance
+    to the reachable annulus, the angles to the joint ranges).
     """
     n = feet.shape[0]
     angles = np.empty((n, 3))
@@ -50,20 +52,42 @@ def solve_legs(constants, feet):
             t2, horizontal = _wrap(t2 + math.pi), -horizontal  # foot behind the hip
         rho, zz = horizontal - l2, dz
         s = cpython_hypot(rho, zz)
-        solved[i] = s_low <= s <= s_high
-        if not solved[i]:
-            angles[i, 0] = angles[i, 1] = angles[i, 2] = math.nan
-            continue
+        reachable = s_low <= s <= s_high
+        if not reachable:  # LegIK.solve's nearest point of the reachable annulus
+            s_new = _python_min(_python_max(s, abs(l3 - l4) + 1e-9), l3 + l4 - 1e-9)
+            if s > 0:
+                rho, zz = rho * s_new / s, zz * s_new / s
+            else:
+                rho, zz = s_new, 0.0
+            s = s_new
         c4 = (s * s - l3_sq - l4_sq) / two_l3_l4  # eqs. (17)-(18), knee up
         t4 = -math.acos(c4 if -1.0 <= c4 <= 1.0 else min(1.0, max(-1.0, c4)))
         t3 = _wrap(math.atan2(zz, rho) - math.atan2(l4 * math.sin(t4), l3 + l4 * math.cos(t4)))
-        angles[i, 0], angles[i, 1], angles[i, 2] = t2, t3, t4
         solved[i] = (
-            lo2 - 1e-9 <= t2 <= hi2 + 1e-9
+            reachable
+            and lo2 - 1e-9 <= t2 <= hi2 + 1e-9
             and lo3 - 1e-9 <= t3 <= hi3 + 1e-9
             and lo4 - 1e-9 <= t4 <= hi4 + 1e-9
         )
+        if not solved[i]:
+            t2 = _python_min(_python_max(t2, lo2), hi2)
+            t3 = _python_min(_python_max(t3, lo3), hi3)
+            t4 = _python_min(_python_max(t4, lo4), hi4)
+        angles[i, 0], angles[i, 1], angles[i, 2] = t2, t3, t4
     return angles, solved
+
+
+@njit(cache=True)
+def _python_max(a, b):
+    """CPython's ``max(a, b)`` of two floats: ``a`` unless ``b`` is greater (ties keep ``a``,
+    which decides the sign of a zero)."""
+    return b if b > a else a
+
+
+@njit(cache=True)
+def _python_min(a, b):
+    """CPython's ``min(a, b)`` of two floats: ``a`` unless ``b`` is smaller."""
+    return b if b < a else a
 
 
 @njit(cache=True)

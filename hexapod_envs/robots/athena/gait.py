@@ -293,9 +293,7 @@ class AthenaPostureController:
         self.start_from = start_from
         self.ground_search = ground_search
         self.rng = rng
-        self._iks = [leg_ik(leg, params) for leg in LEG_NAMES]
-        self._solvers = [ik.solve for ik in self._iks]  # bound once
-        self._ik_constants = np.array([ik.packed_constants for ik in self._iks])
+        self._ik_constants = np.array([leg_ik(leg, params).packed_constants for leg in LEG_NAMES])
         self._gains = _checked_gains(kz, k_alpha, k_beta)
         self.reset()
 
@@ -416,7 +414,7 @@ class AthenaPostureController:
             plan.stance_delta,
         )
         self._tick = (self._tick + 1) % self.ticks_per_phase
-        return self._clamp_unsolved(angles, solved)
+        return self._note_clamped(angles, solved)
 
     def _begin_phase(
         self, q: np.ndarray, contact: np.ndarray, forces: np.ndarray, height: float
@@ -512,21 +510,12 @@ class AthenaPostureController:
         """IK of the commanded feet; unreachable points get the nearest reachable pose. The six
         legs are solved in one compiled call (`_compiled.solve_legs`, `LegIK.solve`'s
         arithmetic)."""
-        return self._clamp_unsolved(*_compiled.solve_legs(self._ik_constants, self._command))
+        return self._note_clamped(*_compiled.solve_legs(self._ik_constants, self._command))
 
-    def _clamp_unsolved(self, angles: np.ndarray, solved: np.ndarray) -> np.ndarray:
-        """The compiled IK's `angles` with each leg it flagged (not `solved`) replaced by
-        `LegIK.solve`'s clamped pose; `clamped_legs` names those out of reach."""
-        if solved.all():  # most ticks
-            self.clamped_legs = ()
-            return angles
-        clamped = []
-        for i in np.flatnonzero(~solved).tolist():
-            t2, t3, t4, problem = self._solvers[i](*self._command[i].tolist())
-            angles[i] = (t2, t3, t4)
-            if problem is not None:
-                clamped.append(LEG_NAMES[i])
-        self.clamped_legs = tuple(clamped)
+    def _note_clamped(self, angles: np.ndarray, solved: np.ndarray) -> np.ndarray:
+        """The compiled IK's `angles` (a leg it could not solve holds `LegIK.solve`'s clamped
+        pose); `clamped_legs` names those legs."""
+        self.clamped_legs = () if solved.all() else tuple(itertools.compress(LEG_NAMES, ~solved))
         return angles
 
 

@@ -10,8 +10,8 @@ eq. (18)'s pi + acos(...) is the same angle modulo 2 pi).
 All positions are in the body frame (x forward, y left, z up, origin at the torso centre), in m;
 angles are the DH joint angles theta_2 (TC), theta_3 (CTr), theta_4 (FTi) in rad. Per-robot
 arrays have shape (6, 3): rows in `LEG_NAMES` order, columns (TC, CTr, FTi) or (x, y, z). The
-posture controller solves all six legs per tick with `_compiled.solve_legs`: `LegIK.solve`'s
-reachable case compiled (the same bits); a leg it flags goes through `LegIK.solve`.
+posture controller solves all six legs per tick with `_compiled.solve_legs`: `LegIK.solve`
+compiled (the same bits, the clamped poses included; the messages are `LegIK.solve`'s).
 """
 
 from __future__ import annotations
