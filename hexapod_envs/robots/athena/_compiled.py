@@ -3,8 +3,8 @@ posture-controller tick (`tick_legs`: its feet and their IK), a phase's foot pat
 (`phase_plan`) and eq. (12) for all legs (`feet_closed_form`).
 
 The posture controller solves the IK of all six feet at every control tick (50 ms);
-:func:`solve_legs` is `LegIK.solve`'s usual case (a reachable point inside the joint ranges)
-for the six legs at once, with the same operations in the same order. ``math.atan2``, ``sin``,
+:func:`solve_legs` is `LegIK.solve` for the six legs at once, with the same operations in the
+same order. ``math.atan2``, ``sin``,
 ``cos`` and ``acos`` are the C library's in CPython and in numba alike; ``math.hypot`` is not
 (CPython computes it with its own correctly rounded algorithm, libm's ``hypot`` differs in the
 last bit for about 0.3 % of inputs), so the IK uses
