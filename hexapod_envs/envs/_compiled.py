@@ -80,11 +80,10 @@ def heavy_duty_measure(
     loaded,
     cog,
     feet,
-    power_terms,
 ):
     """One step's measurements of a legged robot's env (see `RobotSensors.support`), written
     into the caller's buffers: foot forces (n, 3) world frame [N], loaded (n,), CoG (3,) [m],
-    and as scratch the feet (n, 3) and the power terms (one per actuator). A foot's force is
+    and as scratch the feet (n, 3). A foot's force is
     minus its force sensor's reading (site frame) rotated by its site's orientation.
 
     Returns (FASM status, margin [deg], edge i, edge j, actuator power Σ|F v| [W]). Writing
@@ -105,10 +104,8 @@ def heavy_duty_measure(
     for j in range(3):
         cog[j] = subtree_com[torso, j]
     status, margin, edge_i, edge_j = fasm_from_feet(feet, forces, cog, loaded)
-    for k in range(actuators.shape[0]):
-        a = actuators[k]
-        power_terms[k] = abs(actuator_force[a] * actuator_velocity[a])
-    return status, margin, edge_i, edge_j, numpy_sum(power_terms)
+    power = actuator_power(actuator_force[actuators], actuator_velocity[actuators])
+    return status, margin, edge_i, edge_j, power
 
 
 @njit(cache=True)

@@ -84,7 +84,6 @@ class RobotSensors:
         self._loaded = np.empty(self.n_legs, dtype=bool)
         self._cog = np.empty(3)
         self._feet = np.empty((self.n_legs, 3))
-        self._power_terms = np.empty(len(self._act))
 
     # --- encoders -------------------------------------------------------------------------
     def joint_positions(self) -> np.ndarray:
@@ -133,7 +132,6 @@ class RobotSensors:
             loaded,
             cog,
             self._feet,
-            self._power_terms,
         )
         if status == _stability.NOT_FINITE:
             raise ValueError("foot forces, feet or CoG contain NaN or infinite values")
