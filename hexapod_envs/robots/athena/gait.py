@@ -420,7 +420,8 @@ class AthenaPostureController:
         self, q: np.ndarray, contact: np.ndarray, forces: np.ndarray, height: float
     ) -> None:
         self._phase_index += 1
-        stance = _TRIPOD_INDICES[(self._phase_index + 1) % 2]
+        stance_tripod = (self._phase_index + 1) % 2  # the other tripod swings
+        stance = _TRIPOD_INDICES[stance_tripod]
         kz, ka, kb = self._gains
         if self.start_from == "commanded":
             start = self._command.copy()
@@ -437,8 +438,7 @@ class AthenaPostureController:
 
         stride = self.stride / 2 if self._phase_index == 0 else self.stride
         rotation = posture_rotation(ka * d_pitch, kb * d_roll)
-        swing_rows = _TRIPOD_ROWS[self._phase_index % 2]
-        stance_rows = _TRIPOD_ROWS[(self._phase_index + 1) % 2]
+        swing_rows, stance_rows = _TRIPOD_ROWS[1 - stance_tripod], _TRIPOD_ROWS[stance_tripod]
         # swing_control_points and stance_end_point of each leg, in one compiled call.
         swing_points, stance_start, stance_delta = _compiled.phase_plan(
             start, swing_rows, stance_rows, stride, self.swing_height, kz * d_z, rotation
