@@ -340,6 +340,34 @@ def test_torso_contact_is_detected_and_penalised():
     assert infos[-1]["torso_clearance"] < 0.005
 
 
+def test_torso_contact_between_sensor_evaluations_matches_the_sensor():
+    """The env evaluates its sensors once per control period but looks for torso contact
+    every 10 ms: each check must agree with the `torso_contact` sensor evaluated at that moment
+    (replayed here on a copy stepping with every sensor on), also when the torso touches only
+    between the period's sensor evaluations."""
+    env = gym.make(ENV_ID, terrain="blocks", action_mode="joint")
+    env.reset(seed=0)
+    base = env.unwrapped
+    up = base.action_map.to_action(np.tile([0.0, 1.4, -1.5 * math.pi / 2], 6)).astype(np.float32)
+    rng = np.random.default_rng(0)
+    sensor = base.model.sensor(base.handles.torso_contact_sensor).adr[0]
+    chunk = base.n_substeps // 5
+    only_between = 0
+    for k in range(25):  # torso dropped onto the bed, then lifted off by random joint targets
+        replay = mujoco.MjData(base.model)
+        mujoco.mj_copyData(replay, base.model, base.data)
+        info = env.step(up if k < 15 else rng.uniform(-1, 1, 18).astype(np.float32))[-1]
+        replay.ctrl[:] = base.data.ctrl
+        checks = []
+        for _ in range(5):
+            mujoco.mj_step(base.model, replay, nstep=chunk)
+            checks.append(replay.sensordata[sensor] > 0)
+        np.testing.assert_array_equal(replay.qpos, base.data.qpos)
+        assert info["torso_contact"] == any(checks), k
+        only_between += any(checks) and not checks[-1]
+    assert only_between >= 1
+
+
 def test_unstable_simulation_truncates_with_a_flag():
     env = gym.make(ENV_ID, terrain="flat")
     env.reset(seed=0)

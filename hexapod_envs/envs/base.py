@@ -35,6 +35,7 @@ __all__ = [
     "TaskDescription",
     "check_choice",
     "step_sensing_last",
+    "step_without_sensors",
 ]
 
 _SENSORS_OFF = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
@@ -49,15 +50,20 @@ def step_sensing_last(model: mujoco.MjModel, data: mujoco.MjData, nstep: int) ->
     dynamics pass, ATHENA's rangefinders cast rays) cost 5-10 % of a physics step.
     """
     if nstep > 1:
-        opt = model.opt
-        flags = opt.disableflags
-        opt.disableflags = flags | _SENSORS_OFF
-        try:
-            mujoco.mj_step(model, data, nstep=nstep - 1)
-        finally:
-            opt.disableflags = flags
+        step_without_sensors(model, data, nstep - 1)
         nstep = 1
     mujoco.mj_step(model, data, nstep=nstep)
+
+
+def step_without_sensors(model: mujoco.MjModel, data: mujoco.MjData, nstep: int) -> None:
+    """`nstep` MuJoCo steps with the sensors disabled (`data.sensordata` keeps its values)."""
+    opt = model.opt
+    flags = opt.disableflags
+    opt.disableflags = flags | _SENSORS_OFF
+    try:
+        mujoco.mj_step(model, data, nstep=nstep)
+    finally:
+        opt.disableflags = flags
 
 
 DEFAULT_CAMERA = {"distance": 14.0, "elevation": -20.0, "azimuth": 135.0, "trackbodyid": 1}
