@@ -555,7 +555,7 @@ class HexapodEnv(gym.Env):
 
     def _is_tipped_over(self) -> bool:
         """True when the body's up axis leans more than ``tip_over_angle_deg`` from vertical."""
-        return bool(self.data.xmat[self.sensors.torso_id, 8] < self.tip_over_cos)
+        return self.sensors.tilt_cos() < self.tip_over_cos
 
     def _is_tipping(self) -> bool:
         """The stability criterion fails: FASM below the robot's ξ."""

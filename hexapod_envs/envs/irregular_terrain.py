@@ -659,7 +659,7 @@ class IrregularTerrainEnv(HexapodEnv):
         (privileged: uses the terrain model and the true pose; for evaluation only)."""
         x, y, z = self.sensors.torso_position().tolist()
         ground = 0.0 if self.terrain_info is None else self.terrain_info.height_at(x, y)
-        bottom = z - self._torso_half_height * float(self.data.xmat[self.sensors.torso_id, 8])
+        bottom = z - self._torso_half_height * self.sensors.tilt_cos()
         return float(bottom - ground)
 
     def torso_footprint_clearance(self) -> float:
@@ -669,8 +669,7 @@ class IrregularTerrainEnv(HexapodEnv):
         below its centre: on 6 held-out block beds all 928 torso-contact steps fell in gait
         cycles whose footprint clearance dropped below 1 cm, 819 of them in cycles whose
         clearance below the centre stayed at 4 cm or more."""
-        pos = self.data.xpos[self.sensors.torso_id]
-        rot = self.data.xmat[self.sensors.torso_id].reshape(3, 3)
+        pos, rot = self.sensors.torso_position(), self.sensors.torso_rotation()
         points = pos[:, None] + rot @ self._footprint
         return float(np.min(points[2] - self._ground(points[0], points[1])))
 

@@ -8,6 +8,7 @@ per-step measurements and the observation's sensor pieces are one compiled call 
 
 from __future__ import annotations
 
+import copy
 from typing import NamedTuple
 
 import mujoco
@@ -84,17 +85,53 @@ class RobotSensors:
         self._loaded = np.empty(self.n_legs, dtype=bool)
         self._cog = np.empty(3)
         self._feet = np.empty((self.n_legs, 3))
+        self._bind_views()
+
+    _VIEWS = (
+        "_sensordata",
+        "_site_xmat",
+        "_site_xpos",
+        "_subtree_com",
+        "_actuator_length",
+        "_actuator_velocity",
+        "_actuator_force",
+        "_torso_xpos",
+        "_torso_xmat",
+    )
+
+    def _bind_views(self) -> None:
+        """Views of `data`'s arrays that the compiled calls read, built once: MjData's buffers
+        never move, and building a view per call costs more than some calls' arithmetic."""
+        d = self.data
+        self._sensordata = d.sensordata
+        self._site_xmat, self._site_xpos = d.site_xmat, d.site_xpos
+        self._subtree_com = d.subtree_com
+        self._actuator_length = d.actuator_length
+        self._actuator_velocity = d.actuator_velocity
+        self._actuator_force = d.actuator_force
+        self._torso_xpos, self._torso_xmat = d.xpos[self.torso_id], d.xmat[self.torso_id]
+
+    def __deepcopy__(self, memo: dict) -> RobotSensors:
+        """A copy reading the copied data (`copy.deepcopy` would turn the views into arrays of
+        their own, frozen at the copy's moment)."""
+        new = type(self).__new__(type(self))
+        memo[id(self)] = new
+        for key, value in self.__dict__.items():
+            if key not in self._VIEWS:
+                new.__dict__[key] = copy.deepcopy(value, memo)
+        new._bind_views()
+        return new
 
     # --- encoders -------------------------------------------------------------------------
     def joint_positions(self) -> np.ndarray:
         """Actuator-side joint positions (the robot's joint units), actuator order."""
-        return self.data.actuator_length[self._act]
+        return self._actuator_length[self._act]
 
     def joint_velocities(self) -> np.ndarray:
-        return self.data.actuator_velocity[self._act]
+        return self._actuator_velocity[self._act]
 
     def actuator_forces(self) -> np.ndarray:
-        return self.data.actuator_force[self._act]
+        return self._actuator_force[self._act]
 
     # --- feet -----------------------------------------------------------------------------
     def foot_forces(self) -> np.ndarray:
@@ -103,8 +140,8 @@ class RobotSensors:
         MuJoCo's force sensor reports, in the site frame, the force the parent exerts on the foot
         body; with a light foot that is minus the ground reaction.
         """
-        local = self.data.sensordata[self._force_idx]
-        rot = self.data.site_xmat[self._foot_site].reshape(-1, 3, 3)
+        local = self._sensordata[self._force_idx]
+        rot = self._site_xmat[self._foot_site].reshape(-1, 3, 3)
         return -(rot @ local[:, :, None])[:, :, 0]
 
     def support(self, contact_force_sq: float) -> SupportReading:
@@ -114,18 +151,17 @@ class RobotSensors:
         The reading's arrays are this object's buffers, overwritten by the next call; they are
         also the env's measurements of the step, so a call from outside the env's step (with
         another threshold, say) changes what the env reports for that step."""
-        d = self.data
         forces, loaded, cog = self._forces, self._loaded, self._cog
         status, margin, i, j, power = _compiled.heavy_duty_measure(
-            d.sensordata,
+            self._sensordata,
             self._force_idx,
-            d.site_xmat,
-            d.site_xpos,
+            self._site_xmat,
+            self._site_xpos,
             self._foot_site,
-            d.subtree_com,
+            self._subtree_com,
             self.torso_id,
-            d.actuator_force,
-            d.actuator_velocity,
+            self._actuator_force,
+            self._actuator_velocity,
             self._act,
             contact_force_sq,
             forces,
@@ -151,16 +187,15 @@ class RobotSensors:
         compiled call: `joint_positions`, `joint_velocities`, the measured foot `forces`
         (n_legs, 3) [N] row by row, the `loaded` flags as 0 / 1, `fasm_deg` and `gyro`,
         `accelerometer`, `orientation`."""
-        d = self.data
         _compiled.sensor_observation(
             out,
-            d.actuator_length,
-            d.actuator_velocity,
+            self._actuator_length,
+            self._actuator_velocity,
             self._act,
             forces,
             loaded,
             fasm_deg,
-            d.sensordata,
+            self._sensordata,
             self._imu,
         )
 
@@ -173,12 +208,11 @@ class RobotSensors:
         (clipped at 0). One compiled call with the arithmetic of
         ``(foot_positions() - torso_position()) @ torso_rotation()`` and
         `hexapod_envs.stability.zmp_margin`; NaN and 0 without a loaded foot."""
-        d = self.data
         return _compiled.torso_frame_zmp(
-            d.site_xpos,
+            self._site_xpos,
             self._foot_site,
-            d.xpos[self.torso_id],
-            d.xmat[self.torso_id],
+            self._torso_xpos,
+            self._torso_xmat,
             forces,
             loaded,
             min_force,
@@ -186,27 +220,31 @@ class RobotSensors:
 
     def foot_positions(self) -> np.ndarray:
         """(n_legs, 3) foot (sole) points in the world frame [m] (FK of the encoders + IMU)."""
-        return self.data.site_xpos[self._foot_site]
+        return self._site_xpos[self._foot_site]
 
     # --- body -----------------------------------------------------------------------------
     def gyro(self) -> np.ndarray:
-        return self.data.sensordata[self._gyro]
+        return self._sensordata[self._gyro]
 
     def accelerometer(self) -> np.ndarray:
-        return self.data.sensordata[self._accel]
+        return self._sensordata[self._accel]
 
     def orientation(self) -> np.ndarray:
         """Torso orientation quaternion (w, x, y, z), world frame."""
-        return self.data.sensordata[self._quat]
+        return self._sensordata[self._quat]
 
     def torso_rotation(self) -> np.ndarray:
         """3x3 rotation matrix body -> world."""
-        return self.data.xmat[self.torso_id].reshape(3, 3)
+        return self._torso_xmat.reshape(3, 3)
+
+    def tilt_cos(self) -> float:
+        """Cosine of the torso's tilt from vertical: the world z component of its up axis."""
+        return float(self._torso_xmat[8])
 
     def cog(self) -> np.ndarray:
         """Whole-robot centre of gravity, world frame [m]: what the kinematic model computes from
         the known link masses and the encoders."""
-        return self.data.subtree_com[self.torso_id]
+        return self._subtree_com[self.torso_id]
 
     def torso_position(self) -> np.ndarray:
-        return self.data.xpos[self.torso_id]
+        return self._torso_xpos
