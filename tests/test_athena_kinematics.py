@@ -275,3 +275,30 @@ def test_compiled_closed_form_is_foot_position_closed_form():
         assert kin.feet_closed_form(q).tobytes() == np.array(expected).tobytes()
     with pytest.raises(ValueError, match=r"shape \(6, 3\)"):
         kin.feet_closed_form(np.zeros((5, 3)))
+
+
+def test_compiled_plane_triples_are_the_controllers_comprehension():
+    """plane_triples lists the triples of contact legs with a usable triangle in
+    itertools.combinations order, each area `triangle_area_xy`'s to the bit, for random feet
+    (some near-collinear triples among them) and every contact pattern."""
+    import itertools
+
+    from hexapod_envs.robots.athena._compiled import plane_triples
+    from hexapod_envs.robots.athena.gait import triangle_area_xy
+
+    rng = np.random.default_rng(5)
+    standing = kin.forward_kinematics_all(np.tile(ATHENA.standing_posture, (6, 1)))
+    rejected = 0
+    for k in range(300):
+        feet = standing + rng.normal(scale=0.02, size=(6, 3))
+        if k % 3 == 0:  # legs 0, 2, 4 on one line in x-y (up to 1 mm)
+            feet[[2, 4], 1] = feet[0, 1] + rng.normal(scale=0.001, size=2)
+        contact = rng.uniform(size=6) < 0.7
+        legs = [int(i) for i in np.flatnonzero(contact)]
+        areas = {t: triangle_area_xy(feet[list(t)]) for t in itertools.combinations(legs, 3)}
+        expected = [t for t, area in areas.items() if area > 1e-4]
+        rejected += len(areas) - len(expected)
+        triples, got = plane_triples(feet, contact, 1e-4)
+        assert [tuple(t) for t in triples.tolist()] == expected
+        assert got.tobytes() == np.array([areas[t] for t in expected], dtype=float).tobytes()
+    assert rejected > 10

@@ -1,6 +1,7 @@
 """ATHENA's six-leg kinematics as compiled calls (private; numba): the IK (`solve_legs`), a
 posture-controller tick (`tick_legs`: its feet and their IK), a phase's foot paths
-(`phase_plan`) and eq. (12) for all legs (`feet_closed_form`).
+(`phase_plan`), eq. (12) for all legs (`feet_closed_form`) and the candidate ground-plane
+triples of a phase start (`plane_triples`).
 
 The posture controller solves the IK of all six feet at every control tick (50 ms);
 :func:`solve_legs` is `LegIK.solve` for the six legs at once, with the same operations in the
@@ -161,3 +162,29 @@ def phase_plan(start, swing, stance, stride, swing_height, height_correction, ro
         for j in range(3):
             stance_delta[k, j] = end[j] - stance_start[k, j]
     return swing_points, stance_start, stance_delta
+
+
+@njit(cache=True)
+def plane_triples(feet, contact, min_area):
+    """The triples of feet in ``contact`` (6,) whose x-y support triangle is larger than
+    ``min_area`` [m²]: (leg indices (k, 3), areas (k,)), in ``itertools.combinations`` order of
+    the contact legs. Each area is `gait.triangle_area_xy` of the body-frame ``feet`` (6, 3)
+    [m], the same operations in the same order."""
+    legs = np.flatnonzero(contact)
+    n = legs.size
+    triples = np.empty((max(n * (n - 1) * (n - 2) // 6, 0), 3), dtype=np.int64)
+    areas = np.empty(triples.shape[0])
+    k = 0
+    for a in range(n):
+        for b in range(a + 1, n):
+            for c in range(b + 1, n):
+                i, j, m = legs[a], legs[b], legs[c]
+                cross = (feet[j, 0] - feet[i, 0]) * (feet[m, 1] - feet[i, 1]) - (
+                    feet[j, 1] - feet[i, 1]
+                ) * (feet[m, 0] - feet[i, 0])
+                area = 0.5 * abs(cross)
+                if area > min_area:
+                    triples[k, 0], triples[k, 1], triples[k, 2] = i, j, m
+                    areas[k] = area
+                    k += 1
+    return triples[:k], areas[:k]

@@ -56,7 +56,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...checks import check_number
-from ...stability.plane_fit import fit_plane
+from ...stability.plane_fit import fit_plane, plane_normal
 from . import _compiled
 from .kinematics import feet_closed_form, forward_kinematics_all, leg_ik
 from .params import ATHENA, LEG_NAMES, TRIPODS, AthenaParams
@@ -466,10 +466,14 @@ class AthenaPostureController:
         plane through three of the body-frame `feet` (6, 3) [m] in `contact` (the `stance`
         tripod when all of it touches) and the torso's deviation from it; without a usable
         triple, no plane: legs (), normal (0, 0, 1), no deviation."""
+        feet, contact = np.asarray(feet, dtype=float), np.asarray(contact, dtype=bool)
         plane_legs = self._choose_plane_legs(feet, contact, stance)
         if not plane_legs:
             return (), np.array([0.0, 0.0, 1.0]), 0.0, 0.0
-        normal = fit_plane(feet[list(plane_legs)]).normal
+        points = feet[list(plane_legs)]
+        normal = plane_normal(points)
+        if normal is None:  # a degenerate stance tripod: fit_plane says why
+            normal = fit_plane(points).normal
         d_pitch, d_roll = torso_deviation_from_plane(normal)
         return plane_legs, normal, d_pitch, d_roll
 
@@ -494,17 +498,13 @@ class AthenaPostureController:
         """Indices of the three feet that define the ground plane (eq. 24), () if none."""
         if self.rng is None and all(contact[i] for i in stance):
             return tuple(stance)
-        in_contact = [int(i) for i in np.flatnonzero(contact)]
-        triples = [
-            t
-            for t in itertools.combinations(in_contact, 3)
-            if triangle_area_xy(feet[list(t)]) > _MIN_TRIANGLE_AREA
-        ]
-        if not triples:
+        # Every triple of contact legs with a usable triangle (`triangle_area_xy`), compiled.
+        triples, areas = _compiled.plane_triples(feet, contact, _MIN_TRIANGLE_AREA)
+        if not len(areas):
             return ()
         if self.rng is not None:
-            return triples[int(self.rng.integers(len(triples)))]
-        return max(triples, key=lambda t: triangle_area_xy(feet[list(t)]))
+            return tuple(triples[int(self.rng.integers(len(areas)))].tolist())
+        return tuple(triples[int(np.argmax(areas))].tolist())  # the first of the largest
 
     def _joint_targets(self) -> np.ndarray:
         """IK of the commanded feet; unreachable points get the nearest reachable pose. The six
