@@ -594,13 +594,17 @@ class IrregularTerrainEnv(HexapodEnv):
         if self.gains_due:
             self.controller.set_gains(*action.tolist())
             self._gains_read_for = self.controller.next_phase_index
-        targets = self.controller.step(self._controller_sensors())
+        targets = self.controller.step_readings(
+            self._joints.reshape(6, 3), self._forces, self._height
+        )
         if self.action_mode == "residual":
             _compiled.offset_targets(targets, self._residual_gain, action, ctrl, self._act_ids)
         else:
             ctrl[self._act_ids] = targets.reshape(-1)
 
     def _controller_sensors(self) -> AthenaSensors:
+        """The readings the posture controller gets at this step (`_apply_action` hands them
+        over without the dataclass, `AthenaPostureController.step_readings`)."""
         return AthenaSensors(
             joint_angles=self._joints.reshape(6, 3),
             foot_forces=self._forces,

@@ -2,8 +2,9 @@
 
 Every robot follows the same naming contract (see robots/*/model.py): per leg `L` a force sensor
 `L_foot_force` on site `L_foot`, actuators named after their joints, and IMU sensors `imu_gyro`,
-`imu_accel`, `imu_quat`. Addresses are resolved once; reading is a few array copies, and the
-per-step measurements and the observation's sensor pieces are one compiled call each.
+`imu_accel`, `imu_quat`. Addresses and views of the data's arrays are resolved once; reading
+is a few array copies, and the per-step measurements and the observation's sensor pieces are
+one compiled call each.
 """
 
 from __future__ import annotations

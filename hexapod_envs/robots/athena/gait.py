@@ -381,7 +381,12 @@ class AthenaPostureController:
     # ----- the control tick ----------------------------------------------------------------
     def step(self, sensors: AthenaSensors) -> np.ndarray:
         """One control tick: (6, 3) joint-angle targets from the current sensor readings."""
-        q, forces, height = _checked_sensors(sensors)
+        return self.step_readings(*_checked_sensors(sensors))
+
+    def step_readings(self, q: np.ndarray, forces: np.ndarray, height: float) -> np.ndarray:
+        """`step` on readings already in the checked form, for a caller that makes them so at
+        every tick (the env): joint angles ``q`` (6, 3) [rad] and foot ``forces`` (6,) or (6, 3)
+        [N] as float64 arrays, the torso ``height`` [m] a float. Nothing is checked here."""
         if self._tick == 0:  # forces only matter at a phase start
             forces = _normal_forces(forces)
             contact = forces > self.contact_threshold
