@@ -164,6 +164,8 @@ class StewartTiltEnv(HeavyDutyEnv):
         self.hold_depth = s.hold_depth
         self._max_tilt_arg = s.max_tilt_deg
         self.platform = DEFAULT_PLATFORM
+        self._platform_centre = self.platform.neutral_position  # read-only: never moves
+        self._platform_centre.flags.writeable = False
         self.task_ranges = {"train": s.train_ranges, "test": s.test_ranges}
         super()._setup()
         self._hold = self._hold_posture(STANCES[self.stance_name])  # set per episode at reset
@@ -342,7 +344,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         """Command the tilt rate that carries the platform to tilt_at(t + dt) within the period."""
         t = self.time
         rate = (self.tilt_at(t + self.control_dt) - self.tilt_at(t)) / self.control_dt
-        roll_rate, pitch_rate, _ = self._rpy(rate)
+        roll_rate, pitch_rate = rate * self.axis[0], rate * self.axis[1]  # `_rpy(rate)`
         self.data.ctrl[self._platform_act] = (pitch_rate, roll_rate)
 
     # --- stability, termination, reward ---------------------------------------------------
@@ -351,7 +353,7 @@ class StewartTiltEnv(HeavyDutyEnv):
 
     def _is_tipped_over(self) -> bool:
         """Tipped when the body leans more than tip_over_angle_deg relative to the platform."""
-        body_up = self.data.xmat[self.sensors.torso_id].reshape(3, 3)[:, 2]
+        body_up = self.sensors.torso_rotation()[:, 2]
         return bool(body_up @ self._platform_up() < self.tip_over_cos)
 
     def _measure(self) -> None:
@@ -377,7 +379,7 @@ class StewartTiltEnv(HeavyDutyEnv):
             "stance": self.stance,
             "platform_tilt_deg": float(np.degrees(np.arccos(min(1.0, self._platform_up()[2])))),
             "platform_rpy": rpy,
-            "actuator_lengths": self.platform.actuator_lengths(self.platform.neutral_position, rpy),
+            "actuator_lengths": self.platform.actuator_lengths(self._platform_centre, rpy),
             "adjustment_leg": self._adjustment_leg,
             "recovery_time": self._recovery_time,
         }

@@ -39,7 +39,7 @@ AXIS_NAMES: dict[str, tuple[float, float, float]] = {
 
 def rpy_matrix(rpy) -> np.ndarray:
     """Rotation matrix R = Rz(yaw) Ry(pitch) Rx(roll) from (roll, pitch, yaw) [rad]."""
-    roll, pitch, yaw = (float(a) for a in np.asarray(rpy, dtype=float).reshape(3))
+    roll, pitch, yaw = np.asarray(rpy, dtype=float).reshape(3).tolist()
     cr, sr = math.cos(roll), math.sin(roll)
     cp, sp = math.cos(pitch), math.sin(pitch)
     cy, sy = math.cos(yaw), math.sin(yaw)
@@ -122,7 +122,7 @@ class StewartPlatform:
     def lengths_for_rotation(self, position, rotation: np.ndarray) -> np.ndarray:
         """(6,) actuator lengths ‖p + R a_i - b_i‖ [m]."""
         legs = self.joint_positions(position, rotation) - self.base_joints
-        return np.linalg.norm(legs, axis=1)
+        return np.sqrt(np.add.reduce(legs * legs, axis=1))  # np.linalg.norm's, without its checks
 
     def actuator_lengths(self, position, rpy) -> np.ndarray:
         """(6,) actuator lengths [m] for the platform centre at ``position`` (base frame, m) and
