@@ -231,3 +231,23 @@ def test_offset_targets_is_the_numpy_sum_to_the_bit():
         )
         offset_targets(targets, gain, action, ctrl, actuators)
         assert _same(ctrl[actuators], targets.reshape(-1) + gain * action)
+
+
+@needs_same_blas
+def test_stewart_actuator_lengths_are_the_platforms_to_the_bit():
+    """The tilt env's compiled actuator lengths are StewartPlatform.actuator_lengths' numbers
+    for random poses about every axis, level and yawed ones among them."""
+    from hexapod_envs.envs._compiled import stewart_actuator_lengths
+    from hexapod_envs.terrain.stewart_kinematics import DEFAULT_PLATFORM as platform
+
+    rng = np.random.default_rng(4)
+    centre = platform.neutral_position
+    for k in range(500):
+        rpy = rng.uniform(-0.8, 0.8, 3) * (1.0, 1.0, k % 2)
+        if k % 50 == 0:
+            rpy[:] = 0.0
+        expected = platform.actuator_lengths(centre, rpy)
+        got = stewart_actuator_lengths(
+            platform.base_joints, platform.platform_joints, centre, *rpy.tolist()
+        )
+        assert got.tobytes() == expected.tobytes(), rpy

@@ -53,6 +53,7 @@ import numpy as np
 from ..robots.heavy_duty import LEG_NAMES, TRIPODS, joints_for_foot, within_limits
 from ..terrain.stewart import add_stewart_platform
 from ..terrain.stewart_kinematics import DEFAULT_PLATFORM
+from . import _compiled
 from .heavy_duty import (
     TEST_PAYLOAD,
     TRAIN_PAYLOAD,
@@ -370,8 +371,11 @@ class StewartTiltEnv(HeavyDutyEnv):
                     break
 
     def _extra_info(self, unstable: bool) -> dict:
-        rpy = np.array(
-            [self.data.qpos[self._platform_qpos[1]], self.data.qpos[self._platform_qpos[0]], 0.0]
+        pitch, roll = self.data.qpos[self._platform_qpos].tolist()
+        rpy = np.array([roll, pitch, 0.0])
+        platform = self.platform  # its actuator lengths, in one compiled call:
+        lengths = _compiled.stewart_actuator_lengths(
+            platform.base_joints, platform.platform_joints, self._platform_centre, roll, pitch, 0.0
         )
         return {
             **super()._extra_info(unstable),
@@ -379,7 +383,7 @@ class StewartTiltEnv(HeavyDutyEnv):
             "stance": self.stance,
             "platform_tilt_deg": float(np.degrees(np.arccos(min(1.0, self._platform_up()[2])))),
             "platform_rpy": rpy,
-            "actuator_lengths": self.platform.actuator_lengths(self._platform_centre, rpy),
+            "actuator_lengths": lengths,
             "adjustment_leg": self._adjustment_leg,
             "recovery_time": self._recovery_time,
         }
