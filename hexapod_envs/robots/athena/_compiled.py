@@ -172,7 +172,7 @@ def plane_triples(feet, contact, min_area):
     [m], the same operations in the same order."""
     legs = np.flatnonzero(contact)
     n = legs.size
-    triples = np.empty((max(n * (n - 1) * (n - 2) // 6, 0), 3), dtype=np.int64)
+    triples = np.empty((n * (n - 1) * (n - 2) // 6, 3), dtype=np.int64)  # 0 below 3 legs
     areas = np.empty(triples.shape[0])
     k = 0
     for a in range(n):
