@@ -7,7 +7,9 @@ controller step time in µs, with issue 14's target (median <= 15 µs) printed b
 mode (zero actions: in "residual" and "gains" mode the env runs the Coelho et al. 2024 gait with its
 internal controller, in "joint" mode it holds zero targets), and the per-step costs of the
 pieces that the env adds to the physics are timed on their own and inside the step loop
-(`common.step_profile`, where they cost more), so that a shortfall can be attributed.
+(`common.step_profile`, where they cost more), so that a shortfall can be attributed. Last, the
+ramp's and the block bed's simulated s per wall s on training tasks with random actions, beside
+their bare physics.
 Run: python benchmarks/bench_irregular_terrain.py [--posture-only]
 """
 
@@ -30,6 +32,7 @@ from benchmarks.common import (
     env_vs_raw,
     per_call_us,
     print_step_profile,
+    random_action_rates,
     verdict,
 )
 from hexapod_envs.robots.athena.gait import AthenaPostureController
@@ -161,6 +164,23 @@ def main() -> None:
         print(f"env per step, {name:34s} {us:6.1f} us")
     for terrain in ("ramp", "blocks"):
         print_step_profile(ENV_ID, terrain=terrain)
+    print_training_task_rates()
+
+
+def print_training_task_rates(steps: int = 600) -> None:
+    """Simulated s per wall s on training tasks with random actions, the env's and its bare
+    physics' (`common.random_action_rates`: what the env would reach if only MuJoCo cost
+    anything), best of 3 seeds: the figure of issue 14's block-bed target (2x the bed's rate at
+    the issue's commit, which benchmarks/README.md measures in a worktree beside this one)."""
+    for terrain in ("ramp", "blocks"):
+        with gym.make(ENV_ID, terrain=terrain, task_distribution="train") as env:
+            dt = env.unwrapped.control_dt
+            runs = [random_action_rates(env, steps, seed) for seed in range(3)]
+        env_rate, physics_rate = (max(r[k] for r in runs) * dt for k in (0, 1))
+        print(
+            f"{terrain}, training tasks, random actions: env {env_rate:.1f}, bare physics "
+            f"{physics_rate:.1f} simulated s per wall s"
+        )
 
 
 if __name__ == "__main__":

@@ -20,9 +20,9 @@ def _dot(a, b):
 @functools.cache
 def numba_blas_matches_numpy() -> bool:
     """True when 200 random products of the kernels' shapes (6 x 12 by 12 x 6 and by 12, 12 x 6
-    by 6, 6 x 3 by 3 x 3 and by its transpose, 3 x 3 by 3) are the same to the bit. The transposes are passed as the
-    kernels pass them, as transposed views: a contiguous copy would take BLAS's other gemv
-    kernel, whose sums differ."""
+    by 6, 6 x 3 by 3 x 3 and by its transpose, 3 x 3 by 3) are the same to the bit. The
+    transposes are passed as the kernels pass them, as transposed views: a contiguous copy
+    would take BLAS's other gemv kernel, whose sums differ."""
     rng = np.random.default_rng(0)
     for _ in range(200):
         a, b = rng.normal(size=(6, 12)), rng.normal(size=(3, 3))

@@ -2,6 +2,7 @@
 env skeleton's signatures (no timing assertions)."""
 
 import math
+import re
 import sys
 from pathlib import Path
 
@@ -10,7 +11,10 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the benchmarks p
 import gymnasium as gym  # noqa: E402
 
 import hexapod_envs  # noqa: E402, F401
-from benchmarks.bench_irregular_terrain import env_piece_costs  # noqa: E402
+from benchmarks.bench_irregular_terrain import (  # noqa: E402
+    env_piece_costs,
+    print_training_task_rates,
+)
 from benchmarks.common import (  # noqa: E402
     STEP_PIECES,
     random_action_rates,
@@ -22,6 +26,15 @@ from benchmarks.common import (  # noqa: E402
 def test_irregular_terrain_env_pieces_run():
     costs = env_piece_costs()
     assert len(costs) == 7 and all(math.isfinite(us) and us > 0 for us in costs.values())
+
+
+def test_training_task_rates_print_the_env_and_its_bare_physics(capsys):
+    print_training_task_rates(steps=5)
+    lines = capsys.readouterr().out.splitlines()
+    assert [line.split(",")[0] for line in lines] == ["ramp", "blocks"]
+    for line in lines:
+        rates = [float(x) for x in re.findall(r"(?:env|physics) ([0-9.]+)", line)]
+        assert len(rates) == 2 and all(rate > 0 for rate in rates), line
 
 
 def test_replay_measures_raw_physics_both_ways_and_the_env():
