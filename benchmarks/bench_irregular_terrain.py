@@ -16,7 +16,6 @@ Run: python benchmarks/bench_irregular_terrain.py [--posture-only]
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import sys
 import time
 from pathlib import Path
@@ -35,7 +34,7 @@ from benchmarks.common import (
     random_action_rates,
     verdict,
 )
-from hexapod_envs.robots.athena.gait import AthenaPostureController
+from hexapod_envs.robots.athena.gait import AthenaPostureController, AthenaSensors
 from hexapod_envs.robots.athena.kinematics import leg_ik
 from hexapod_envs.stability import fasm_from_feet
 
@@ -53,13 +52,12 @@ def controller_step_us(terrain: str = "ramp", steps: int = 2400) -> tuple[float,
     base = env.unwrapped
     env.reset(seed=0)
     readings = []
-    for _ in range(steps):
-        sensors = base._controller_sensors()  # its arrays are the env's per-step buffers
+    for _ in range(steps):  # what the env's controller reads (copies: the env's buffers)
         readings.append(
-            dataclasses.replace(
-                sensors,
-                joint_angles=sensors.joint_angles.copy(),
-                foot_forces=sensors.foot_forces.copy(),
+            AthenaSensors(
+                joint_angles=base._joints.reshape(6, 3).copy(),
+                foot_forces=base._forces.copy(),
+                torso_height=base._height,
             )
         )
         env.step(np.array([0.8, 0.6, 0.0], np.float32))

@@ -131,7 +131,6 @@ from ..robots.athena.gait import (
     GROUND_SEARCH,
     START_FROM,
     AthenaPostureController,
-    AthenaSensors,
 )
 from ..robots.athena.kinematics import standing_foot_positions
 from ..robots.athena.model import add_athena
@@ -601,15 +600,6 @@ class IrregularTerrainEnv(HexapodEnv):
             _compiled.offset_targets(targets, self._residual_gain, action, ctrl, self._act_ids)
         else:
             ctrl[self._act_ids] = targets.reshape(-1)
-
-    def _controller_sensors(self) -> AthenaSensors:
-        """The readings the posture controller gets at this step (`_apply_action` hands them
-        over without the dataclass, `AthenaPostureController.step_readings`)."""
-        return AthenaSensors(
-            joint_angles=self._joints.reshape(6, 3),
-            foot_forces=self._forces,
-            torso_height=self._height,
-        )
 
     def _run_physics(self) -> None:
         """One control period of physics, looking for torso-terrain contact every 10 ms.
