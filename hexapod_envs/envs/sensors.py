@@ -88,29 +88,24 @@ class RobotSensors:
         self._feet = np.empty((self.n_legs, 3))
         self._bind_views()
 
-    _VIEWS = (
-        "_sensordata",
-        "_site_xmat",
-        "_site_xpos",
-        "_subtree_com",
-        "_actuator_length",
-        "_actuator_velocity",
-        "_actuator_force",
-        "_torso_xpos",
-        "_torso_xmat",
-    )
-
     def _bind_views(self) -> None:
         """Views of `data`'s arrays that the compiled calls read, built once: MjData's buffers
-        never move, and building a view per call costs more than some calls' arithmetic."""
+        never move, and building a view per call costs more than some calls' arithmetic. Their
+        names are kept in `_view_names` (a deep copy rebuilds them)."""
         d = self.data
-        self._sensordata = d.sensordata
-        self._site_xmat, self._site_xpos = d.site_xmat, d.site_xpos
-        self._subtree_com = d.subtree_com
-        self._actuator_length = d.actuator_length
-        self._actuator_velocity = d.actuator_velocity
-        self._actuator_force = d.actuator_force
-        self._torso_xpos, self._torso_xmat = d.xpos[self.torso_id], d.xmat[self.torso_id]
+        views = {
+            "_sensordata": d.sensordata,
+            "_site_xmat": d.site_xmat,
+            "_site_xpos": d.site_xpos,
+            "_subtree_com": d.subtree_com,
+            "_actuator_length": d.actuator_length,
+            "_actuator_velocity": d.actuator_velocity,
+            "_actuator_force": d.actuator_force,
+            "_torso_xpos": d.xpos[self.torso_id],
+            "_torso_xmat": d.xmat[self.torso_id],
+        }
+        self.__dict__.update(views)
+        self._view_names = frozenset(views)
 
     def __deepcopy__(self, memo: dict) -> RobotSensors:
         """A copy reading the copied data (`copy.deepcopy` would turn the views into arrays of
@@ -118,7 +113,7 @@ class RobotSensors:
         new = type(self).__new__(type(self))
         memo[id(self)] = new
         for key, value in self.__dict__.items():
-            if key not in self._VIEWS:
+            if key not in self._view_names:
                 new.__dict__[key] = copy.deepcopy(value, memo)
         new._bind_views()
         return new
