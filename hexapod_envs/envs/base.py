@@ -654,6 +654,17 @@ class HexapodEnv(gym.Env):
         else:
             step_sensing_last(self.model, self.data, nstep)
 
+    def _step_sensing_position(self, nstep: int) -> None:
+        """`nstep` MuJoCo steps without sensors, then the position-stage sensors alone
+        (`mj_sensorPos`: encoders, frames, rangefinders, contact counts) for a check within a
+        control period, whose last step evaluates them all; sensors with a history are
+        evaluated at every step instead."""
+        if self._sensors_every_step:
+            mujoco.mj_step(self.model, self.data, nstep=nstep)
+        else:
+            step_without_sensors(self.model, self.data, nstep)
+            mujoco.mj_sensorPos(self.model, self.data)
+
     # --- rendering -----------------------------------------------------------------------
     def render(self):
         if self.render_mode is None:

@@ -138,7 +138,7 @@ from ..robots.athena.params import ATHENA, LEG_NAMES
 from ..terrain.flat import add_flat
 from ..terrain.irregular import PAPER_FRICTION, add_blocks, add_ramp
 from . import _compiled
-from .base import HexapodEnv, JointActionMap, step_sensing_last, step_without_sensors
+from .base import HexapodEnv, JointActionMap
 from .sensors import RobotSensors
 from .settings import EnvSettings, RewardScales, TaskRanges, choice, number, numbers, option
 
@@ -605,29 +605,20 @@ class IrregularTerrainEnv(HexapodEnv):
         """One control period of physics, looking for torso-terrain contact every 10 ms.
 
         The `torso_contact` sensor is a position-stage sensor: it counts the torso geom's
-        entries in `data.contact`, the contacts of the last physics step's collision pass. At
-        the first checks only the position-stage sensors are evaluated (`mj_sensorPos`, about
-        1 µs), after physics steps without sensors; the period's last step evaluates every
-        sensor for the step's measurements and overwrites the other position readings. The
+        entries in `data.contact`, the contacts of the last physics step's collision pass. The
+        first checks evaluate the position-stage sensors alone (`_step_sensing_position`, about
+        1 µs); the period's last step evaluates every sensor for the step's measurements. The
         counts are the ones a full evaluation gives, without its dynamics pass for the
         foot-force sensors and the accelerometer (about 4 µs per check).
         """
         chunk = self.n_substeps // _CONTACT_CHECKS
-        model, data = self.model, self.data
-        sensordata, adr = data.sensordata, self._torso_contact_adr
+        sensordata, adr = self.data.sensordata, self._torso_contact_adr
         touched = False
-        if self._sensors_every_step:  # sensor histories: every step must evaluate them
-            for _ in range(_CONTACT_CHECKS):
-                mujoco.mj_step(model, data, nstep=chunk)
-                touched = touched or sensordata[adr] > 0.0
-        else:
-            for _ in range(_CONTACT_CHECKS - 1):
-                step_without_sensors(model, data, chunk)
-                if not touched:
-                    mujoco.mj_sensorPos(model, data)
-                    touched = sensordata[adr] > 0.0
-            step_sensing_last(model, data, chunk)
+        for _ in range(_CONTACT_CHECKS - 1):
+            self._step_sensing_position(chunk)
             touched = touched or sensordata[adr] > 0.0
+        self._step_sensing_last(chunk)
+        touched = touched or sensordata[adr] > 0.0
         self._touched_in_physics = bool(touched)
 
     # --- measurements --------------------------------------------------------------------
