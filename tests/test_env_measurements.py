@@ -251,3 +251,19 @@ def test_stewart_actuator_lengths_are_the_platforms_to_the_bit():
             platform.base_joints, platform.platform_joints, centre, *rpy.tolist()
         )
         assert got.tobytes() == expected.tobytes(), rpy
+
+
+def test_torso_up_is_the_rotations_third_column_and_a_copy_reads_its_own_data():
+    """`RobotSensors.torso_up` is a view bound once: it follows the data step by step, and a
+    deep copy of the env reads the copy's data, not the original's."""
+    import copy
+
+    env, base = _seeded_env("HexapodStewartTilt-v0", 4, task_distribution="train")
+    twin = copy.deepcopy(base)
+    for _ in range(20):
+        action = env.action_space.sample()
+        base.step(action)
+        twin.step(-action)
+        for e in (base, twin):
+            assert _same(e.sensors.torso_up(), e.data.xmat[e.sensors.torso_id].reshape(3, 3)[:, 2])
+    assert not _same(twin.sensors.torso_up(), base.sensors.torso_up())

@@ -103,6 +103,7 @@ class RobotSensors:
             "_actuator_force": d.actuator_force,
             "_torso_xpos": d.xpos[self.torso_id],
             "_torso_xmat": d.xmat[self.torso_id],
+            "_torso_up": d.xmat[self.torso_id, 2::3],
         }
         self.__dict__.update(views)
         self._view_names = frozenset(views)
@@ -232,6 +233,10 @@ class RobotSensors:
     def torso_rotation(self) -> np.ndarray:
         """3x3 rotation matrix body -> world."""
         return self._torso_xmat.reshape(3, 3)
+
+    def torso_up(self) -> np.ndarray:
+        """(3,) the torso's up axis in the world frame (a view: read it before the next step)."""
+        return self._torso_up
 
     def tilt_cos(self) -> float:
         """Cosine of the torso's tilt from vertical: the world z component of its up axis."""

@@ -349,13 +349,10 @@ class StewartTiltEnv(HeavyDutyEnv):
         self.data.ctrl[self._platform_act] = (pitch_rate, roll_rate)
 
     # --- stability, termination, reward ---------------------------------------------------
-    def _platform_up(self) -> np.ndarray:
-        return self.data.xmat[self._platform_body].reshape(3, 3)[:, 2]
-
     def _is_tipped_over(self) -> bool:
         """Tipped when the body leans more than tip_over_angle_deg relative to the platform."""
-        body_up = self.sensors.torso_rotation()[:, 2]
-        return bool(body_up @ self._platform_up() < self.tip_over_cos)
+        platform_up = self.data.xmat[self._platform_body, 2::3]
+        return bool(self.sensors.torso_up() @ platform_up < self.tip_over_cos)
 
     def _measure(self) -> None:
         super()._measure()
@@ -372,6 +369,7 @@ class StewartTiltEnv(HeavyDutyEnv):
 
     def _extra_info(self, unstable: bool) -> dict:
         pitch, roll = self.data.qpos[self._platform_qpos].tolist()
+        body = self._platform_body  # xmat[body, 8]: world z of the platform's up axis
         rpy = np.array([roll, pitch, 0.0])
         platform = self.platform  # its actuator lengths, in one compiled call:
         lengths = _compiled.stewart_actuator_lengths(
@@ -381,7 +379,7 @@ class StewartTiltEnv(HeavyDutyEnv):
             **super()._extra_info(unstable),
             "scenario": self.scenario,
             "stance": self.stance,
-            "platform_tilt_deg": float(np.degrees(np.arccos(min(1.0, self._platform_up()[2])))),
+            "platform_tilt_deg": float(np.degrees(np.arccos(min(1.0, self.data.xmat[body, 8])))),
             "platform_rpy": rpy,
             "actuator_lengths": lengths,
             "adjustment_leg": self._adjustment_leg,
