@@ -39,6 +39,7 @@ __all__ = [
 ]
 
 _SENSORS_OFF = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+_RK4 = int(mujoco.mjtIntegrator.mjINT_RK4)
 
 
 def step_sensing_last(model: mujoco.MjModel, data: mujoco.MjData, nstep: int) -> None:
@@ -655,12 +656,16 @@ class HexapodEnv(gym.Env):
             step_sensing_last(self.model, self.data, nstep)
 
     def _step_sensing_position(self, nstep: int) -> None:
-        """`nstep` MuJoCo steps without sensors, then the position-stage sensors alone
-        (`mj_sensorPos`: encoders, frames, rangefinders, contact counts) for a check within a
-        control period, whose last step evaluates them all; sensors with a history are
-        evaluated at every step instead."""
-        if self._sensors_every_step:
-            mujoco.mj_step(self.model, self.data, nstep=nstep)
+        """`nstep` MuJoCo steps for a check within a control period (whose last step evaluates
+        every sensor): without sensors, then the position-stage sensors alone (`mj_sensorPos`).
+
+        Contact counts, frames and rangefinders then read what a full evaluation in the last
+        step reads: the collisions and kinematics of that step's start. Encoders read the
+        stepped qpos instead, so only the former may be read between evaluations. Under RK4,
+        whose intermediate stages overwrite the contacts, and with sensors that keep a history,
+        every sensor is evaluated in the last step instead (`_step_sensing_last`)."""
+        if self._sensors_every_step or self.model.opt.integrator == _RK4:
+            self._step_sensing_last(nstep)
         else:
             step_without_sensors(self.model, self.data, nstep)
             mujoco.mj_sensorPos(self.model, self.data)

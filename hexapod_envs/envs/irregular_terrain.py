@@ -609,7 +609,8 @@ class IrregularTerrainEnv(HexapodEnv):
         first checks evaluate the position-stage sensors alone (`_step_sensing_position`, about
         1 µs); the period's last step evaluates every sensor for the step's measurements. The
         counts are the ones a full evaluation gives, without its dynamics pass for the
-        foot-force sensors and the accelerometer (about 4 µs per check).
+        foot-force sensors and the accelerometer (about 4 µs per check); under RK4 every check
+        evaluates every sensor (see `_step_sensing_position`).
         """
         chunk = self.n_substeps // _CONTACT_CHECKS
         sensordata, adr = self.data.sensordata, self._torso_contact_adr
