@@ -277,13 +277,21 @@ def test_instability_while_settling_is_flagged_at_reset(env_id, monkeypatch):
     assert env.reset(seed=0)[1]["sim_unstable"]
 
 
+def _cloudpickled(env):
+    import cloudpickle  # a Gymnasium dependency; plain pickle cannot take the readers' lambdas
+
+    return cloudpickle.loads(cloudpickle.dumps(env))
+
+
+@pytest.mark.parametrize("copier", [copy.deepcopy, _cloudpickled], ids=["deepcopy", "cloudpickle"])
 @pytest.mark.parametrize(
     ("env_id", "kwargs"), [*SPEED_ONLY_CASES, (ENV_IDS[0], {"sensor_noise": 0.05})]
 )
-def test_a_deep_copy_steps_and_observes_on_its_own(env_id, kwargs):
+def test_a_deep_copy_steps_and_observes_on_its_own(env_id, kwargs, copier):
     """`copy.deepcopy` of a reset env (look-ahead and common-random-number rollouts step such
-    twins): the twin's observations equal a fresh env's stepped alike; the original is intact
-    (with sensor noise: the twin draws from its own copy of the random generator)."""
+    twins), or a pickled and unpickled one: the twin's observations equal a fresh env's stepped
+    alike; the original is intact (with sensor noise: the twin draws from its own copy of the
+    random generator)."""
     space = gym.make(env_id, **kwargs).action_space
     space.seed(9)
     actions = [space.sample() for _ in range(5)]
@@ -294,7 +302,7 @@ def test_a_deep_copy_steps_and_observes_on_its_own(env_id, kwargs):
         return env
 
     original = fresh()
-    twin, alike = copy.deepcopy(original), fresh()
+    twin, alike = copier(original), fresh()
     for a in actions:
         np.testing.assert_array_equal(twin.step(a)[0], alike.step(a)[0])
     np.testing.assert_array_equal(original.step(actions[0])[0], fresh().step(actions[0])[0])

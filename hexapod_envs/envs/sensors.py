@@ -9,7 +9,6 @@ one compiled call each.
 
 from __future__ import annotations
 
-import copy
 from typing import NamedTuple
 
 import mujoco
@@ -91,7 +90,7 @@ class RobotSensors:
     def _bind_views(self) -> None:
         """Views of `data`'s arrays that the compiled calls read, built once: MjData's buffers
         never move, and building a view per call costs more than some calls' arithmetic. Their
-        names are kept in `_view_names` (a deep copy rebuilds them)."""
+        names are kept in `_view_names` (a deep or unpickled copy rebinds them)."""
         d = self.data
         views = {
             "_sensordata": d.sensordata,
@@ -108,16 +107,14 @@ class RobotSensors:
         self.__dict__.update(views)
         self._view_names = frozenset(views)
 
-    def __deepcopy__(self, memo: dict) -> RobotSensors:
-        """A copy reading the copied data (`copy.deepcopy` would turn the views into arrays of
-        their own, frozen at the copy's moment)."""
-        new = type(self).__new__(type(self))
-        memo[id(self)] = new
-        for key, value in self.__dict__.items():
-            if key not in self._view_names:
-                new.__dict__[key] = copy.deepcopy(value, memo)
-        new._bind_views()
-        return new
+    def __getstate__(self) -> dict:
+        """The state without the views of `data`: a deep copy or an unpickled copy rebinds
+        them to its own data (copied as views, they would be arrays frozen at the copy)."""
+        return {k: v for k, v in self.__dict__.items() if k not in self._view_names}
+
+    def __setstate__(self, state: dict) -> None:
+        self.__dict__.update(state)
+        self._bind_views()
 
     # --- encoders -------------------------------------------------------------------------
     def joint_positions(self) -> np.ndarray:
