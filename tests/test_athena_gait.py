@@ -334,3 +334,7 @@ def test_bad_arguments_raise_clear_errors():
         ctrl.step(AthenaSensors(np.zeros((6, 3)), np.zeros(5), 0.1))
     with pytest.raises(ValueError, match="g_z"):
         torso_deviation_from_plane([0, 0, -1])
+    feet = np.tile([0.1, 0.1, -0.1], (6, 1))
+    for bad_feet, bad_contact in ((feet[:4], np.ones(6, bool)), (feet, np.ones(4, bool))):
+        with pytest.raises(ValueError, match=r"shape \(6, 3\).*\(6,\)"):  # not read past
+            ctrl.ground_deviation(bad_feet, bad_contact, (0, 2, 4))

@@ -472,6 +472,11 @@ class AthenaPostureController:
         tripod when all of it touches) and the torso's deviation from it; without a usable
         triple, no plane: legs (), normal (0, 0, 1), no deviation."""
         feet, contact = np.asarray(feet, dtype=float), np.asarray(contact, dtype=bool)
+        if feet.shape != (6, 3) or contact.shape != (6,):  # the compiled search reads 6 rows
+            raise ValueError(
+                f"feet must have shape (6, 3) and contact (6,) (rows {LEG_NAMES}), got "
+                f"{feet.shape} and {contact.shape}"
+            )
         plane_legs = self._choose_plane_legs(feet, contact, stance)
         if not plane_legs:
             return (), np.array([0.0, 0.0, 1.0]), 0.0, 0.0
