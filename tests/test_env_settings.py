@@ -123,7 +123,7 @@ def test_the_heavy_duty_payload_is_a_task_range(env_id):
     tasks = [env.reset(seed=k)[1]["task"] for k in range(8)]
     assert all(100.0 <= t["payload_mass"] <= 200.0 for t in tasks)
     assert all(t["payload_offset_x"] == t["payload_offset_y"] == 0.0 for t in tasks)
-    with pytest.raises(ValueError, match="payload_offset must be >= 0"):
+    with pytest.raises(ValueError, match="payload_offset entries must be >= 0"):
         gym.make(env_id, train_ranges={"payload_offset": -0.1})
 
 
@@ -159,6 +159,39 @@ def test_bad_task_ranges_are_named(ranges, error, words):
     with pytest.raises(error) as caught:
         gym.make("HexapodCliffWalk-v0", train_ranges=ranges)
     assert all(w in str(caught.value) for w in words), str(caught.value)
+
+
+@pytest.mark.parametrize(
+    "env_id, ranges, words",
+    [
+        ("HexapodCliffWalk-v0", {"friction": [-1.0, -0.5]}, ["friction", ">= 0"]),
+        ("HexapodCliffWalk-v0", {"drop": [-1.0, 1.0]}, ["drop", "> 0"]),
+        ("HexapodCliffWalk-v0", {"cliff_x": [0.0, 1.0]}, ["cliff_x", "> 2.65"]),
+        ("HexapodStewartTilt-v0", {"rates_deg_s": [[0.0, 1.0]]}, ["rates_deg_s", "> 0"]),
+        ("HexapodStewartTilt-v0", {"friction": [-1.0, 0.5]}, ["friction", ">= 0"]),
+        ("HexapodIrregularTerrain-v0", {"servo_kp_scale": [[-2.0, -1.0]]}, ["servo_kp_scale"]),
+        ("HexapodIrregularTerrain-v0", {"slope_deg": [[40.0, 50.0]]}, ["slope_deg", "<= 45"]),
+        ("HexapodIrregularTerrain-v0", {"block_size": [0.0, 0.1]}, ["block_size", "> 0"]),
+        ("HexapodDitchCrossing-v0", {"depth": [0.0, 0.1]}, ["depth", "> 0"]),
+        ("HexapodDitchCrossing-v0", {"friction": [-1.0, 0.0]}, ["friction", ">= 0"]),
+        ("HexapodDitchCrossing-v0", {"start_x": [0.1, 0.2]}, ["start_x", ">= 0.240 m"]),
+    ],
+)
+def test_task_ranges_outside_what_the_plain_setting_takes_are_refused_at_make(
+    env_id, ranges, words
+):
+    """A range is refused where the plain setting of the same quantity is (negative friction,
+    a cliff behind the robot, a ditch under it), at gym.make, not at a reset that draws it."""
+    for where in ("train_ranges", "test_ranges"):
+        with pytest.raises(ValueError) as caught:
+            gym.make(env_id, **{where: ranges})
+        assert all(w in str(caught.value) for w in [where, *words]), str(caught.value)
+
+
+@pytest.mark.parametrize("env_id", ENV_IDS)
+def test_task_ranges_cannot_be_none(env_id):
+    with pytest.raises(ValueError, match="train_ranges must be a .*TaskRanges or a mapping"):
+        gym.make(env_id, train_ranges=None)
 
 
 def test_a_probability_range_outside_0_1_is_named():

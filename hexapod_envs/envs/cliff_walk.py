@@ -54,9 +54,12 @@ from .heavy_duty import (
     HeavyDutySettings,
     HeavyDutyTaskRanges,
 )
-from .settings import choice, number, option
+from .settings import bounded, choice, number, option
 
 TERRAINS = ("cliff", "flat")
+
+FRONT_FEET_X = 2.4 + 0.25
+"""x of the farthest foot at the start (hip x + half the stroke) [m]."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -67,10 +70,10 @@ class CliffTaskRanges(HeavyDutyTaskRanges):
     farther ahead and deeper, the edge nearer the centre line, lower friction, heavier payload.
     """
 
-    cliff_x: tuple[float, float]
-    edge_y: tuple[float, float]
-    drop: tuple[float, float]
-    friction: tuple[float, float]
+    cliff_x: tuple[float, float] = bounded(FRONT_FEET_X, strict=True)
+    edge_y: tuple[float, float] = bounded(None)
+    drop: tuple[float, float] = bounded(strict=True)
+    friction: tuple[float, float] = bounded()
     sides: tuple[str, ...] = CLIFF_SIDES
 
 
@@ -80,10 +83,6 @@ CLIFF_TRAIN = CliffTaskRanges(
 CLIFF_TEST = CliffTaskRanges(
     cliff_x=(3.4, 4.0), edge_y=(-0.9, -0.7), drop=(3.0, 5.0), friction=(0.6, 0.8), **TEST_PAYLOAD
 )
-
-
-FRONT_FEET_X = 2.4 + 0.25
-"""x of the farthest foot at the start (hip x + half the stroke) [m]."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -100,8 +99,8 @@ class CliffWalkSettings(HeavyDutySettings):
     """y of the cliff's side edge [m] (signed: toward the cliff side)."""
     friction: float = number(1.0)
     """Ground friction coefficient."""
-    train_ranges: CliffTaskRanges = option(CLIFF_TRAIN, kind=CliffTaskRanges)
-    test_ranges: CliffTaskRanges = option(CLIFF_TEST, kind=CliffTaskRanges)
+    train_ranges: CliffTaskRanges = option(CLIFF_TRAIN, kind=CliffTaskRanges, optional=False)
+    test_ranges: CliffTaskRanges = option(CLIFF_TEST, kind=CliffTaskRanges, optional=False)
 
     def __post_init__(self) -> None:
         super().__post_init__()

@@ -109,7 +109,16 @@ from ..terrain.flat import add_flat
 from . import _compiled
 from .base import HexapodEnv
 from .sensors import RobotSensors
-from .settings import EnvSettings, RewardScales, TaskRanges, choice, number, numbers, option
+from .settings import (
+    EnvSettings,
+    RewardScales,
+    TaskRanges,
+    bounded,
+    choice,
+    number,
+    numbers,
+    option,
+)
 
 TERRAINS = ("ditch", "flat")
 ACTION_MODES = ("joint", "residual")
@@ -125,10 +134,10 @@ class DitchTaskRanges(TaskRanges):
     above ~0.16 m), farther ahead, lower friction.
     """
 
-    start_x: tuple[float, float]
-    width: tuple[float, float]
-    depth: tuple[float, float]
-    friction: tuple[float, float]
+    start_x: tuple[float, float] = bounded(None)
+    width: tuple[float, float] = bounded(strict=True)
+    depth: tuple[float, float] = bounded(strict=True)
+    friction: tuple[float, float] = bounded()
 
 
 DITCH_TRAIN = DitchTaskRanges(
@@ -212,8 +221,8 @@ class DitchCrossingSettings(EnvSettings):
     gait_timing: GaitTiming | None = option(None, kind=GaitTiming)
     gait_settings: GaitSettings | None = option(None, kind=GaitSettings)
     params: UpuParams | None = option(None, kind=UpuParams)
-    train_ranges: DitchTaskRanges = option(DITCH_TRAIN, kind=DitchTaskRanges)
-    test_ranges: DitchTaskRanges = option(DITCH_TEST, kind=DitchTaskRanges)
+    train_ranges: DitchTaskRanges = option(DITCH_TRAIN, kind=DitchTaskRanges, optional=False)
+    test_ranges: DitchTaskRanges = option(DITCH_TEST, kind=DitchTaskRanges, optional=False)
 
 
 class DitchCrossingEnv(HexapodEnv):
@@ -272,6 +281,11 @@ class DitchCrossingEnv(HexapodEnv):
                 for v in rng:
                     values[key] = v
                     self._check_geometry(**values)
+        for name, r in (("train_ranges", s.train_ranges), ("test_ranges", s.test_ranges)):
+            try:  # the nearest ditch a task distribution can draw
+                self._check_geometry(r.start_x[0], r.width[0], r.depth[0])
+            except ValueError as err:
+                raise ValueError(f"{name}.start_x: {err}") from None
         self.ditch = Ditch(s.ditch_start_x, s.ditch_width, s.ditch_depth)
         """The episode's ditch geometry (public: a controller that knows the ditch, as the
         paper's robot does, plans from it). On flat ground it marks the finish line only."""

@@ -30,6 +30,7 @@ from .settings import (
     EnvSettings,
     RewardScales,
     TaskRanges,
+    bounded,
     choice,
     number,
     numbers,
@@ -65,18 +66,10 @@ class HeavyDutyTaskRanges(TaskRanges):
     """What every heavy-duty scenario's task ranges hold: the payload on the body, a point mass
     at an offset from the body's CoG (the scenarios' range dataclasses extend this one)."""
 
-    payload_mass: tuple[float, float]
+    payload_mass: tuple[float, float] = bounded()
     """Payload mass range [kg] (uniform)."""
-    payload_offset: float
+    payload_offset: float = bounded()
     """Largest offset of the payload from the body's CoG in x and in y [m] (uniform in ±)."""
-
-    def __post_init__(self) -> None:
-        super().__post_init__()
-        if self.payload_mass[0] < 0 or self.payload_offset < 0:
-            raise ValueError(
-                f"{type(self).__name__}: payload_mass and payload_offset must be >= 0, got "
-                f"{self.payload_mass!r} and {self.payload_offset!r}"
-            )
 
 
 TRAIN_PAYLOAD = {"payload_mass": (0.0, 500.0), "payload_offset": 0.15}

@@ -140,7 +140,16 @@ from ..terrain.irregular import PAPER_FRICTION, add_blocks, add_ramp
 from . import _compiled
 from .base import HexapodEnv, JointActionMap
 from .sensors import RobotSensors
-from .settings import EnvSettings, RewardScales, TaskRanges, choice, number, numbers, option
+from .settings import (
+    EnvSettings,
+    RewardScales,
+    TaskRanges,
+    bounded,
+    choice,
+    number,
+    numbers,
+    option,
+)
 
 TERRAINS = ("ramp", "blocks", "flat")
 ACTION_MODES = ("residual", "joint", "gains")
@@ -167,13 +176,13 @@ class TerrainTaskRanges(TaskRanges):
     to rank.
     """
 
-    slope_deg: tuple[tuple[float, float], ...]
-    block_height_max: tuple[float, float]
+    slope_deg: tuple[tuple[float, float], ...] = bounded(high=45.0)
+    block_height_max: tuple[float, float] = bounded(strict=True)
     """Highest block [m] (blocks are drawn 0.04 m up to it)."""
-    block_size: tuple[float, float]
+    block_size: tuple[float, float] = bounded(strict=True)
     """Block edge length [m] (square blocks)."""
-    friction: tuple[float, float]
-    servo_kp_scale: tuple[tuple[float, float], ...]
+    friction: tuple[float, float] = bounded()
+    servo_kp_scale: tuple[tuple[float, float], ...] = bounded(strict=True)
     """Servo stiffness as a multiple of `servo_kp`."""
 
 
@@ -298,8 +307,8 @@ class IrregularTerrainSettings(EnvSettings):
     """((x0, x1), (y0, y1)) covered by blocks [m]."""
     block_layout_seed: int | None = number(None, integer=True, optional=True)
     """Fixes one block bed for all episodes (None: a new bed from every episode's seed)."""
-    train_ranges: TerrainTaskRanges = option(TERRAIN_TRAIN, kind=TerrainTaskRanges)
-    test_ranges: TerrainTaskRanges = option(TERRAIN_TEST, kind=TerrainTaskRanges)
+    train_ranges: TerrainTaskRanges = option(TERRAIN_TRAIN, kind=TerrainTaskRanges, optional=False)
+    test_ranges: TerrainTaskRanges = option(TERRAIN_TEST, kind=TerrainTaskRanges, optional=False)
 
     def __post_init__(self) -> None:
         super().__post_init__()

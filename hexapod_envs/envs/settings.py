@@ -137,14 +137,21 @@ def choice(default: Any, choices: tuple, *, optional: bool = False) -> Any:
     return dataclasses.field(default=default, metadata={"check": check})
 
 
-def option(default: Any = None, *, kind: type | tuple[type, ...] | None = None) -> Any:
-    """A setting of another type (a parameter dataclass, a name): None or an instance of
-    `kind`, checked by type; its own dataclass checks its fields."""
+def option(
+    default: Any = None, *, kind: type | tuple[type, ...] | None = None, optional: bool = True
+) -> Any:
+    """A setting of another type (a parameter dataclass, a name): an instance of `kind` (or
+    None if `optional`), checked by type; its own dataclass checks its fields."""
 
     def check(name: str, value: Any) -> None:
-        if value is not None and kind is not None and not isinstance(value, kind):
+        if value is None and optional:
+            return
+        if kind is not None and not isinstance(value, kind):
             names = kind.__name__ if isinstance(kind, type) else [k.__name__ for k in kind]
-            raise ValueError(f"{name} must be None or a {names}, got {value!r}")
+            either = "None or " if optional else ""
+            ranges = isinstance(kind, type) and issubclass(kind, TaskRanges)
+            mapping = " or a mapping of the ranges to change" if ranges else ""
+            raise ValueError(f"{name} must be {either}a {names}{mapping}, got {value!r}")
 
     if isinstance(default, (list, dict, set)):
         raise TypeError("mutable defaults are not allowed for settings")
@@ -163,9 +170,17 @@ class _Checked:
                 object.__setattr__(self, f.name, _as_tuples(getattr(self, f.name)))
 
 
+def bounded(low: float | None = 0.0, high: float | None = None, strict: bool = False) -> Any:
+    """A field of a `TaskRanges` dataclass whose numbers (a number, a (low, high) pair or a
+    tuple of pairs) must lie in [`low`, `high`] (> `low` with `strict`; ``low=None``: any
+    sign), as the env's plain setting of the same quantity must."""
+    return dataclasses.field(metadata={"bounds": (low, high, strict)})
+
+
 class TaskRanges:
     """Base of the envs' task-range dataclasses: every (low, high) pair (or tuple of pairs) must
-    be finite with low <= high, every number finite; checked on construction.
+    be finite with low <= high, every number finite, and within its field's bounds (`bounded`);
+    checked on construction.
 
     The envs' ``train_ranges`` / ``test_ranges`` settings also take a mapping, e.g. from a YAML
     config: it replaces the named ranges of the default and keeps the others (`updated`).
@@ -202,19 +217,34 @@ class TaskRanges:
             object.__setattr__(self, f.name, value)
             if _shape(value) == _NUMBER:
                 _check_real(f.name, value, value)
-                continue
-            if not isinstance(value, tuple) or not value or isinstance(value[0], str):
-                continue
-            pairs = value if isinstance(value[0], tuple) else (value,)
-            for pair in pairs:
-                ok = len(pair) == 2 and all(
-                    isinstance(x, _numbers.Real) and math.isfinite(x) for x in pair
-                )
-                if not (ok and pair[0] <= pair[1]):
-                    raise ValueError(
-                        f"{type(self).__name__}.{f.name} must be finite (low, high) pairs with "
-                        f"low <= high, got {value!r}"
+            elif isinstance(value, tuple) and value and not isinstance(value[0], str):
+                pairs = value if isinstance(value[0], tuple) else (value,)
+                for pair in pairs:
+                    ok = len(pair) == 2 and all(
+                        isinstance(x, _numbers.Real) and math.isfinite(x) for x in pair
                     )
+                    if not (ok and pair[0] <= pair[1]):
+                        raise ValueError(
+                            f"{type(self).__name__}.{f.name} must be finite (low, high) pairs "
+                            f"with low <= high, got {value!r}"
+                        )
+            else:  # names (checked against the default's by `updated`)
+                continue
+            self._check_bounds(f, value)
+
+    def _check_bounds(self, f: dataclasses.Field, value: Any) -> None:
+        """ValueError naming the field and its bounds when a number of `value` lies outside."""
+        if "bounds" not in f.metadata:
+            return
+        low, high, strict = f.metadata["bounds"]
+        pairs = value if _shape(value) == _PAIRS else (value,)
+        for x in (x for pair in pairs for x in (pair if isinstance(pair, tuple) else (pair,))):
+            too_low = low is not None and (x <= low if strict else x < low)
+            if too_low or (high is not None and x > high):
+                raise ValueError(
+                    f"{type(self).__name__}.{f.name} entries must be "
+                    f"{_range_text(low, high, strict)}, got {value!r}"
+                )
 
 
 def _shape(value: Any) -> str:

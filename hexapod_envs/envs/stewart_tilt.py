@@ -61,7 +61,7 @@ from .heavy_duty import (
     HeavyDutySettings,
     HeavyDutyTaskRanges,
 )
-from .settings import choice, number, option
+from .settings import bounded, choice, number, option
 
 SCENARIOS = ("climb", "descend", "side", "random")
 STANCES = {"LF-LR-RM": TRIPODS[0], "LM-RF-RR": TRIPODS[1]}
@@ -92,8 +92,8 @@ class TiltTaskRanges(HeavyDutyTaskRanges):
     lower platform friction; a heavier payload farther off centre.
     """
 
-    rates_deg_s: tuple[tuple[float, float], ...]
-    friction: tuple[float, float]
+    rates_deg_s: tuple[tuple[float, float], ...] = bounded(strict=True)
+    friction: tuple[float, float] = bounded()
     case_probability: float = 0.5
 
     def __post_init__(self) -> None:
@@ -146,8 +146,8 @@ class StewartTiltSettings(HeavyDutySettings):
     """Residual action 1 = this fraction of each joint's half range (2: any target)."""
     tip_over_angle_deg: float = number(10.0, strict=True, high=90.0)
     """Tip-over: the body leans more than this relative to the platform [deg]."""
-    train_ranges: TiltTaskRanges = option(TILT_TRAIN, kind=TiltTaskRanges)
-    test_ranges: TiltTaskRanges = option(TILT_TEST, kind=TiltTaskRanges)
+    train_ranges: TiltTaskRanges = option(TILT_TRAIN, kind=TiltTaskRanges, optional=False)
+    test_ranges: TiltTaskRanges = option(TILT_TEST, kind=TiltTaskRanges, optional=False)
 
 
 class StewartTiltEnv(HeavyDutyEnv):
