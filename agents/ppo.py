@@ -75,14 +75,15 @@ class PPOPolicy:
                     f"the model at {files.model} expects {what} shape {tuple(meta[key])}, "
                     f"but {env_id} (with these kwargs) has {env_space.shape}"
                 )
-        policy_kwargs = load_train_config(data=config).policy.policy_kwargs()
+        train_config = load_train_config(data=config)
+        policy_kwargs = train_config.policy.policy_kwargs()
         action_space = env.action_space
         if config.get("hybrid") is not None:  # the learned action of a hybrid lies in [-1, 1]
             shape, dtype = env.action_space.shape, env.action_space.dtype
             action_space = gym.spaces.Box(-1.0, 1.0, shape=shape, dtype=dtype)
         objects = ppo_custom_objects(policy_kwargs, env.observation_space, action_space)
         model = load_ppo(files.model, objects, trust_pickle, device=device)
-        stats = load_stats(files.directory, trust_pickle)
+        stats = load_stats(files.directory, trust_pickle, train_config.normalize.observation)
         train_kwargs = (config.get("env") or {}).get("kwargs") or {}
         policy = cls(model, stats, files, deterministic, train_kwargs)
         return _as_trained(policy, env, config)

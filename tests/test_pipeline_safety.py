@@ -254,6 +254,28 @@ def test_resume_falls_back_past_a_damaged_newest_checkpoint(copy_run, capsys):
     assert meta(run_dir / "final")["num_timesteps"] >= 1100
 
 
+def test_resume_skips_half_written_checkpoints_and_ones_without_their_statistics(copy_run, capsys):
+    """A folder a kill left with model.zip but no meta.json is not a checkpoint; one whose
+    normalisation statistics are gone is refused (it would restart them from nothing)."""
+    run_dir = copy_run()
+    shutil.rmtree(run_dir / "final")
+    half = run_dir / "checkpoints" / "step_000000002048"
+    half.mkdir()
+    shutil.copy(run_dir / "checkpoints" / "step_000000001024" / "model.zip", half)
+    (run_dir / "checkpoints" / "step_000000001024" / "vecnormalize.npz").unlink()
+    assert train_main(["--resume", str(run_dir), "--set", "train.total_timesteps=1100"]) == 0
+    err = capsys.readouterr().err
+    assert "step_000000002048" not in err
+    assert "has no vecnormalize.npz" in err and "falling back to step_000000000768" in err
+
+
+def test_a_model_without_its_normalisation_statistics_is_refused(run, tmp_path):
+    model_dir = model_copy(run, tmp_path)
+    (model_dir / "vecnormalize.npz").unlink()
+    with pytest.raises(UserError, match="has no vecnormalize.npz.*normalised observations"):
+        PPOPolicy.load(model_dir, gym.make("HexapodCliffWalk-v0", **_kwargs(run)))
+
+
 # --- hyperparameter ranges -----------------------------------------------------------------
 @pytest.mark.parametrize(
     ("override", "key"),

@@ -94,6 +94,7 @@ def save_model_dir(
     `env_settings`: the training env's resolved settings (`env_settings.resolved_settings`)."""
     path = Path(path)
     path.mkdir(parents=True, exist_ok=True)
+    (path / META_FILE).unlink(missing_ok=True)  # rewriting: incomplete until the new meta.json
     with atomic_path(path / MODEL_FILE) as tmp:
         model.save(tmp)  # the temporary name ends in .tmp, so SB3 adds no .zip
     if vec_normalize is not None:
@@ -138,11 +139,18 @@ def _timesteps(model_dir: Path) -> int:
 
 
 def saved_model_dirs(run_dir: Path) -> list[Path]:
-    """checkpoints/* and final/ of a run, newest (most timesteps) first."""
+    """The completely written (`is_complete`) checkpoints/* and final/ of a run, newest (most
+    timesteps) first."""
     run_dir = Path(run_dir)
     candidates = sorted((run_dir / CHECKPOINTS).glob("step_*")) + [run_dir / FINAL]
-    candidates = [c for c in candidates if (c / MODEL_FILE).is_file()]
+    candidates = [c for c in candidates if is_complete(c)]
     return sorted(candidates, key=lambda c: (_timesteps(c), c.name == FINAL), reverse=True)
+
+
+def is_complete(model_dir: Path) -> bool:
+    """Whether a model directory of a run was completely written: its ``meta.json`` is written
+    last (a save interrupted by a kill or a second Ctrl-C leaves none)."""
+    return (Path(model_dir) / MODEL_FILE).is_file() and (Path(model_dir) / META_FILE).is_file()
 
 
 def latest_model_dir(run_dir: Path) -> Path | None:
@@ -183,7 +191,7 @@ def find_model(path: str | Path) -> ModelFiles:
         directory, model = path, path / MODEL_FILE
     elif is_run_dir(path):
         for sub in (path / BEST, path / FINAL):
-            if (sub / MODEL_FILE).is_file():
+            if is_complete(sub):
                 directory = sub
                 break
         else:

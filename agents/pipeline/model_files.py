@@ -182,14 +182,24 @@ class NormalizationStats:
         return stats
 
 
-def load_stats(model_dir: str | Path, trust_pickle: bool = False) -> NormalizationStats | None:
+def load_stats(
+    model_dir: str | Path, trust_pickle: bool = False, required: bool = False
+) -> NormalizationStats | None:
     """The statistics of a model directory: ``vecnormalize.npz``, else (only when trusted) the
-    legacy ``vecnormalize.pkl``; None when the model was trained without normalisation."""
+    legacy ``vecnormalize.pkl``; None when the model was trained without normalisation.
+    `required` (its config normalises): a missing file is a UserError, not a policy that would
+    act on observations on a scale it never saw."""
     model_dir = Path(model_dir)
     if (model_dir / STATS_FILE).is_file():
         return NormalizationStats.load(model_dir / STATS_FILE)
     legacy = model_dir / LEGACY_STATS_FILE
     if not legacy.is_file():
+        if required:
+            raise UserError(
+                f"{model_dir} has no {STATS_FILE}, but the model was trained with normalised "
+                "observations (its config.yaml's normalize section); without the statistics it "
+                "would act on inputs on a scale it never saw. Copy the file from the model's run"
+            )
         return None
     if not trust_pickle:
         raise UserError(

@@ -318,7 +318,8 @@ def _load_checkpoint(
     checkpoint: Path, config: TrainConfig, done: int, trust_pickle: bool
 ) -> tuple[Any, Any]:
     """The PPO model of a checkpoint on fresh vec envs; UserError (envs closed) if damaged."""
-    stats = load_stats(checkpoint, trust_pickle)
+    norm = config.normalize
+    stats = load_stats(checkpoint, trust_pickle, required=norm.observation or norm.reward)
     seed = config.train.seed + done
     venv, eval_env = _vec_envs(config, seed, stats)
     ppo = config.ppo
