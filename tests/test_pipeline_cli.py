@@ -138,6 +138,26 @@ def test_ctrl_c_saves_a_checkpoint_and_exits_130(tmp_path, monkeypatch, capsys):
     assert "python train.py --resume" in capsys.readouterr().err
 
 
+def test_a_resumed_run_evaluates_at_the_steps_of_an_uninterrupted_one(tmp_path, monkeypatch):
+    """Interrupted at 300 steps, between evaluations: the resumed part evaluates at 512, 768
+    and 1024 (multiples of eval.freq), not 256 steps after the restart."""
+    calls = {"n": 0}
+    original = callbacks.EpisodeStatsCallback._on_step
+
+    def interrupt(self):
+        calls["n"] += 1
+        if calls["n"] == 300:
+            raise KeyboardInterrupt
+        return original(self)
+
+    monkeypatch.setattr(callbacks.EpisodeStatsCallback, "_on_step", interrupt)
+    assert train(tmp_path, "cut", overrides=[*TINY, "eval.freq=256"]) == 130
+    monkeypatch.undo()
+    assert train_main(["--resume", str(tmp_path / "cut")]) == 0
+    timesteps = np.load(tmp_path / "cut" / "evaluations.npz")["timesteps"]
+    assert timesteps.tolist() == [0, 256, 512, 768, 1024]
+
+
 def test_existing_run_dir_is_not_overwritten_without_force(run, capsys):
     run_dir = run[0]
     before = meta(run_dir / "final")

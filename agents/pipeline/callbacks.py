@@ -145,6 +145,9 @@ class StatsEvalCallback(EvalCallback):
         action net it is the analytical controller or the reference motion, and ``best/`` then
         only holds a trained policy that scored higher than where training started."""
         super()._on_training_start()
+        # SB3 counts calls from this process's start; counting them from the run's start keeps
+        # a resumed run's evaluations at the steps of an uninterrupted run's.
+        self.n_calls = self.num_timesteps // self.training_env.num_envs
         if self.eval_freq > 0 and self.num_timesteps == 0 and not self.evaluations_timesteps:
             self._on_step()
 
