@@ -118,6 +118,7 @@ def test_overrides_are_typed_and_reach_nested_dicts():
         ("ppo.batch_size=100000", r"batch_size=100000 exceeds the rollout size"),
         ("ppo", r"must look like key.subkey=value"),
         ("policy.pi=5", r"policy.pi: expected a list"),
+        ("train.device=gpu0", r"train.device must be \"auto\" or a torch device"),
     ],
 )
 def test_bad_values_are_named(override, match):
@@ -179,6 +180,20 @@ def test_override_into_a_value_is_an_error():
 def test_suite_policy_names_are_checked():
     with pytest.raises(ConfigError, match=r"unknown policy 'ppo'.*ppo:<path>"):
         from_mapping(EvaluationSuite, {"envs": ["HexapodCliffWalk-v0"], "policies": ["ppo"]})
+
+
+@pytest.mark.parametrize(
+    ("key", "value", "match"),
+    [
+        ("seed", -1, r"seed must be >= 0"),
+        ("frame_size", [320, -240], r"frame_size \[width, height\] in pixels >= 1"),
+        ("xi_f_deg", float("nan"), r"xi_f_deg must be in \[0, 90\]"),
+        ("episodes", 0, r"episodes must be >= 1"),
+    ],
+)
+def test_bad_suite_values_are_named(key, value, match):
+    with pytest.raises(ConfigError, match=match):
+        from_mapping(EvaluationSuite, {"envs": ["HexapodCliffWalk-v0"], key: value})
 
 
 # --- episode statistics -------------------------------------------------------------------------

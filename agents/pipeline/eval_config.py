@@ -97,8 +97,15 @@ class EvaluationSuite:
     def __post_init__(self):
         if self.episodes < 1:
             raise ValueError(f"episodes must be >= 1, got {self.episodes}")
-        if self.frame_count < 1 or len(self.frame_size) != 2:
-            raise ValueError("frame_count must be >= 1 and frame_size [width, height]")
+        if self.seed < 0:
+            raise ValueError(f"seed must be >= 0 (Gymnasium seeds), got {self.seed}")
+        if self.frame_count < 1 or len(self.frame_size) != 2 or min(self.frame_size) < 1:
+            raise ValueError(
+                "frame_count must be >= 1 and frame_size [width, height] in pixels >= 1, got "
+                f"{self.frame_count} and {self.frame_size}"
+            )
+        if not 0.0 <= self.xi_f_deg <= 90.0:  # NaN fails too
+            raise ValueError(f"xi_f_deg must be in [0, 90] degrees, got {self.xi_f_deg}")
         if not 0 < self.video_fps <= 100:
             raise ValueError(f"video_fps must be in (0, 100], got {self.video_fps}")
         unknown = [r for r in self.references or () if r not in self.policies]

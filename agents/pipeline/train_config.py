@@ -233,6 +233,14 @@ class TrainingConfig:
         for name in ("num_threads", "total_timesteps"):
             _require(f"train.{name}", getattr(self, name), ">= 1", getattr(self, name) >= 1)
         _require("train.seed", self.seed, ">= 0", self.seed >= 0)
+        if self.device != "auto":  # SB3's "auto": CUDA when available
+            import torch  # here, not at import: the config is read where torch is not needed
+
+            try:
+                torch.device(self.device)
+            except (RuntimeError, TypeError):
+                valid = '"auto" or a torch device ("cpu", "cuda", "cuda:<n>", ...)'
+                _require("train.device", self.device, valid, False)
 
 
 @dataclass
