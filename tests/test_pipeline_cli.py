@@ -535,6 +535,12 @@ def test_reward_exclude_takes_the_named_terms_out_of_the_reward():
         env.step(np.zeros(18))
 
 
+def test_a_misspelt_reward_exclude_stops_training_before_the_run_folder(tmp_path, capsys):
+    assert train(tmp_path, "x", overrides=[*TINY, "env.reward_exclude=[alivee]"]) == 2
+    assert "reward_alivee" in capsys.readouterr().err
+    assert not (tmp_path / "x").exists()
+
+
 def test_a_settings_note_names_the_model_of_its_env_not_the_template(run, tmp_path):
     """``ppo:models/{env_id}/...`` differing from its training env is told per env, with the
     path of the model that differs (the report must not show an unexpanded template)."""

@@ -99,9 +99,13 @@ def _probe(
     learner step is a gait cycle), metric specs and the robot's tipping threshold ξ (the time
     below it is logged). Returns a factory of episode
     accumulators for the training and evaluation callbacks, and the env's resolved settings
-    (recorded with the run, see `env_settings`)."""
+    (recorded with the run, see `env_settings`); with ``reward_exclude``, one step checks
+    that the terms exist."""
     env = spec.make()
     try:
+        if spec.reward_exclude:  # a term missing from the info is named at the first step
+            env.reset(seed=0)
+            env.step(np.zeros(env.action_space.shape, env.action_space.dtype))
         dt, specs = env_time_step(env), metric_specs(env)
         if spec.decision == "gait_cycle":
             dt = None  # a learner step is a gait cycle, not control_dt: no durations or energy
