@@ -165,7 +165,15 @@ def test_schedules(value, at_start, at_half, at_end):
 
 
 @pytest.mark.parametrize(
-    "value", ["lin_x", "exp_3e-4", {"type": "cosine", "initial": 1.0}, {"initial": 1, "end": 0}]
+    "value",
+    [
+        "lin_x",
+        "exp_3e-4",
+        "lin_1e-4_2",  # not 1e-42 (Python's float() takes digit separators)
+        "1_000",
+        {"type": "cosine", "initial": 1.0},
+        {"initial": 1, "end": 0},
+    ],
 )
 def test_bad_schedules_are_errors(value):
     with pytest.raises(ConfigError, match="ppo.learning_rate"):

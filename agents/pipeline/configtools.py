@@ -52,7 +52,7 @@ def parse_float(value: Any, where: str) -> float:
         raise ConfigError(f"{where}: expected a number, got {value!r}")
     if isinstance(value, int | float):
         return float(value)
-    if isinstance(value, str):
+    if isinstance(value, str) and "_" not in value:  # float() reads "1e-4_2" as 1e-42
         try:
             return float(value)
         except ValueError:
