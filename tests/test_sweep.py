@@ -216,6 +216,10 @@ def test_sweep_flags_are_checked(tmp_path):
                     "--output-dir", str(tmp_path), "--run-name", "x")  # fmt: skip
     assert result.returncode == 2 and f"no Ray cluster answers at {address}" in result.stderr
     assert not (tmp_path / "x").exists()
+    bad_kwarg = tiny_sweep(tmp_path, [0], **{"env.kwargs": {"terain": "blocks"}})
+    result = _train("--sweep", str(bad_kwarg), "--output-dir", str(tmp_path), "--run-name", "y")
+    assert result.returncode == 2 and "terain" in result.stderr  # before Ray starts
+    assert not (tmp_path / "y").exists()
 
 
 # --- Ctrl-C and --resume ---------------------------------------------------------------------

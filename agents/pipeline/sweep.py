@@ -259,9 +259,12 @@ def run_sweep(
     """Create the sweep directory, run every trial on Ray Tune, write the summaries."""
     from ray import tune
 
+    from .training import check_env
+
     max_concurrent = _default_concurrency(address, max_concurrent)
+    check_env(sweep.base_config)  # before the sweep directory exists, as is:
     if address is not None:
-        _check_reachable(address)  # before the sweep directory exists
+        _check_reachable(address)
     stem = sweep.config.name or (sweep.path.stem if sweep.path else "sweep")
     name = name or f"{stem}__{time.strftime('%Y%m%d-%H%M%S')}"
     sweep_dir = prepare_new_dir(Path(output_dir) / name, force, "sweep directory").resolve()

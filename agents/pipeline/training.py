@@ -116,6 +116,12 @@ def _probe(
     return partial(EpisodeAccumulator, dt, specs, xi_f_deg=xi), settings
 
 
+def check_env(config: TrainConfig) -> None:
+    """Build the config's env once in this process, so that its errors (an unknown keyword, a
+    misspelt reward term) come before any folder exists, e.g. before a sweep starts Ray."""
+    _probe(env_spec(config))
+
+
 def _vec_envs(config: TrainConfig, seed: int, stats: NormalizationStats | None = None):
     """Training vec env (VecNormalize on top when configured) and a 1-env evaluation vec env."""
     from stable_baselines3.common.vec_env import DummyVecEnv, VecNormalize
