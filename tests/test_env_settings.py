@@ -242,6 +242,8 @@ def test_every_setting_is_checked_and_every_number_is_a_numeric_setting(env_id):
         ("HexapodIrregularTerrain-v0", {"block_height_range": (0.04, math.nan)}),
         ("HexapodDitchCrossing-v0", {"ditch_width_range": (0.3, math.inf)}),
         ("HexapodDitchCrossing-v0", {"task_distribution": "easy"}),
+        ("HexapodDitchCrossing-v0", {"camera_name": "trak"}),
+        ("HexapodCliffWalk-v0", {"camera_name": "side"}),
     ],
 )
 def test_meaningless_values_are_named(env_id, kwargs):

@@ -311,6 +311,12 @@ class HexapodEnv(gym.Env):
         self.model: mujoco.MjModel | None = None
         self.data: mujoco.MjData | None = None
         self._setup()
+        cameras = [self.model.camera(i).name for i in range(self.model.ncam)]
+        if self._camera_name is not None and self._camera_name not in cameras:
+            raise ValueError(
+                f"camera_name {self._camera_name!r} is not a camera of the model; valid: "
+                f"{cameras}, or None (the free camera)"
+            )
         self._action_low = np.asarray(self.action_space.low, dtype=np.float64)
         self._action_high = np.asarray(self.action_space.high, dtype=np.float64)
         self._action = np.empty_like(self._action_low)
