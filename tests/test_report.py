@@ -193,3 +193,73 @@ def test_success_and_tip_over_differences_say_when_they_are_not_resolved():
     (bullet,), _ = verdict_lines(result, aggs)
     assert "success 20/20 vs 0/20," in bullet and "tip-overs 0/20 vs 20/20." in bullet
     assert "lead in successes over `zero` is resolved" in verdict_paragraph(result, aggs)
+
+
+def test_the_report_says_which_checkpoint_it_evaluated(report):
+    """A shipped model's sources name its checkpoint and steps; a best/ kept from step 0 says it
+    is the initial policy (models/HexapodIrregularTerrain-v0/hybrid: step 0)."""
+    from agents.pipeline.artifacts import read_meta
+    from agents.pipeline.evaluation import checkpoint_note
+
+    md = (report / "report.md").read_text()
+    for env_id in ENVS:
+        meta = read_meta(f"models/{env_id}/hybrid")
+        assert f"({meta['kind']} checkpoint at {meta['num_timesteps']} env steps" in md
+    note = checkpoint_note("models/HexapodIrregularTerrain-v0/hybrid")
+    assert note == " (best checkpoint at 0 env steps: the initial policy, no training step kept)"
+
+
+def test_speed_gets_no_verdict_where_the_robot_stands(report):
+    """The Stewart tilt's robot stands: its distance is drift or a fall, so no policy is
+    better for a larger one; the ditch's robot walks, and speed is compared there."""
+    metrics = json.loads((report / "metrics.json").read_text())["envs"]
+    stewart = metrics["HexapodStewartTilt-v0"]
+    assert stewart["unranked_metrics"] == ["speed_m_s"]
+    assert not [c for c in stewart["comparisons"] if c["metric"] == "speed_m_s"]
+    ditch = metrics["HexapodDitchCrossing-v0"]
+    assert [c for c in ditch["comparisons"] if c["metric"] == "speed_m_s"]
+
+
+def test_an_unstable_episode_is_flagged_and_its_repeated_readings_count_once():
+    from agents.pipeline.episode import EpisodeAccumulator
+    from hexapod_envs import info_keys as keys
+
+    acc = EpisodeAccumulator(dt=0.1, xi_f_deg=20.0)
+    good = {keys.FASM_MARGIN_DEG: 10.0, "actuator_power_w": 5.0, keys.IS_SUCCESS: False}
+    acc.add(1.0, good)
+    acc.add(0.0, {**good, keys.SIM_UNSTABLE: True})  # the env repeats the last good readings
+    record = acc.finish(terminated=False, truncated=True)
+    assert record.sim_unstable and record.scalar_metrics()["sim_unstable"]
+    assert record.length == 2 and record.energy_j == pytest.approx(0.5)
+    assert record.time_below_xi_s == pytest.approx(0.1) and record.fraction_below_xi == 1.0
+    stable = EpisodeAccumulator(dt=0.1, xi_f_deg=20.0)
+    stable.add(1.0, good)
+    assert not stable.finish(terminated=False, truncated=True).sim_unstable
+
+
+def test_a_study_row_names_the_checkpoint_it_evaluates(tmp_path):
+    """A trial's row gives the steps of the model evaluated (best/ first), not of its newest
+    checkpoint: a best/ kept from step 0 is the initial policy however long the trial ran."""
+    from agents.pipeline.configtools import from_mapping
+    from agents.pipeline.eval_config import EvaluationSuite
+    from agents.pipeline.evaluation import checkpoint_note
+    from agents.pipeline.study import expand_studies
+
+    sweep = tmp_path / "sweep"
+    trial = sweep / "trial_00000"
+    (sweep / "sweep.yaml").parent.mkdir()
+    (sweep / "sweep.yaml").write_text("{}\n")
+    for sub, steps in (("best", 0), ("final", 100352)):
+        (trial / sub).mkdir(parents=True)
+        (trial / sub / "model.zip").write_bytes(b"")
+        meta = {"kind": sub, "num_timesteps": steps}
+        (trial / sub / "meta.json").write_text(json.dumps(meta))
+    (trial / "config.yaml").write_text("{}\n")
+    (trial / "trial.json").write_text(json.dumps({"overrides": ["train.seed=0"]}))
+    suite = from_mapping(
+        EvaluationSuite, {"envs": ["HexapodCliffWalk-v0"], "policies": [f"ppo:{sweep}"]}
+    )
+    _, (study,), _ = expand_studies(suite)
+    (label,) = study.members.values()
+    assert label == "train.seed=0" + checkpoint_note(trial / "best")
+    assert "at 0 env steps: the initial policy" in label

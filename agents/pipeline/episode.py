@@ -178,6 +178,7 @@ class EpisodeRecord:
     specifics: dict[str, Any] = field(default_factory=dict)
     fasm_trace_deg: list[float] | None = None
     task: dict[str, Any] = field(default_factory=dict)  # the env's info["task"] (sampled task)
+    sim_unstable: bool = False  # ended by an unstable simulation (info["sim_unstable"])
 
     def scalar_metrics(self) -> dict[str, Any]:
         """Flat name -> value of every per-episode metric (for JSON and aggregation)."""
@@ -195,6 +196,7 @@ class EpisodeRecord:
             "energy_j": self.energy_j,
             "speed_m_s": _per_second(self.distance_m, self.duration_s),
             "mean_power_w": _per_second(self.energy_j, self.duration_s),
+            "sim_unstable": self.sim_unstable,
         }
         out.update({f"return_{k}": v for k, v in self.reward_terms.items()})
         return out
@@ -236,6 +238,7 @@ class EpisodeAccumulator:
         self.energy = 0.0
         self.has_power = False
         self.tipped = False
+        self.unstable = False
         self.last_info: Mapping[str, Any] = {}
         self.episode_metrics: dict[str, Any] = {}
         self.reducers = {s.name: _Reducer(s.reduce) for s in self._step_specs}
@@ -244,6 +247,12 @@ class EpisodeAccumulator:
     def add(self, reward: float, info: Mapping[str, Any]) -> None:
         self.length += 1
         self.episode_return += float(reward)
+        if info.get(keys.SIM_UNSTABLE):
+            # The step that went unstable repeats the last good step's readings (FASM, power,
+            # the env's metrics): counted once, with that step, not twice.
+            self.unstable = True
+            self.last_info = info
+            return
         for key, value in info.items():
             if key.startswith(keys.REWARD_PREFIX):
                 name = key[len(keys.REWARD_PREFIX) :]
@@ -301,6 +310,7 @@ class EpisodeAccumulator:
             specifics=specifics,
             task=_plain(dict(info.get(keys.TASK) or {})),
             fasm_trace_deg=list(self.trace) if self.keep_trace else None,
+            sim_unstable=self.unstable,
         )
         self.reset()
         return record

@@ -55,6 +55,7 @@ class EnvResult:
     runs: dict[str, PolicyRun] = field(default_factory=dict)
     xi_deg: float | None = None  # the robot's FASM threshold ξ; None: FASM is not its criterion
     criterion: str = ""  # the robot's stability criterion, in words
+    unranked: tuple[str, ...] = ()  # standard metrics without a verdict here (see `prepare`)
 
     def label(self, name: str) -> str:
         """The policy name with ``{env_id}`` expanded (what a reader of this env sees)."""
@@ -215,7 +216,22 @@ def build_policy(
     policy = PPOPolicy.load(
         path, env, deterministic=suite.deterministic, trust_pickle=suite.trust_pickle
     )
-    return policy, str(policy.files.model)
+    return policy, f"{policy.files.model}{checkpoint_note(policy.files.directory)}"
+
+
+def checkpoint_note(model_dir: Path) -> str:
+    """The text ' (<kind> checkpoint at <n> env steps)' from a model directory's meta.json,
+    saying so when it is the initial policy (a best/ that no later evaluation beat); '' without
+    a meta.json."""
+    from .artifacts import read_meta
+
+    meta = read_meta(model_dir)
+    steps = meta.get("num_timesteps")
+    if steps is None:
+        return ""
+    kind = meta.get("kind", "saved")
+    initial = ": the initial policy, no training step kept" if steps == 0 else ""
+    return f" ({kind} checkpoint at {steps} env steps{initial})"
 
 
 def _check_env_ids(suite: EvaluationSuite) -> None:
@@ -336,6 +352,8 @@ def prepare(
             specs=metric_specs(env),
         )
         result.xi_deg, result.criterion = stability_threshold(env, suite.xi_f_deg)
+        if not getattr(env.unwrapped, "walks", True):  # a standing task (the Stewart tilt):
+            result.unranked = ("speed_m_s",)  # distance is drift or a fall, not progress
         policies = {}
         for name in suite.policies:
             missing = _missing_reason(name, suite_env.id)

@@ -305,7 +305,7 @@ def verdict_lines(
         for name in aggs:
             if name in keys[: i + 1]:
                 continue  # itself, or a pair already compared the other way round
-            verdicts = compare(name, reference, aggs, result.specs, episodes)
+            verdicts = compare(name, reference, aggs, result.specs, episodes, result.unranked)
             all_verdicts += verdicts
             lines.append(_bullet(name, reference, aggs, verdicts))
     if not lines:
@@ -326,9 +326,12 @@ def _agg_key(reference: str, result: EnvResult, aggs: dict[str, dict]) -> str | 
 
 
 def _unresolved(v: Verdict | None) -> str:
-    """ " (not resolved: difference [lo, hi])" for a difference whose interval includes 0."""
-    if v is None or v.outcome == "tie" or v.interval is None or v.resolved:
+    """ " (not resolved: difference [lo, hi])" for a difference whose interval includes 0,
+    " (no paired interval)" for one that has none (fewer than two episodes pair up)."""
+    if v is None or v.outcome == "tie" or v.resolved:
         return ""
+    if v.interval is None:
+        return " (no paired interval)"
     return f" (not resolved: difference [{_num(v.interval[0])}, {_num(v.interval[1])}])"
 
 
@@ -400,7 +403,12 @@ HOW_TO_READ = [
     "- **Not resolved** marks a difference whose 95 % paired-bootstrap interval includes 0: "
     "every policy runs the same seeds, hence the same tasks, and the bootstrap resamples the "
     "tasks with both policies' episodes together, so the interval shows how much of the "
-    "difference the draw of the tasks alone could make.",
+    "difference the draw of the tasks alone could make. **No paired interval** marks one "
+    "measured on fewer than two pairs of episodes: its uncertainty is unknown.",
+    "- **Ties**: a difference within 1 % of the larger value counts as equal and gets no "
+    "verdict, even where its interval excludes 0 (the per-policy tables show the values). Where "
+    "the robot stands rather than walks (the Stewart tilt), distance per second gets no verdict: "
+    "its distance is drift or the direction of a fall, not progress.",
 ]
 
 
@@ -453,6 +461,7 @@ def build_metrics(result: SuiteResult) -> dict[str, Any]:
             "max_episode_steps": r.max_episode_steps,
             "dt_s": r.dt,
             "metric_specs": [s.__dict__ for s in r.specs],
+            "unranked_metrics": list(r.unranked),
             "policies": {
                 n: {
                     "label": r.label(n),
@@ -623,6 +632,17 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
         if not r.runs:
             continue
         table(main_table(aggs))
+        unstable = [
+            f"`{name}` {rate(a['sim_unstable'])}"
+            for name, a in aggs.items()
+            if a.get("sim_unstable") and a["sim_unstable"]["mean"] > 0
+        ]
+        if unstable:
+            para(
+                "Episodes that ended in an unstable simulation (`info['sim_unstable']`: the "
+                "episode truncates; it counts as no success, and its last step's repeated "
+                "readings are left out): " + ", ".join(unstable) + "."
+            )
         heading("Comparisons (like with like)", 3)
         bullets(verdict_lines(r, aggs, result.suite.reference_names)[0])
         if all(a["energy_j"] is None for a in aggs.values()):

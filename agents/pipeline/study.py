@@ -59,7 +59,8 @@ def expand_studies(suite: EvaluationSuite) -> tuple[EvaluationSuite, list[Study]
 
     Returns the expanded suite, the studies and warning lines (trials without a saved model).
     """
-    from .artifacts import latest_model_dir, read_meta
+    from .artifacts import find_model
+    from .evaluation import checkpoint_note
     from .sweep_summary import TRIAL_FILE, trial_dirs
 
     policies: list[str] = []
@@ -77,16 +78,15 @@ def expand_studies(suite: EvaluationSuite) -> tuple[EvaluationSuite, list[Study]
             )
         study = Study(name, sweep_dir)
         for trial in trial_dirs(sweep_dir):
-            has_model = (trial / "best" / "model.zip").is_file() or latest_model_dir(trial)
-            if not has_model:
+            try:  # the model evaluated: best/ > final/ > the latest checkpoint
+                evaluated = find_model(trial).directory
+            except UserError:
                 warnings.append(f"{name}: {trial.name} holds no saved model yet; left out")
                 continue
             info_path = trial / TRIAL_FILE
             info = json.loads(info_path.read_text()) if info_path.is_file() else {}
-            final = latest_model_dir(trial)
-            steps = read_meta(final).get("num_timesteps") if final else None
             label = " ".join(info.get("overrides", [])) or trial.name
-            study.members[f"{PPO_PREFIX}{trial}"] = f"{label} ({steps} steps)"
+            study.members[f"{PPO_PREFIX}{trial}"] = f"{label}{checkpoint_note(evaluated)}"
         if not study.members:
             raise UserError(f"{name}: the sweep directory {sweep_dir} holds no trained trial")
         policies.extend(m for m in study.members if m not in policies)

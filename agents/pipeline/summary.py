@@ -189,11 +189,13 @@ def compare(
     aggregates: dict[str, dict[str, Any]],
     specs: list[MetricSpec],
     episodes: dict[str, list[EpisodeRecord]] | None = None,
+    unranked: Iterable[str] = (),
 ) -> list[Verdict]:
     """Metric-by-metric verdicts of `challenger` against `baseline` (means; medians for pooled
     per-cycle lists). Differences up to `TIE_TOLERANCE` of the larger magnitude are ties. With
     `episodes` (per policy, in seed order, the same seeds for both) every verdict carries the
-    paired-bootstrap interval of the difference (`paired_difference_interval`)."""
+    paired-bootstrap interval of the difference (`paired_difference_interval`). `unranked`:
+    standard metrics that have no better direction on this env (speed where the robot stands)."""
     a, b = aggregates[challenger], aggregates[baseline]
     per_episode = None  # name -> every episode's metrics (standard ones over specifics)
     if episodes is not None and len(episodes[challenger]) == len(episodes[baseline]):
@@ -203,7 +205,7 @@ def compare(
         }
     rows: list[tuple[str, str, str, dict | None, dict | None, bool]] = []
     for key, (label, _, better) in STANDARD_METRICS.items():
-        if better is not None:
+        if better is not None and key not in unranked:
             rows.append((key, label, better, a.get(key), b.get(key), False))
     for spec in specs:
         if spec.better is None:
