@@ -252,6 +252,9 @@ def test_resume_falls_back_past_a_damaged_newest_checkpoint(copy_run, capsys):
     err = capsys.readouterr().err
     assert "cannot resume from" in err and "falling back to step_000000000768" in err
     assert meta(run_dir / "final")["num_timesteps"] >= 1100
+    # the evaluation at 1024 steps is made again, not appended after the first one
+    timesteps = np.load(run_dir / "evaluations.npz")["timesteps"]
+    assert timesteps.tolist() == [0, 512, 1024]
 
 
 def test_resume_skips_half_written_checkpoints_and_ones_without_their_statistics(copy_run, capsys):

@@ -409,7 +409,7 @@ def _learn(
             select_saver=saver if by_success else None,
         )
         if resumed:
-            _restore_eval_history(eval_cb, run_dir)
+            _restore_eval_history(eval_cb, run_dir, model.num_timesteps)
         callbacks.append(eval_cb)
     tb_dir = run_dir / "tb"
     formats = []
@@ -556,8 +556,11 @@ def close_vec_env(venv: Any, timeout: float = WORKER_CLOSE_TIMEOUT_S) -> None:
     inner.closed = True
 
 
-def _restore_eval_history(eval_cb: Any, run_dir: Path) -> None:
-    """Keep the best reward and the evaluation log of the earlier part of a resumed run."""
+def _restore_eval_history(eval_cb: Any, run_dir: Path, done: int) -> None:
+    """Keep the best reward and the evaluation log of the earlier part of a resumed run: the
+    log's entries up to the resumed checkpoint's `done` steps (resuming from an older checkpoint
+    than the newest, the later evaluations are made again), the best score over all of them
+    (``best/`` keeps the model that scored it)."""
     best = read_meta(run_dir / BEST)
     if "eval_mean_reward" in best:
         eval_cb.best_mean_reward = float(best["eval_mean_reward"])
@@ -575,6 +578,10 @@ def _restore_eval_history(eval_cb: Any, run_dir: Path) -> None:
             eval_cb.best_score = max(
                 eval_cb.score(i) for i in range(len(eval_cb.evaluations_results))
             )
+        kept = sum(1 for t in eval_cb.evaluations_timesteps if t <= done)
+        for name in ("timesteps", "results", "length", "successes"):
+            entries = getattr(eval_cb, f"evaluations_{name}")
+            del entries[kept:]
     except (OSError, ValueError, KeyError, EOFError) as exc:
         print(
             f"warning: the evaluation log {log} is unreadable ({exc}); it starts anew",
