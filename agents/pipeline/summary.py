@@ -4,7 +4,9 @@ paired-bootstrap intervals of their differences.
 Verdicts compare like with like: rates per episode (success, tip-over), per-episode extremes
 (min FASM), and time-integrated quantities only per second of episode (share of time below ξ,
 speed, mean power), so a policy whose episodes end early cannot look better on a total that is
-small only because its episode was short. The totals stay in the tables, with no verdict."""
+small only because its episode was short. The totals stay in the tables, with no verdict; the
+exceptions are the return, the objective the agents are trained on, and the totals an env
+declares with a direction (e.g. the irregular terrain's torso-collision count)."""
 
 from __future__ import annotations
 
