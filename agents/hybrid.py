@@ -19,6 +19,14 @@ so training and evaluation compute the same env action from the same observation
     internal state (clock, gait phase, tipping judgment) is current when it takes over. Meant
     for residual action modes, where a zero env action is the env's reference motion.
 
+    The heavy-duty robot's recovery (Zhang et al. 2024) acts once per episode: after judging
+    tipping it lands a leg, distributes the foot forces and then holds that stance until the env
+    resets; handing control back does not re-arm it. Every later override in the episode applies
+    that recovery's supported or held posture, not a new judgment: on the shipped cliff
+    hybrid's first four test tasks (zero learned action), 414-581 of the 505-657 override steps
+    per episode found the controller in its supported or holding phase, none in monitoring. All
+    four episodes succeeded.
+
 ``safety_filter=True`` adds the same override to the residual mode: the learned residual is
 dropped (the pure analytical action is applied) while the FASM is below ξ, so a residual cannot
 spoil a recovery. ``info["safety_override"]`` tells, at every step, whether the analytical
@@ -275,21 +283,30 @@ def from_run_config(learned: Policy, env: gym.Env, config: dict[str, Any]) -> Po
     """`learned` as its training run used it: wrapped in `HybridPolicy` when the run's resolved
     config has a ``hybrid`` section, unchanged otherwise (`agents.ppo.PPOPolicy.load`'s hook).
 
-    A hybrid's learned action only means something in the action mode it was trained in, so a
-    different ``action_mode`` on `env` is an error (ValueError) naming both.
+    A hybrid's learned action only means something with the env settings that say how an action
+    is read or what the observation holds (`agents.pipeline.evaluation.POLICY_SETTINGS`: the
+    action mode, the residual scale and filter, ...), so one that differs on `env` is an error
+    (ValueError) naming both values.
     """
     settings = settings_from_config(config.get("hybrid"))
     if settings is None:
         return learned
-    from .pipeline.evaluation import _constructor_defaults
+    from .pipeline.evaluation import POLICY_SETTINGS, _constructor_defaults
 
     trained_kwargs = (config.get("env") or {}).get("kwargs") or {}
     defaults = _constructor_defaults(env)
-    trained = trained_kwargs.get("action_mode", defaults.get("action_mode"))
-    current = getattr(env.unwrapped, "action_mode", None)
-    if trained != current:
-        raise ValueError(
-            f"this hybrid model was trained with action_mode={trained!r} but the env has "
-            f"action_mode={current!r}; evaluate it with env kwargs action_mode: {trained}"
-        )
+    env_settings = getattr(env.unwrapped, "settings", None)
+    for key in POLICY_SETTINGS:
+        if env_settings is not None and hasattr(env_settings, key):
+            current = getattr(env_settings, key)
+        elif key == "action_mode":
+            current = getattr(env.unwrapped, "action_mode", None)
+        else:
+            continue  # a setting this env does not have
+        trained = trained_kwargs.get(key, defaults.get(key, current))
+        if trained != current:
+            raise ValueError(
+                f"this hybrid model was trained with {key}={trained!r} but the env has "
+                f"{key}={current!r}; evaluate it with env kwargs {key}: {trained}"
+            )
     return HybridPolicy(learned, env, settings)

@@ -8,6 +8,7 @@ same way. Analytical policies read the observation by name through the env's
 
 from __future__ import annotations
 
+import copy
 from typing import Protocol, runtime_checkable
 
 import gymnasium as gym
@@ -19,6 +20,25 @@ class Policy(Protocol):
     def reset(self) -> None: ...
 
     def __call__(self, observation: np.ndarray) -> np.ndarray: ...
+
+
+class EnvBound:
+    """Base of a policy that reads its env's task description (``self.env``) after each reset.
+
+    A deep copy of the policy keeps reading the same env, unless that env was copied earlier in
+    the same `copy.deepcopy` call (a wrapper holding both copies its env first): then the copy
+    reads the copied env. A plain deep copy would give it an env of its own that nobody resets.
+    """
+
+    env: gym.Env
+
+    def __deepcopy__(self, memo: dict) -> EnvBound:
+        new = type(self).__new__(type(self))
+        memo[id(self)] = new
+        for key, value in self.__dict__.items():
+            shared = key == "env"
+            new.__dict__[key] = memo.get(id(value), value) if shared else copy.deepcopy(value, memo)
+        return new
 
 
 class ZeroPolicy:

@@ -42,12 +42,12 @@ from hexapod_envs.robots.upu.gait_plan import (
 from hexapod_envs.robots.upu.gait_schedule import Checkpoint, GaitSchedule, GaitTiming
 from hexapod_envs.robots.upu.params import LEG_NAMES
 
-from .policy import ObservationReader
+from .policy import EnvBound, ObservationReader
 
 _LEG_INDEX = {leg: i for i, leg in enumerate(LEG_NAMES)}
 
 
-class UpuGaitPolicy:
+class UpuGaitPolicy(EnvBound):
     """The paper's 3-3 gait planned for the env's ditch; `reset()`, `__call__(obs) -> action`.
 
     Args:

@@ -322,6 +322,14 @@ def test_task_description_is_declared_and_frozen(env_id):
         desc.control_dt = 1.0
     with pytest.raises(TypeError):
         desc.course["x"] = 1.0
+    import pickle
+
+    for copied in (copy.deepcopy(desc), pickle.loads(pickle.dumps(desc))):
+        assert copied.course == desc.course and type(copied.robot) is type(desc.robot)
+        assert copied.observation_structure == desc.observation_structure
+        assert copied.reference.keys() == desc.reference.keys()  # values: arrays, plans
+        with pytest.raises(TypeError):  # read-only again
+            copied.reference["x"] = 1.0
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)

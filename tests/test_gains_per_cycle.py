@@ -177,7 +177,10 @@ def test_a_gait_cycle_run_trains_per_cycle_and_evaluates_per_step(tmp_path):
     assert "rollout/ep_len_mean" in log.Tags()["scalars"]
     lengths = [e.value for e in log.Scalars("rollout/ep_len_mean")]
     assert lengths and max(lengths) <= 120 / _ticks_per_cycle() + 1
-    env = gym.make(ENV_ID, action_mode="gains", task_distribution="test")
+    # the env settings it was trained with (the config's; evaluate.py sets them the same way)
+    env = gym.make(
+        ENV_ID, action_mode="gains", task_distribution="test", gait_ground_search="always"
+    )
     policy = PPOPolicy.load(run / "final", env)
     obs, _ = env.reset(seed=0)
     gains = policy(obs)

@@ -289,3 +289,47 @@ def test_override_cost_is_a_named_reward_term_of_the_overridden_steps():
         HybridSettings(override_cost=0.1)
     with pytest.raises(ValueError, match="override_cost must be a finite number >= 0"):
         HybridSettings(mode="safety", override_cost=-1.0)
+
+
+def test_a_copy_of_a_hybrid_or_its_controller_reads_the_env_it_belongs_to():
+    """A deep copy of an analytical policy alone keeps reading its env (which its user resets);
+    a deep copy of a wrapper holding both reads the copied env. The ditch's task description
+    (read-only mappings) copies too."""
+    import copy
+
+    env = gym.make("HexapodStewartTilt-v0", task_distribution="train", action_mode="joint")
+    policy = analytical_policy(env)
+    obs, _ = env.reset(seed=0)
+    policy.reset()
+    policy(obs)
+    twin = copy.deepcopy(policy)
+    assert twin.env is policy.env
+    for seed in range(1, 4):  # the held tripod changes from task to task
+        obs, _ = env.reset(seed=seed)
+        policy.reset(), twin.reset()
+        np.testing.assert_array_equal(policy(obs), twin(obs))
+    for name, kwargs in (("HexapodDitchCrossing-v0", {"action_mode": "joint"}), (env.spec.id, {})):
+        wrapper = HybridWrapper(gym.make(name, **kwargs), HybridSettings())
+        copied = copy.deepcopy(wrapper)
+        assert copied.core.base.env in (copied.env, copied.unwrapped)
+        assert wrapper.core.base.env in (wrapper.env, wrapper.unwrapped)
+
+
+def test_the_recovery_judges_tipping_at_the_envs_threshold():
+    env = gym.make("HexapodStewartTilt-v0", tipping_threshold_deg=25.0)
+    assert analytical_policy(env).controller.config.threshold_deg == 25.0
+    assert (
+        analytical_policy(gym.make("HexapodStewartTilt-v0")).controller.config.threshold_deg == 20.0
+    )
+
+
+def test_a_hybrid_model_refuses_an_env_that_reads_its_action_otherwise():
+    """The shipped cliff hybrid learned its action at residual_scale 2: at the env's default
+    0.25 its actions would mean something else, so loading it there names the setting."""
+    from agents.pipeline.errors import UserError
+    from agents.ppo import PPOPolicy
+
+    model = Path(__file__).resolve().parents[1] / "models" / "HexapodCliffWalk-v0" / "hybrid"
+    with pytest.raises(UserError, match=r"residual_scale=2.0 but the env has residual_scale=0.25"):
+        PPOPolicy.load(model, gym.make("HexapodCliffWalk-v0"))
+    PPOPolicy.load(model, gym.make("HexapodCliffWalk-v0", residual_scale=2.0))

@@ -56,7 +56,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from agents.policy import ObservationReader
+from agents.policy import EnvBound, ObservationReader
 from agents.tipping import _compiled
 from agents.tipping.body_model import (
     GRAVITY,
@@ -628,7 +628,7 @@ class TippingRecoveryController:
         _compiled.offset_targets(targets, self._nominal, self._offsets, held)
 
 
-class TippingRecoveryPolicy:
+class TippingRecoveryPolicy(EnvBound):
     """Zhang et al. 2024's tipping recovery as a policy for the heavy-duty hexapod envs.
 
     Works in either action mode: the joint targets of :class:`TippingRecoveryController` become
@@ -643,7 +643,8 @@ class TippingRecoveryPolicy:
     Args:
         env: a heavy-duty hexapod env (e.g. HexapodStewartTilt-v0).
         config: :class:`RecoveryConfig`; keyword overrides of its fields may be given instead,
-            e.g. ``TippingRecoveryPolicy(env, reach_model="paper", solver="quadprog")``.
+            e.g. ``TippingRecoveryPolicy(env, reach_model="paper", solver="quadprog")``. Without
+            a config, the tipping threshold ξ is the env's (``tipping_threshold_deg``).
     """
 
     def __init__(self, env: gym.Env, config: RecoveryConfig | None = None, **overrides):
@@ -652,6 +653,8 @@ class TippingRecoveryPolicy:
         task = getattr(base, "task_description", None)
         if task is None or not isinstance(task.robot, HeavyDutyParams):
             raise ValueError(f"{type(base).__name__} is not a heavy-duty hexapod env")
+        if config is None and "threshold_deg" not in overrides:
+            overrides = {"threshold_deg": float(task.tipping_threshold_deg), **overrides}
         self.config = _config_with(config, overrides)
         self.read = ObservationReader(task.observation_structure)
         self.action_map = JointActionMap(np.column_stack([task.joint_low, task.joint_high]))

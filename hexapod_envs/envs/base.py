@@ -231,6 +231,21 @@ class TaskDescription:
     observation_structure: Mapping[str, slice]
     """Name -> slice of every piece of the flat observation (what a controller reads)."""
 
+    def __reduce__(self):
+        """Deep-copied and pickled with plain dicts in place of the read-only mappings (neither
+        `copy.deepcopy` nor pickle takes a mappingproxy), which the copy makes read-only again."""
+        fields = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
+        fields.update({name: dict(fields[name]) for name in _READ_ONLY})
+        return _task_description, (fields,)
+
+
+_READ_ONLY = ("course", "reference", "observation_structure")
+
+
+def _task_description(fields: dict[str, Any]) -> TaskDescription:
+    read_only = {name: MappingProxyType(fields[name]) for name in _READ_ONLY}
+    return TaskDescription(**{**fields, **read_only})
+
 
 _W = mujoco.mjtWarning
 if {_W.mjWARN_BADQPOS, _W.mjWARN_BADQVEL, _W.mjWARN_BADQACC, _W.mjWARN_BADCTRL} != set(
