@@ -275,7 +275,7 @@ def test_resume_skips_half_written_checkpoints_and_ones_without_their_statistics
 def test_a_model_without_its_normalisation_statistics_is_refused(run, tmp_path):
     model_dir = model_copy(run, tmp_path)
     (model_dir / "vecnormalize.npz").unlink()
-    with pytest.raises(UserError, match="has no vecnormalize.npz.*normalised observations"):
+    with pytest.raises(UserError, match="has no vecnormalize.npz, but its config.yaml normalises"):
         PPOPolicy.load(model_dir, gym.make("HexapodCliffWalk-v0", **_kwargs(run)))
 
 

@@ -196,9 +196,9 @@ def load_stats(
     if not legacy.is_file():
         if required:
             raise UserError(
-                f"{model_dir} has no {STATS_FILE}, but the model was trained with normalised "
-                "observations (its config.yaml's normalize section); without the statistics it "
-                "would act on inputs on a scale it never saw. Copy the file from the model's run"
+                f"{model_dir} has no {STATS_FILE}, but its config.yaml normalises (the normalize "
+                "section): without the statistics the policy would act on inputs on a scale it "
+                "never saw, and training would restart them. Copy the file from the model's run"
             )
         return None
     if not trust_pickle:
