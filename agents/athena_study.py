@@ -93,7 +93,7 @@ def run_episode(
     for k in range(steps):
         obs, _, terminated, truncated, info = env.step(policy(obs))
         record.zmp_margins.append(info["zmp_margin"])
-        stats = info["cycle_stats"]
+        stats = info.get("cycle_stats")
         if stats is not None and (top is None or stats["x_end"] < top):
             record.cycles.append(stats)
         record.steps = k + 1

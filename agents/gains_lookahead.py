@@ -241,7 +241,7 @@ def run_episode(env: gym.Env, seed: int, choose: Chooser) -> dict:
             action = np.asarray(choose(env, observation), dtype=env.action_space.dtype)
         observation, _, terminated, truncated, info = env.step(action)
         steps += 1
-        stats = info["cycle_stats"]
+        stats = info.get("cycle_stats")
         if stats is not None:
             pitch.append(stats["pitch_rate_rms"])
             roll.append(stats["roll_rate_rms"])

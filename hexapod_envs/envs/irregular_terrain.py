@@ -112,10 +112,11 @@ distance torso bottom - terrain below the torso centre, privileged, m), ``pitch_
 ``cycle_stats``: on the first step of every new gait cycle a dict of per-cycle statistics of the
 cycle just finished (``index``, ``steps``, ``height_rms``, ``pitch_rate_rms``, ``roll_rate_rms``,
 ``zmp_margin_mean``, ``zmp_margin_min``, ``torso_contact``, ``distance``, ``x_start``, ``x_end``,
-``gains``), otherwise None. The seed's box plots are made from these. ``actuator_power_w``
-(sum of |torque x joint speed|, W) and ``episode_metrics`` (at reset and whenever a cycle
-finishes: the lists so far of this episode's per-cycle height, pitch-rate and roll-rate RMS and
-mean ZMP margin) feed the evaluation pipeline (`evaluation_metrics`).
+``gains``), absent on the other steps (a key that is sometimes None and sometimes a dict breaks
+Gymnasium's vector envs' info batching). The seed's box plots are made from these.
+``actuator_power_w`` (sum of |torque x joint speed|, W) and ``episode_metrics`` (at reset and
+whenever a cycle finishes: the lists so far of this episode's per-cycle height, pitch-rate and
+roll-rate RMS and mean ZMP margin) feed the evaluation pipeline (`evaluation_metrics`).
 """
 
 from __future__ import annotations
@@ -829,8 +830,9 @@ class IrregularTerrainEnv(HexapodEnv):
             "roll_rate": float(self._gyro[0]),
             "posture_gains": self.controller.gains if self.action_mode != "joint" else None,
             "gait_cycle": self._gait_cycle_index(),
-            "cycle_stats": stats,
         }
+        if stats is not None:
+            info["cycle_stats"] = stats
         if stats is not None or self._step_count == 0:
             # A fresh copy whenever the lists change (and at reset): infos must not share data.
             info["episode_metrics"] = {k: list(v) for k, v in self._episode_metrics.items()}
