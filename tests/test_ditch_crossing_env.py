@@ -173,6 +173,23 @@ def test_flat_terrain_keeps_the_finish_line():
     env.close()
 
 
+def test_flat_terrain_plans_for_each_sampled_finish_line():
+    """A randomised finish line on flat ground gets its own reference plan, not the first
+    episode's: the plan reaches past each episode's finish line."""
+    from hexapod_envs.robots.upu.gait_plan import plan_flat_past
+
+    env = gym.make("HexapodDitchCrossing-v0", terrain="flat", ditch_start_x_range=(0.6, 1.1))
+    plans = set()
+    for seed in range(4):
+        _, info = env.reset(seed=seed)
+        base = env.unwrapped
+        expected = plan_flat_past(base.params, info["finish_x"], base.start_x, base.gait_settings)
+        assert len(base.plan.steps) == len(expected.steps), seed
+        plans.add(len(base.plan.steps))
+    assert len(plans) > 1
+    env.close()
+
+
 def test_impassable_ditch_reference_stands_still():
     env = DitchCrossingEnv(ditch_depth=0.2)
     _, info = env.reset(seed=0)

@@ -375,7 +375,12 @@ class DitchCrossingEnv(HexapodEnv):
         )
 
     def _plan_for(self, ditch: Ditch) -> GaitPlan:
-        key = self._geometry_key(ditch) or ("flat", ditch.end_x)
+        """The reference plan of `ditch` (cached by what it depends on: the ditch's geometry, or
+        on flat ground the finish line `end_x`; not the friction)."""
+        if self.terrain == "ditch":
+            key = ("ditch", ditch.start_x, ditch.width, ditch.depth)
+        else:
+            key = ("flat", ditch.end_x)
         if key not in self._plans:
             p, s = self.params, self.gait_settings
             if self.terrain == "ditch":
