@@ -79,3 +79,21 @@ def test_random_scenario_is_seeded():
         env.reset(seed=seed)
         axes.append(tuple(env.unwrapped.axis.round(6)))
     assert axes[0] == axes[1] != axes[2]
+
+
+@pytest.mark.parametrize(
+    ("rate_deg", "max_deg"), [(2.0, 38.0), (7.0, 15.0), (12.0, 8.0), (40.0, 10.0), (20.0, 20.0)]
+)
+def test_tilt_profile_rises_to_max_tilt_without_overshoot(rate_deg, max_deg):
+    """The commanded tilt rises monotonically to max_tilt and stays there, never faster than
+    the rate and with the ramps' (de)celeration, also when max_tilt is too small for the rate
+    to be reached (the ramps used to overlap: 19.2 deg peak for 10 at 40 deg/s)."""
+    env = gym.make(
+        "HexapodStewartTilt-v0", scenario="climb", tilt_rate_deg=rate_deg, max_tilt_deg=max_deg
+    ).unwrapped
+    times = env.tilt_start_time + np.arange(-0.5, max_deg / rate_deg + 3.0, 1e-3)
+    tilt = np.array([env.tilt_at(t) for t in times])
+    rate = np.diff(tilt) / np.diff(times)
+    assert np.all(rate >= -1e-12) and tilt.max() == pytest.approx(np.radians(max_deg))
+    assert tilt[-1] == pytest.approx(np.radians(max_deg))
+    assert rate.max() <= np.radians(rate_deg) * (1 + 1e-6)

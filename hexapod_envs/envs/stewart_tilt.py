@@ -46,6 +46,7 @@ to land after tipping was flagged) and recovery_time [s].
 from __future__ import annotations
 
 import dataclasses
+import math
 
 import mujoco
 import numpy as np
@@ -227,15 +228,21 @@ class StewartTiltEnv(HeavyDutyEnv):
 
     def tilt_at(self, t: float) -> float:
         """Platform tilt [rad] at time t: level while settling, then the scenario rate reached
-        and left with a constant (de)celeration over RAMP_TIME so the plate never jerks."""
+        and left with a constant (de)celeration over RAMP_TIME so the plate never jerks. A tilt
+        too small to reach the rate (max_tilt < rate x RAMP_TIME) accelerates and decelerates
+        only, with the same (de)celeration, and stops at max_tilt."""
         ramp = RAMP_TIME
         tau = t - self.tilt_start_time
         if tau <= 0.0:
             return 0.0
-        total = self.max_tilt / self.rate + ramp  # time to reach max_tilt with both ramps
+        accel = self.rate / ramp
+        if self.max_tilt >= self.rate * ramp:
+            total = self.max_tilt / self.rate + ramp  # time to reach max_tilt with both ramps
+        else:  # the ramps would overlap: half the time speeding up, half slowing down
+            ramp = math.sqrt(self.max_tilt / accel)
+            total = 2.0 * ramp
         if tau >= total:
             return self.max_tilt
-        accel = self.rate / ramp
         if tau < ramp:
             return 0.5 * accel * tau**2
         if tau > total - ramp:
