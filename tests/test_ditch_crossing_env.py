@@ -241,3 +241,18 @@ def test_residual_is_filtered_and_observed():
     joint.reset(seed=0)
     obs, *_ = joint.step(np.zeros(9))
     np.testing.assert_array_equal(obs[state], 0.0)
+
+
+def test_a_crossing_ends_the_episode_once_and_pays_its_bonus_once():
+    """Stepping on after the crossing terminated keeps `terminated` True and the success, and
+    never pays the success bonus again (it paid ~2000 per extra step)."""
+    env = gym.make("HexapodDitchCrossing-v0").unwrapped
+    env.reset(seed=0)
+    for _ in range(env.horizon_steps):
+        _, _, terminated, _, info = env.step(ZERO)
+        if terminated:
+            break
+    assert terminated and info["is_success"] and info["reward_success"] > 0
+    for _ in range(5):
+        _, _, terminated, _, info = env.step(ZERO)
+        assert terminated and info["is_success"] and info["reward_success"] == 0.0

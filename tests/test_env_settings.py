@@ -173,7 +173,7 @@ def test_bad_task_ranges_are_named(ranges, error, words):
         ("HexapodIrregularTerrain-v0", {"slope_deg": [[40.0, 50.0]]}, ["slope_deg", "<= 45"]),
         ("HexapodIrregularTerrain-v0", {"block_size": [0.0, 0.1]}, ["block_size", "> 0"]),
         ("HexapodDitchCrossing-v0", {"depth": [0.0, 0.1]}, ["depth", "> 0"]),
-        ("HexapodDitchCrossing-v0", {"friction": [-1.0, 0.0]}, ["friction", ">= 0"]),
+        ("HexapodDitchCrossing-v0", {"friction": [-1.0, 0.0]}, ["friction", "> 0"]),
         ("HexapodDitchCrossing-v0", {"start_x": [0.1, 0.2]}, ["start_x", ">= 0.240 m"]),
     ],
 )

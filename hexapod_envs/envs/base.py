@@ -449,6 +449,7 @@ class HexapodEnv(gym.Env):
         self._measure()
         self._start_cog_x = self._prev_cog_x = float(self._cog[0])
         self._success = self._is_success()
+        self._new_success = False
         obs, info = self._observation(), self._info({}, unstable=not settled)
         # An unstable settle shows in info["sim_unstable"] now; MuJoCo's warning counts stay
         # until the next reset, so the first step truncates as unstable too.
@@ -470,7 +471,11 @@ class HexapodEnv(gym.Env):
         # episode terminated keeps `terminated` True and never pays it again.
         tipped = not self._tipped and self._is_tipped_over()
         self._tipped = self._tipped or tipped
-        self._success = not self._tipped and self._is_success()
+        # Likewise a success that ends the episode stays (and its bonus is paid once: on the
+        # step `_new_success` is True).
+        ended = self.ends_on_success and self._success
+        self._success = not self._tipped and (ended or self._is_success())
+        self._new_success = self._success and not ended
         terms = self._reward_terms(tipped)
         self._end_step()
         self._prev_cog_x = float(self._cog[0])

@@ -137,7 +137,7 @@ class DitchTaskRanges(TaskRanges):
     start_x: tuple[float, float] = bounded(None)
     width: tuple[float, float] = bounded(strict=True)
     depth: tuple[float, float] = bounded(strict=True)
-    friction: tuple[float, float] = bounded()
+    friction: tuple[float, float] = bounded(strict=True)  # the ditch's geoms need > 0
 
 
 DITCH_TRAIN = DitchTaskRanges(
@@ -217,7 +217,7 @@ class DitchCrossingSettings(EnvSettings):
     horizon_steps: int = number(1500, strict=True, integer=True)
     """The episode's step budget (the registered time limit) whose remaining steps the
     success bonus pays for."""
-    friction: float = number(1.0)
+    friction: float = number(1.0, strict=True)
     gait_timing: GaitTiming | None = option(None, kind=GaitTiming)
     gait_settings: GaitSettings | None = option(None, kind=GaitSettings)
     params: UpuParams | None = option(None, kind=UpuParams)
@@ -602,7 +602,7 @@ class DitchCrossingEnv(HexapodEnv):
             "forward": w["forward"] * min(max(speed, -FORWARD_CLIP_M_S), FORWARD_CLIP_M_S),
             "stability": w["stability"] * margin,
             "alive": 0.0 if self._tipped else self.step_cost_bound(),
-            "success": remaining * self.step_reward_bound() if self._success else 0.0,
+            "success": remaining * self.step_reward_bound() if self._new_success else 0.0,
             "tip_over": -w["tip_over"] if tipped else 0.0,
             "effort": -w["effort"] * min(self._power / self._reference_power, EFFORT_CAP),
         }
