@@ -97,3 +97,13 @@ def test_tilt_profile_rises_to_max_tilt_without_overshoot(rate_deg, max_deg):
     assert np.all(rate >= -1e-12) and tilt.max() == pytest.approx(np.radians(max_deg))
     assert tilt[-1] == pytest.approx(np.radians(max_deg))
     assert rate.max() <= np.radians(rate_deg) * (1 + 1e-6)
+
+
+def test_info_names_the_episodes_case_on_a_task_distribution():
+    env = gym.make("HexapodStewartTilt-v0", task_distribution="train")
+    scenarios = set()
+    for seed in range(6):
+        _, info = env.reset(seed=seed)
+        assert info["scenario"] == info["task"]["scenario"]
+        scenarios.add(info["scenario"])
+    assert len(scenarios) > 1  # not the setting's "random" every time

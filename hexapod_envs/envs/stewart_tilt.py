@@ -39,6 +39,7 @@ foot_contact, fasm_margin_deg, imu_gyro, imu_accel, imu_quat). Action: 18 values
 ``"residual"`` (default) offsets the hold posture by residual_scale x half range (default 2, so
 any joint target is reachable), ``"joint"`` gives targets directly. Reward terms as
 HexapodCliffWalk-v0 without forward: stability, alive, tip_over, effort. `info` adds
+scenario and stance (the episode's: on the train/test distributions the sampled case),
 platform_tilt_deg, platform_rpy, actuator_lengths (6, m), adjustment_leg (the first lifted leg
 to land after tipping was flagged) and recovery_time [s].
 """
@@ -384,7 +385,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         )
         return {
             **super()._extra_info(unstable),
-            "scenario": self.scenario,
+            "scenario": self.task.get("scenario", self.scenario),  # the episode's case
             "stance": self.stance,
             "platform_tilt_deg": float(np.degrees(np.arccos(min(1.0, self.data.xmat[body, 8])))),
             "platform_rpy": rpy,
