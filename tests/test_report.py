@@ -263,3 +263,16 @@ def test_a_study_row_names_the_checkpoint_it_evaluates(tmp_path):
     (label,) = study.members.values()
     assert label == "train.seed=0" + checkpoint_note(trial / "best")
     assert "at 0 env steps: the initial policy" in label
+
+
+def test_a_difference_without_a_paired_interval_says_so():
+    """One episode per policy gives no interval: the verdict must not read as resolved."""
+    result = EnvResult("Env-v0", {}, 100, 0.02, [])
+    result.runs = {
+        "zero": PolicyRun("zero", "zero", [_record(100, 0.5, 1.0, False)]),
+        "ppo:x": PolicyRun("ppo:x", "x", [_record(100, 0.1, 2.0, False)]),
+    }
+    aggs = {n: aggregate(r.episodes) for n, r in result.runs.items()}
+    (bullet,), verdicts = verdict_lines(result, aggs)
+    assert all(v.interval is None for v in verdicts if v.outcome != "tie")
+    assert "distance per second 1 vs 0.5 (no paired interval)" in bullet
