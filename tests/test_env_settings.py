@@ -244,6 +244,7 @@ def test_every_setting_is_checked_and_every_number_is_a_numeric_setting(env_id):
         ("HexapodDitchCrossing-v0", {"task_distribution": "easy"}),
         ("HexapodDitchCrossing-v0", {"camera_name": "trak"}),
         ("HexapodCliffWalk-v0", {"camera_name": "side"}),
+        ("HexapodCliffWalk-v0", {"control_dt": np.float32(0.02)}),  # not a divisor of the gait
     ],
 )
 def test_meaningless_values_are_named(env_id, kwargs):

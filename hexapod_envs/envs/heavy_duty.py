@@ -144,7 +144,11 @@ class HeavyDutyEnv(HexapodEnv):
         self.min_progress = s.min_progress
         steps_per_cycle = self.gait.gait.period / self.control_dt
         if abs(steps_per_cycle - round(steps_per_cycle)) > 1e-9:
-            raise ValueError("gait period must be a whole number of control periods")
+            raise ValueError(
+                f"the gait period ({self.gait.gait.period:g} s, settings.gait) must be a whole "
+                f"number of control periods: control_dt={self.control_dt!r} s gives "
+                f"{steps_per_cycle:.9g} per cycle"
+            )
         self._steps_per_cycle = int(round(steps_per_cycle))
         self._reference_table = np.array(
             [
