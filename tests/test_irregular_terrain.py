@@ -379,6 +379,15 @@ def test_unstable_simulation_truncates_with_a_flag():
     assert not info["is_success"]
 
 
+def test_an_episode_that_tipped_over_stays_terminated_when_the_simulation_then_fails():
+    env = gym.make(ENV_ID, terrain="flat").unwrapped
+    env.reset(seed=0)
+    env._tipped = True  # as after a tip-over step (termination is sticky)
+    env.data.qvel[:] = 1e12
+    _, reward, terminated, truncated, info = env.step(np.zeros(18, np.float32))
+    assert terminated and truncated and info["sim_unstable"] and reward == 0.0
+
+
 def test_nan_action_is_a_clear_error():
     env = gym.make(ENV_ID, action_mode="gains")
     env.reset(seed=0)

@@ -464,8 +464,10 @@ class HexapodEnv(gym.Env):
         self._step_count += 1
         if not stable:
             # Keep training runs alive: end the episode with a flag and the last good observation
-            # (the buffer it was copied from, which no caller holds).
-            return self._obs_buffer.copy(), 0.0, False, True, self._info({}, unstable=True)
+            # (the buffer it was copied from, which no caller holds); an episode that already
+            # ended (stepped on after a tip-over or a crossing) stays terminated.
+            ended = self._tipped or (self.ends_on_success and self._success)
+            return self._obs_buffer.copy(), 0.0, ended, True, self._info({}, unstable=True)
         self._measure()
         # The penalty is paid once, on the step the robot tips over; stepping on after the
         # episode terminated keeps `terminated` True and never pays it again.
