@@ -466,8 +466,8 @@ class HexapodEnv(gym.Env):
             # Keep training runs alive: end the episode with a flag and the last good observation
             # (the buffer it was copied from, which no caller holds); an episode that already
             # ended (stepped on after a tip-over or a crossing) stays terminated.
-            ended = self._tipped or (self.ends_on_success and self._success)
-            return self._obs_buffer.copy(), 0.0, ended, True, self._info({}, unstable=True)
+            info = self._info({}, unstable=True)
+            return self._obs_buffer.copy(), 0.0, self._terminated, True, info
         self._measure()
         # The penalty is paid once, on the step the robot tips over; stepping on after the
         # episode terminated keeps `terminated` True and never pays it again.
@@ -475,18 +475,22 @@ class HexapodEnv(gym.Env):
         self._tipped = self._tipped or tipped
         # Likewise a success that ends the episode stays (and its bonus is paid once: on the
         # step `_new_success` is True).
-        ended = self.ends_on_success and self._success
-        self._success = not self._tipped and (ended or self._is_success())
-        self._new_success = self._success and not ended
+        succeeded_before = self.ends_on_success and self._success
+        self._success = not self._tipped and (succeeded_before or self._is_success())
+        self._new_success = self._success and not succeeded_before
         terms = self._reward_terms(tipped)
         self._end_step()
         self._prev_cog_x = float(self._cog[0])
         obs = self._observation()
         reward = float(sum(terms.values()))
-        terminated = self._tipped or (self.ends_on_success and self._success)
         if self.render_mode == "human":
             self.render()
-        return obs, reward, terminated, False, self._info(terms, unstable=False)
+        return obs, reward, self._terminated, False, self._info(terms, unstable=False)
+
+    @property
+    def _terminated(self) -> bool:
+        """The episode has ended: a tip-over, or a success that ends it (`ends_on_success`)."""
+        return self._tipped or (self.ends_on_success and self._success)
 
     def _info(self, terms: dict[str, float], unstable: bool) -> dict:
         """The common info keys (`hexapod_envs.info_keys`) plus the env's `_extra_info`, then
