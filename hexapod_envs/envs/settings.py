@@ -216,7 +216,7 @@ class TaskRanges:
             value = _as_tuples(getattr(self, f.name))  # lists (e.g. from YAML) as tuples
             object.__setattr__(self, f.name, value)
             if _shape(value) == _NUMBER:
-                _check_real(f.name, value, value)
+                numbers = (_check_real(f.name, value, value),)
             elif isinstance(value, tuple) and value and not isinstance(value[0], str):
                 pairs = value if isinstance(value[0], tuple) else (value,)
                 for pair in pairs:
@@ -228,17 +228,18 @@ class TaskRanges:
                             f"{type(self).__name__}.{f.name} must be finite (low, high) pairs "
                             f"with low <= high, got {value!r}"
                         )
+                numbers = [x for pair in pairs for x in pair]
             else:  # names (checked against the default's by `updated`)
                 continue
-            self._check_bounds(f, value)
+            self._check_bounds(f, numbers, value)
 
-    def _check_bounds(self, f: dataclasses.Field, value: Any) -> None:
-        """ValueError naming the field and its bounds when a number of `value` lies outside."""
+    def _check_bounds(self, f: dataclasses.Field, numbers: Any, value: Any) -> None:
+        """ValueError naming the field and its bounds (`bounded`) when one of the `numbers` of
+        its `value` lies outside them."""
         if "bounds" not in f.metadata:
             return
         low, high, strict = f.metadata["bounds"]
-        pairs = value if _shape(value) == _PAIRS else (value,)
-        for x in (x for pair in pairs for x in (pair if isinstance(pair, tuple) else (pair,))):
+        for x in numbers:
             too_low = low is not None and (x <= low if strict else x < low)
             if too_low or (high is not None and x > high):
                 raise ValueError(
