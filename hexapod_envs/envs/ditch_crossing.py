@@ -377,13 +377,11 @@ class DitchCrossingEnv(HexapodEnv):
     def _plan_for(self, ditch: Ditch) -> GaitPlan:
         """The reference plan of `ditch` (cached by what it depends on: the ditch's geometry, or
         on flat ground the finish line `end_x`; not the friction)."""
-        if self.terrain == "ditch":
-            key = ("ditch", ditch.start_x, ditch.width, ditch.depth)
-        else:
-            key = ("flat", ditch.end_x)
+        on_ditch = self.terrain == "ditch"
+        key = (ditch.start_x, ditch.width, ditch.depth) if on_ditch else ("flat", ditch.end_x)
         if key not in self._plans:
             p, s = self.params, self.gait_settings
-            if self.terrain == "ditch":
+            if on_ditch:
                 plan = plan_ditch_crossing(p, ditch, self.start_x, s)
             else:
                 plan = plan_flat_past(p, ditch.end_x, self.start_x, s)

@@ -237,7 +237,7 @@ class RobotSensors:
 
     def tilt_cos(self) -> float:
         """Cosine of the torso's tilt from vertical: the world z component of its up axis."""
-        return float(self._torso_xmat[8])
+        return float(self._torso_up[2])
 
     def cog(self) -> np.ndarray:
         """Whole-robot centre of gravity, world frame [m]: what the kinematic model computes from

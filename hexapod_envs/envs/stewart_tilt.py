@@ -377,7 +377,7 @@ class StewartTiltEnv(HeavyDutyEnv):
 
     def _extra_info(self, unstable: bool) -> dict:
         pitch, roll = self.data.qpos[self._platform_qpos].tolist()
-        body = self._platform_body  # xmat[body, 8]: world z of the platform's up axis
+        up_z = min(1.0, self.data.xmat[self._platform_body, 8])  # the platform's up axis' z
         rpy = np.array([roll, pitch, 0.0])
         platform = self.platform  # its actuator lengths, in one compiled call:
         lengths = _compiled.stewart_actuator_lengths(
@@ -387,7 +387,7 @@ class StewartTiltEnv(HeavyDutyEnv):
             **super()._extra_info(unstable),
             "scenario": self.task.get("scenario", self.scenario),  # the episode's case
             "stance": self.stance,
-            "platform_tilt_deg": float(np.degrees(np.arccos(min(1.0, self.data.xmat[body, 8])))),
+            "platform_tilt_deg": float(np.degrees(np.arccos(up_z))),
             "platform_rpy": rpy,
             "actuator_lengths": lengths,
             "adjustment_leg": self._adjustment_leg,
