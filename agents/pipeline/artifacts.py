@@ -126,6 +126,19 @@ def read_meta(model_dir: Path) -> dict[str, Any]:
     return json.loads(path.read_text()) if path.is_file() else {}
 
 
+def checkpoint_note(model_dir: Path) -> str:
+    """The text ' (<kind> checkpoint at <n> env steps)' from a model directory's meta.json,
+    saying so when it is the initial policy (a best/ that no later evaluation beat); '' without
+    a meta.json."""
+    meta = read_meta(model_dir)
+    steps = meta.get("num_timesteps")
+    if steps is None:
+        return ""
+    kind = meta.get("kind", "saved")
+    initial = ": the initial policy, no training step kept" if steps == 0 else ""
+    return f" ({kind} checkpoint at {steps} env steps{initial})"
+
+
 def checkpoint_dir(run_dir: Path, num_timesteps: int) -> Path:
     return Path(run_dir) / CHECKPOINTS / f"step_{num_timesteps:012d}"
 

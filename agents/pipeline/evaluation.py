@@ -17,6 +17,7 @@ import gymnasium as gym
 import numpy as np
 
 from ..policy import Policy, RandomPolicy, ZeroPolicy
+from .artifacts import checkpoint_note
 from .env_settings import describe, differences, read_settings, resolved_settings, reward_only
 from .envs import EnvSpec, check_env_id, env_time_step, import_gym_packages
 from .episode import EpisodeAccumulator, EpisodeRecord, MetricSpec, metric_specs
@@ -217,21 +218,6 @@ def build_policy(
         path, env, deterministic=suite.deterministic, trust_pickle=suite.trust_pickle
     )
     return policy, f"{policy.files.model}{checkpoint_note(policy.files.directory)}"
-
-
-def checkpoint_note(model_dir: Path) -> str:
-    """The text ' (<kind> checkpoint at <n> env steps)' from a model directory's meta.json,
-    saying so when it is the initial policy (a best/ that no later evaluation beat); '' without
-    a meta.json."""
-    from .artifacts import read_meta
-
-    meta = read_meta(model_dir)
-    steps = meta.get("num_timesteps")
-    if steps is None:
-        return ""
-    kind = meta.get("kind", "saved")
-    initial = ": the initial policy, no training step kept" if steps == 0 else ""
-    return f" ({kind} checkpoint at {steps} env steps{initial})"
 
 
 def _check_env_ids(suite: EvaluationSuite) -> None:

@@ -59,8 +59,7 @@ def expand_studies(suite: EvaluationSuite) -> tuple[EvaluationSuite, list[Study]
 
     Returns the expanded suite, the studies and warning lines (trials without a saved model).
     """
-    from .artifacts import find_model
-    from .evaluation import checkpoint_note
+    from .artifacts import checkpoint_note, find_model
     from .sweep_summary import TRIAL_FILE, trial_dirs
 
     policies: list[str] = []
