@@ -16,7 +16,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
-from .pipeline.artifacts import ModelFiles, find_model, read_meta
+from .pipeline.artifacts import ModelFiles, find_model, other_env_error, read_meta
 from .pipeline.errors import UserError
 from .pipeline.model_files import NormalizationStats, load_ppo, load_stats, ppo_custom_objects
 from .policy import Policy
@@ -62,9 +62,7 @@ class PPOPolicy:
             )
         trained_for = (config.get("env") or {}).get("id")
         if trained_for != env_id:
-            raise UserError(
-                f"the model at {files.model} was trained for {trained_for}, not {env_id}"
-            )
+            raise other_env_error(files, trained_for, env_id)
         meta = read_meta(files.directory)
         for what, key, env_space in (
             ("observation", "observation_shape", env.observation_space),

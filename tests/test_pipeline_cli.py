@@ -326,7 +326,17 @@ def test_model_for_another_env_is_refused(run, tmp_path, capsys):
     (fake / "config.yaml").write_text(yaml.safe_dump(config))
     assert evaluate(tmp_path / "rep", f"ppo:{fake}") == 2
     err = capsys.readouterr().err
-    assert "was trained for HexapodStewartTilt-v0, not HexapodCliffWalk-v0" in err
+    assert "was trained on another env (HexapodStewartTilt-v0), not HexapodCliffWalk-v0" in err
+
+
+def test_shipped_model_of_another_env_is_named_before_its_env_kwargs_are_used(tmp_path, capsys):
+    """The irregular-terrain agent's trained settings (gait_ground_search) would be an unknown
+    keyword of the cliff walk: the error names the env it was trained on instead."""
+    policy = "ppo:models/HexapodIrregularTerrain-v0/ppo"
+    assert evaluate(tmp_path / "rep", policy) == 2
+    err = capsys.readouterr().err
+    assert "was trained on another env (HexapodIrregularTerrain-v0), not HexapodCliffWalk-v0" in err
+    assert "unknown keyword" not in err
 
 
 def test_missing_shipped_model_is_skipped_with_a_warning_in_the_report(tmp_path):

@@ -190,6 +190,13 @@ class ModelFiles:
         return load_yaml(self.config) if self.config is not None else None
 
 
+def other_env_error(files: ModelFiles, trained_for: str | None, env_id: str | None) -> UserError:
+    """The error for a model evaluated on an env other than the one it was trained on."""
+    return UserError(
+        f"the model at {files.model} was trained on another env ({trained_for}), not {env_id}"
+    )
+
+
 def find_model(path: str | Path) -> ModelFiles:
     """Resolve a model file, a model directory or a run directory (best/ > final/ > latest
     checkpoint) to its files; UserError naming the path otherwise."""

@@ -17,7 +17,7 @@ import gymnasium as gym
 import numpy as np
 
 from ..policy import Policy, RandomPolicy, ZeroPolicy
-from .artifacts import checkpoint_note
+from .artifacts import checkpoint_note, other_env_error
 from .env_settings import describe, differences, read_settings, resolved_settings, reward_only
 from .envs import EnvSpec, check_env_id, env_time_step, import_gym_packages
 from .episode import EpisodeAccumulator, EpisodeRecord, MetricSpec, metric_specs
@@ -148,7 +148,11 @@ def policy_env_kwargs(name: str, env_id: str, suite_kwargs: dict | None = None) 
         return {}
     from .artifacts import find_model
 
-    config = find_model(_ppo_path(name, env_id)).training_config() or {}
+    files = find_model(_ppo_path(name, env_id))
+    config = files.training_config() or {}
+    trained_for = (config.get("env") or {}).get("id")
+    if trained_for is not None and trained_for != env_id:  # before its kwargs reach the env
+        raise other_env_error(files, trained_for, env_id)
     trained = (config.get("env") or {}).get("kwargs") or {}
     extra = {k: trained[k] for k in POLICY_SETTINGS if k in trained}
     reset = [k for k in POLICY_SETTINGS if k in (suite_kwargs or {}) and k not in trained]
