@@ -1,7 +1,8 @@
 """Compare policies (analytical, PPO, zero, random) on hexapod envs and write a report.
 
 ``python evaluate.py`` runs ``configs/evaluate_default.yaml``; see ``python evaluate.py --help``.
-Thin front end; the logic lives in `agents.pipeline`.
+Thin front end of the installed ``hexapod-evaluate`` command for a source checkout; the logic
+lives in `agents.pipeline`.
 """
 
 import os

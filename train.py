@@ -1,6 +1,7 @@
 """Train PPO on a hexapod env from a YAML config: ``python train.py --config configs/<name>.yaml``.
 
-Thin front end; the logic lives in `agents.pipeline` (see ``python train.py --help``).
+Thin front end of the installed ``hexapod-train`` command for a source checkout; the logic lives
+in `agents.pipeline` (see ``python train.py --help``).
 """
 
 import sys

@@ -339,6 +339,31 @@ def test_shipped_model_of_another_env_is_named_before_its_env_kwargs_are_used(tm
     assert "unknown keyword" not in err
 
 
+def test_the_default_report_is_replaced_on_a_second_run_other_reports_need_force(
+    tmp_path, monkeypatch, capsys
+):
+    """Without --output-dir the default suite writes reports/default (relative to the working
+    directory), and running it again replaces that report; another existing directory, or a
+    reports/default that holds no report, is refused without --force."""
+    monkeypatch.chdir(tmp_path)
+    argv = ["--envs", "HexapodCliffWalk-v0", "--policies", "zero", "--episodes", "1"]
+    argv += ["--max-episode-steps", "5", "--no-progress"]
+    for _ in range(2):
+        assert evaluate_main(argv) == 0
+    assert (tmp_path / "reports" / "default" / "metrics.json").is_file()
+    assert evaluate_main([*argv, "--output-dir", "reports/default"]) == 0  # the same directory
+    assert evaluate_main([*argv, "--output-dir", "mine"]) == 0
+    capsys.readouterr()
+    assert evaluate_main([*argv, "--output-dir", "mine"]) == 2
+    assert "report directory mine already exists; pass --force" in capsys.readouterr().err
+    assert evaluate_main([*argv, "--output-dir", "mine", "--force"]) == 0
+    shutil.rmtree(tmp_path / "reports" / "default")
+    (tmp_path / "reports" / "default").mkdir()
+    (tmp_path / "reports" / "default" / "notes.txt").write_text("not a report")
+    assert evaluate_main(argv) == 2
+    assert (tmp_path / "reports" / "default" / "notes.txt").is_file()
+
+
 def test_missing_shipped_model_is_skipped_with_a_warning_in_the_report(tmp_path):
     models = tmp_path / "models"
     argv = ["--envs", "HexapodCliffWalk-v0", "--episodes", "1", "--max-episode-steps", "20"]

@@ -46,6 +46,7 @@ from .model_files import (
     atomic_path,
     atomic_write_text,
 )
+from .shipped import resolve_shipped
 
 MODEL_FILE = "model.zip"
 CONFIG_FILE = "config.yaml"
@@ -199,8 +200,9 @@ def other_env_error(files: ModelFiles, trained_for: str | None, env_id: str | No
 
 def find_model(path: str | Path) -> ModelFiles:
     """Resolve a model file, a model directory or a run directory (best/ > final/ > latest
-    checkpoint) to its files; UserError naming the path otherwise."""
-    path = Path(path)
+    checkpoint) to its files; UserError naming the path otherwise. A relative ``models/...``
+    path missing from the working directory is a shipped model (`shipped.resolve_shipped`)."""
+    path = resolve_shipped(path)
     if not path.exists():
         raise UserError(f"no PPO model at {path}: the path does not exist")
     if path.is_file():

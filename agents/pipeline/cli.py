@@ -1,4 +1,6 @@
-"""Command-line front ends of `train.py` and `evaluate.py` (argument parsing and error reporting).
+"""Command-line front ends: ``hexapod-train`` / ``train.py`` and ``hexapod-evaluate`` /
+``evaluate.py`` (argument parsing and error reporting). The console scripts (installed with the
+package, see pyproject.toml) and the two scripts at the repository root run the same functions.
 
 User errors (`UserError`: bad config keys, unknown env ids, missing models, existing output
 directories) are printed on stderr as one ``<prog>: error: ...`` line and exit with code 2;
@@ -14,9 +16,17 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from .errors import UserError
+from .shipped import resolve_shipped, shipped_path
 
-REPO_ROOT = Path(__file__).resolve().parents[2]
-DEFAULT_SUITE = REPO_ROOT / "configs" / "evaluate_default.yaml"
+DEFAULT_SUITE = shipped_path("configs", "evaluate_default.yaml")
+"""The suite of ``hexapod-evaluate`` without --config (the shipped copy, see `shipped`)."""
+
+SCRIPTS = {"train.py": "python train.py", "evaluate.py": "python evaluate.py"}
+"""How the usage examples call a prog: the root scripts with python, console scripts as is."""
+
+
+def _invocation(prog: str) -> str:
+    return SCRIPTS.get(prog, prog)
 
 
 def _add_set_option(p: argparse.ArgumentParser, what: str) -> None:
@@ -48,18 +58,20 @@ def _run(prog: str, body: Callable[[], int]) -> int:
         return 2
 
 
-# --- train.py ------------------------------------------------------------------------------
-def train_parser() -> argparse.ArgumentParser:
+# --- train.py / hexapod-train --------------------------------------------------------------
+def train_parser(prog: str = "train.py") -> argparse.ArgumentParser:
+    run = _invocation(prog)
     p = argparse.ArgumentParser(
-        prog="train.py",
-        description="Train PPO (stable-baselines3) on an env from a YAML config.",
+        prog=prog,
+        description="Train PPO (stable-baselines3) on an env from a YAML config. A relative "
+        "configs/... path that is not in the working directory is read from the shipped configs.",
         epilog="examples:\n"
-        "  python train.py --config configs/cliff_walk_ppo.yaml\n"
-        "  python train.py --config configs/cliff_walk_ppo.yaml --set ppo.learning_rate=1e-4 "
+        f"  {run} --config configs/cliff_walk_ppo.yaml\n"
+        f"  {run} --config configs/cliff_walk_ppo.yaml --set ppo.learning_rate=1e-4 "
         "--set vec_env.n_envs=2\n"
-        "  python train.py --resume runs/HexapodCliffWalk-v0__ppo__0__20250101-120000 "
+        f"  {run} --resume runs/HexapodCliffWalk-v0__ppo__0__20250101-120000 "
         "--set train.total_timesteps=2000000\n"
-        "  python train.py --sweep configs/sweep_irregular_terrain_seeds.yaml "
+        f"  {run} --sweep configs/sweep_irregular_terrain_seeds.yaml "
         "[--address auto] [--max-concurrent 2]",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
@@ -89,14 +101,16 @@ def train_parser() -> argparse.ArgumentParser:
     return p
 
 
-def train_main(argv: Sequence[str] | None = None) -> int:
-    args = train_parser().parse_args(argv)
-    command = _command("train.py", argv)
+def train_main(argv: Sequence[str] | None = None, prog: str = "train.py") -> int:
+    args = train_parser(prog).parse_args(argv)
+    command = _command(prog, argv)
 
     def body() -> int:
         from .train_config import load_train_config
         from .training import resume_training, start_training
 
+        if args.sweep is not None:
+            args.sweep = resolve_shipped(args.sweep)
         if args.sweep is not None or (args.resume is not None and _is_sweep_dir(args.resume)):
             from .sweep import sweep_main
 
@@ -110,7 +124,7 @@ def train_main(argv: Sequence[str] | None = None) -> int:
                 args.resume, args.overrides, command=command, trust_pickle=args.trust_pickle
             )
         else:
-            config = load_train_config(args.config, args.overrides)
+            config = load_train_config(resolve_shipped(args.config), args.overrides)
             result = start_training(
                 config, args.output_dir, args.run_name, force=args.force, command=command
             )
@@ -118,7 +132,7 @@ def train_main(argv: Sequence[str] | None = None) -> int:
         if result.interrupted:
             print(
                 f"interrupted at {result.num_timesteps} steps; checkpoint saved to "
-                f"{result.saved_to}\nresume with: python train.py --resume {result.run_dir}",
+                f"{result.saved_to}\nresume with: {_invocation(prog)} --resume {result.run_dir}",
                 file=sys.stderr,
             )
             return 130
@@ -129,7 +143,12 @@ def train_main(argv: Sequence[str] | None = None) -> int:
         )
         return 0
 
-    return _run("train.py", body)
+    return _run(prog, body)
+
+
+def hexapod_train() -> int:
+    """The ``hexapod-train`` console script."""
+    return train_main(prog="hexapod-train")
 
 
 def _is_sweep_dir(path: Path) -> bool:
@@ -144,19 +163,24 @@ def _command(script: str, argv: Sequence[str] | None) -> str:
     return command_line(sys.argv if argv is None else [script, *argv])
 
 
-# --- evaluate.py ---------------------------------------------------------------------------
-def evaluate_parser() -> argparse.ArgumentParser:
+# --- evaluate.py / hexapod-evaluate --------------------------------------------------------
+def evaluate_parser(prog: str = "evaluate.py") -> argparse.ArgumentParser:
+    run = _invocation(prog)
     p = argparse.ArgumentParser(
-        prog="evaluate.py",
+        prog=prog,
         description="Run policies (analytical, ppo:<path>, zero, random) on envs over fixed seeds "
         "and write metrics.json, report.md and report.html. Without arguments runs "
-        "configs/evaluate_default.yaml.",
+        "configs/evaluate_default.yaml into reports/default (replacing a previous default "
+        "report; any other existing report directory needs --force). Relative configs/... and "
+        "models/... paths that are not in the working directory are read from the shipped "
+        "configs and models.",
         epilog="examples:\n"
-        "  python evaluate.py\n"
-        "  python evaluate.py --envs HexapodCliffWalk-v0 --policies analytical zero "
+        f"  {run}\n"
+        f"  {run} --envs HexapodCliffWalk-v0 --policies analytical zero "
         "ppo:runs/HexapodCliffWalk-v0__ppo__0__20250101-120000 --episodes 3 "
         "--output-dir reports/mine\n"
-        "  python evaluate.py --config configs/evaluate_default.yaml --set episodes=10 --force",
+        f"  {run} --config configs/evaluate_default.yaml --set episodes=10 "
+        "--output-dir reports/ten --force",
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("--config", type=Path, help="evaluation suite (YAML)")
@@ -185,8 +209,10 @@ def evaluate_parser() -> argparse.ArgumentParser:
     return p
 
 
-def evaluate_main(argv: Sequence[str] | None = None) -> int:
-    args = evaluate_parser().parse_args(argv)
+def evaluate_main(argv: Sequence[str] | None = None, prog: str = "evaluate.py") -> int:
+    args = evaluate_parser(prog).parse_args(argv)
+    if args.config is not None:
+        args.config = resolve_shipped(args.config)
 
     def body() -> int:
         from .eval_config import load_suite
@@ -217,7 +243,7 @@ def evaluate_main(argv: Sequence[str] | None = None) -> int:
         from .study import expand_studies, write_study_section
 
         suite, studies, study_warnings = expand_studies(suite)  # ppo:<sweep dir> -> trials
-        out = _prepare_report_dir(Path(suite.output_dir), args.force)
+        out = _prepare_report_dir(Path(suite.output_dir), args.force or _is_default_report(suite))
         video_dir = out / "videos" if args.video else None
         result = run_suite(suite, progress=not args.no_progress, video_dir=video_dir)
         result.warnings[:0] = study_warnings
@@ -230,7 +256,15 @@ def evaluate_main(argv: Sequence[str] | None = None) -> int:
         print("wrote " + ", ".join(str(p) for p in paths))
         return 0
 
-    return _run("evaluate.py", body)
+    return _run(prog, body)
+
+
+def hexapod_evaluate() -> int:
+    """The ``hexapod-evaluate`` console script."""
+    import os
+
+    os.environ.setdefault("MUJOCO_GL", "egl")  # headless rendering for --frames and --video
+    return evaluate_main(prog="hexapod-evaluate")
 
 
 def _suite_envs(config: Path | None, ids: list[str]) -> list[dict]:
@@ -244,6 +278,17 @@ def _suite_envs(config: Path | None, ids: list[str]) -> list[dict]:
         entry = {"id": item} if isinstance(item, str) else dict(item)
         known[entry.get("id")] = entry
     return [known.get(env_id, {"id": env_id}) for env_id in ids]
+
+
+def _is_default_report(suite) -> bool:
+    """The suite writes to the default suite's report directory (``reports/default``, a scratch
+    output that git ignores) and what is there is a previous report (its metrics.json): running
+    the default evaluation again replaces it without --force."""
+    from .configtools import load_yaml
+
+    default = load_yaml(DEFAULT_SUITE).get("output_dir")
+    out = Path(suite.output_dir)
+    return default is not None and out == Path(default) and (out / "metrics.json").is_file()
 
 
 def _prepare_report_dir(path: Path, force: bool) -> Path:

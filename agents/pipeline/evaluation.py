@@ -23,6 +23,7 @@ from .envs import EnvSpec, check_env_id, env_time_step, import_gym_packages
 from .episode import EpisodeAccumulator, EpisodeRecord, MetricSpec, metric_specs
 from .errors import UserError
 from .eval_config import PPO_PREFIX, EvaluationSuite, SuiteEnv
+from .shipped import resolve_shipped
 
 
 class EpisodeSeededRandomPolicy(RandomPolicy):
@@ -194,7 +195,9 @@ def _class_defaults(cls: type) -> dict[str, Any]:
 
 
 def _ppo_path(name: str, env_id: str) -> Path:
-    return Path(name[len(PPO_PREFIX) :].replace("{env_id}", env_id))
+    """The model path of ``ppo:<path>`` for `env_id` (``models/...``: the shipped model unless
+    the working directory has one, see `shipped`)."""
+    return resolve_shipped(name[len(PPO_PREFIX) :].replace("{env_id}", env_id))
 
 
 def build_policy(
