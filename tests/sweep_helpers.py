@@ -14,6 +14,7 @@ import shutil
 import signal
 import socket
 import subprocess
+import sys
 import tempfile
 import time
 from collections.abc import Iterator
@@ -22,6 +23,29 @@ from pathlib import Path
 import yaml
 
 REPO = Path(__file__).resolve().parents[1]
+
+
+def ray_executable() -> str:
+    """The ``ray`` command of the interpreter running the tests (next to ``sys.executable``), so
+    that the tests work from a venv that is not activated; PATH only where it is not there."""
+    beside = Path(sys.executable).parent / "ray"
+    if beside.is_file():
+        return str(beside)
+    found = shutil.which("ray")
+    if found is None:
+        raise FileNotFoundError(f"no ray command next to {sys.executable} or on PATH")
+    return found
+
+
+def wait_until(condition, timeout_s: float, what: str, proc=None, log: Path | None = None):
+    """Poll `condition` until it is true; fail naming `what` after `timeout_s`, or at once when
+    `proc` has exited (with the tail of `log`)."""
+    deadline = time.monotonic() + timeout_s
+    while not condition():
+        tail = log.read_text()[-3000:] if log is not None and log.is_file() else ""
+        assert proc is None or proc.poll() is None, f"exited before {what}:\n{tail}"
+        assert time.monotonic() < deadline, f"no {what} after {timeout_s:.0f} s:\n{tail}"
+        time.sleep(0.2)
 
 
 def tiny_sweep(tmp_path: Path, seeds: list[int], **fixed: object) -> Path:
@@ -115,13 +139,13 @@ def loopback_cluster(nodes: int = 2, cpus_per_node: int = 1) -> Iterator[tuple[s
     common = ["--node-ip-address", "127.0.0.1", "--num-cpus", str(cpus_per_node)]
     try:
         subprocess.run(
-            ["ray", "start", "--head", "--port", str(port), "--temp-dir", temp_dir,
+            [ray_executable(), "start", "--head", "--port", str(port), "--temp-dir", temp_dir,
              "--include-dashboard", "false", "--disable-usage-stats", *common],
             env=env, check=True, capture_output=True, timeout=120,
         )  # fmt: skip
         for _ in range(nodes - 1):
             subprocess.run(
-                ["ray", "start", "--address", address, *common],
+                [ray_executable(), "start", "--address", address, *common],
                 env=env, check=True, capture_output=True, timeout=120,
             )  # fmt: skip
         yield address, env

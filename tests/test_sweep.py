@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from sweep_helpers import REPO, free_port, is_gone, loopback_cluster, tiny_sweep
+from sweep_helpers import REPO, free_port, is_gone, loopback_cluster, tiny_sweep, wait_until
 
 from agents.pipeline.cli import evaluate_main
 from agents.pipeline.errors import ConfigError
@@ -225,7 +225,10 @@ def test_sweep_flags_are_checked(tmp_path):
 # --- Ctrl-C and --resume ---------------------------------------------------------------------
 @pytest.mark.slow
 def test_sigint_stops_every_trial_within_30_s_and_resume_finishes(tmp_path):
-    sweep_dir = tmp_path / "s"
+    """Robust under load (the suite on 2 busy cores): the test waits for events with long
+    deadlines, not for fixed times: Ctrl-C comes once two trials have saved a checkpoint, the
+    sweep then has 30 s to stop, and the resume may take many minutes."""
+    sweep_dir, log_path = tmp_path / "s", tmp_path / "log.txt"
     cmd = [
         sys.executable, "train.py", "--sweep", str(tiny_sweep(tmp_path, [0, 1, 2])),
         "--output-dir", str(tmp_path), "--run-name", "s", "--max-concurrent", "2",
@@ -233,31 +236,33 @@ def test_sigint_stops_every_trial_within_30_s_and_resume_finishes(tmp_path):
         "--set", "fixed.checkpoint.freq=500",
     ]  # fmt: skip
     env = {**os.environ, "PYTHONPATH": str(REPO)}
-    with open(tmp_path / "log.txt", "w") as log:
+    with open(log_path, "w") as log:
         proc = subprocess.Popen(
             cmd, cwd=REPO, env=env, stdout=log, stderr=subprocess.STDOUT, start_new_session=True
         )
         try:
-            deadline = time.monotonic() + 180
-            while len(list(sweep_dir.glob("trial_*/trial.json"))) < 2:
-                assert proc.poll() is None, (tmp_path / "log.txt").read_text()[-3000:]
-                assert time.monotonic() < deadline, "no checkpoints after 180 s"
-                time.sleep(0.5)
+            wait_until(
+                lambda: len(_checkpointed_trials(sweep_dir)) >= 2,
+                600,
+                "two trials with a checkpoint",
+                proc,
+                log_path,
+            )
             trial_pids = _trial_pids(sweep_dir)
             sent = time.monotonic()
             os.killpg(proc.pid, signal.SIGINT)  # what Ctrl-C in a terminal does
-            rc = proc.wait(timeout=60)
+            rc = proc.wait(timeout=180)  # the 30 s are asserted below, with the log
             stopped = time.monotonic() - sent
         finally:
             if proc.poll() is None:
                 os.killpg(proc.pid, signal.SIGKILL)
-    assert rc == 130, (tmp_path / "log.txt").read_text()[-3000:]
-    assert stopped < 30
+    assert rc == 130, log_path.read_text()[-3000:]
+    assert stopped < 30, f"stopped after {stopped:.0f} s:\n{log_path.read_text()[-3000:]}"
     assert len(trial_pids) == 2 and all(is_gone(pid) for pid in trial_pids)
     rows = _summary(sweep_dir)
     assert rows and all(r["status"] == "interrupted" for r in rows)
 
-    result = _train("--resume", str(sweep_dir), timeout=300)
+    result = _train("--resume", str(sweep_dir), timeout=1200)
     assert result.returncode == 0, result.stderr[-3000:]
     rows = _summary(sweep_dir)
     assert len(rows) == 3 and all(r["status"] == "finished" for r in rows)
@@ -269,6 +274,15 @@ def test_sigint_stops_every_trial_within_30_s_and_resume_finishes(tmp_path):
     for name in continued:  # continued in its run dir from its checkpoint, not restarted
         commands = (sweep_dir / name / "command.txt").read_text().splitlines()
         assert len(commands) == 2 and "--resume" in commands[1]
+
+
+def _checkpointed_trials(sweep_dir: Path) -> list[Path]:
+    """Trials that have started (trial.json) and saved a checkpoint."""
+    return [
+        trial
+        for trial in sweep_dir.glob("trial_*")
+        if (trial / "trial.json").is_file() and any((trial / "checkpoints").glob("step_*"))
+    ]
 
 
 def _trial_pids(sweep_dir: Path) -> list[int]:
