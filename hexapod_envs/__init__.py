@@ -6,6 +6,7 @@ Importing the package registers the env ids with Gymnasium:
 >>> env = gym.make("HexapodCliffWalk-v0")
 """
 
+import gymnasium
 from gymnasium.envs.registration import register
 
 __version__ = "0.1.0"
@@ -33,3 +34,16 @@ register(
     entry_point="hexapod_envs.envs.ditch_crossing:DitchCrossingEnv",
     max_episode_steps=1500,
 )
+
+# The v1 benchmark (docs/benchmark.md): the same envs with success that means stability,
+# termination at a physical limit and task ranges with headroom (hexapod_envs.benchmark).
+from .benchmark import V1_KWARGS as _V1_KWARGS  # noqa: E402
+
+for _id, _kwargs in _V1_KWARGS.items():
+    _v0 = gymnasium.spec(_id.replace("-v1", "-v0"))
+    register(
+        id=_id,
+        entry_point=_v0.entry_point,
+        max_episode_steps=_v0.max_episode_steps,
+        kwargs=dict(_kwargs),
+    )

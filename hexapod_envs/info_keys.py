@@ -37,6 +37,17 @@ TASK = "task"
 """Flat dict of the episode's task parameters (plain floats, ints, strings): the paper
 scenario's values with ``task_distribution="paper"``, the sampled ones with "train"/"test"."""
 
+TILT_DEG = "tilt_deg"
+"""The body's tilt now [deg]: the angle between its up axis and the vertical (on the Stewart
+platform: the platform's up axis), the quantity of the tip-over angle."""
+MAX_TILT_DEG = "max_tilt_deg"
+"""The largest `tilt_deg` of the episode so far [deg] (a safety figure of the success rule)."""
+TIPPING_TIME_S = "tipping_time_s"
+"""Episode time so far during which the stability criterion failed (`is_tipping`) [s]."""
+TIPPING_SHARE = "tipping_share"
+"""`tipping_time_s` over the episode time so far (0 at reset): the share of the episode spent
+tipping, the other safety figure of the success rule."""
+
 COMMON_INFO_KEYS: tuple[str, ...] = (
     FASM_MARGIN_DEG,
     FASM_EDGE,
@@ -50,6 +61,10 @@ COMMON_INFO_KEYS: tuple[str, ...] = (
     DISTANCE,
     ACTUATOR_POWER_W,
     TASK,
+    TILT_DEG,
+    MAX_TILT_DEG,
+    TIPPING_TIME_S,
+    TIPPING_SHARE,
 )
 """Keys present in the info of every reset and step of every hexapod env."""
 

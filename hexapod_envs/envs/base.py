@@ -24,6 +24,7 @@ from gymnasium import spaces
 
 from .. import info_keys as keys
 from . import _compiled
+from .difficulty import DifficultySpan, task_difficulty
 from .settings import RENDER_MODES, TASK_DISTRIBUTIONS, EnvSettings, check_choice
 
 __all__ = [
@@ -295,6 +296,15 @@ class HexapodEnv(gym.Env):
     """Whether a successful step terminates the episode (a crossing) or success is a running
     status (walking on, staying up)."""
 
+    difficulty_spans: ClassVar[Mapping[str, DifficultySpan]] = {}
+    """Task parameter -> where it is easy and hard: ``info["task"]["difficulty"]`` (0 easy,
+    1 hard) is their weighted mean (`hexapod_envs.envs.difficulty`); none: no difficulty."""
+
+    def task_difficulty_spans(self) -> Mapping[str, DifficultySpan]:
+        """The spans that rate this env's tasks (an env whose hard parameters depend on a
+        setting, such as the terrain, picks them here)."""
+        return self.difficulty_spans
+
     stability_criterion: str = "FASM >= ξ"
     """The stability criterion in words, for reports."""
 
@@ -315,6 +325,11 @@ class HexapodEnv(gym.Env):
         self.tipping_threshold_deg = float(s.tipping_threshold_deg)
         """The robot's tipping threshold ξ on the FASM [deg]: `info["is_tipping"]` below it."""
         self.tip_over_cos = math.cos(math.radians(s.tip_over_angle_deg))
+        self._margin_steps_to_tip = (
+            None
+            if s.tip_over_margin_time is None
+            else max(1, int(round(s.tip_over_margin_time / self.control_dt)))
+        )
         self.task: dict[str, Any] = {}
         """The episode's task parameters (plain floats/ints/strings), also `info["task"]`."""
         self._needs_reset = True
@@ -436,6 +451,9 @@ class HexapodEnv(gym.Env):
             self.task = self.paper_task()
         else:
             self.task = self.sample_task(self.np_random, self.task_distribution)
+        spans = self.task_difficulty_spans()
+        if spans:
+            self.task["difficulty"] = task_difficulty(self.task, spans)
         self._apply_task(self.task)
         mujoco.mj_resetData(self.model, self.data)
         self._set_initial_state()
@@ -447,6 +465,9 @@ class HexapodEnv(gym.Env):
         self._tipped = False
         self._start_episode()
         self._measure()
+        self._tilt_deg = self._max_tilt_deg = self._body_tilt_deg()
+        self._tipping_steps = 0
+        self._steps_at_zero_margin = 0
         self._start_cog_x = self._prev_cog_x = float(self._cog[0])
         self._success = self._is_success()
         self._new_success = False
@@ -469,14 +490,17 @@ class HexapodEnv(gym.Env):
             info = self._info({}, unstable=True)
             return self._obs_buffer.copy(), 0.0, self._terminated, True, info
         self._measure()
+        self._track_safety()
         # The penalty is paid once, on the step the robot tips over; stepping on after the
         # episode terminated keeps `terminated` True and never pays it again.
-        tipped = not self._tipped and self._is_tipped_over()
+        tipped = not self._tipped and (self._is_tipped_over() or self._margin_lost())
         self._tipped = self._tipped or tipped
         # Likewise a success that ends the episode stays (and its bonus is paid once: on the
         # step `_new_success` is True).
         succeeded_before = self.ends_on_success and self._success
-        self._success = not self._tipped and (succeeded_before or self._is_success())
+        self._success = not self._tipped and (
+            succeeded_before or (self._is_success() and self._stayed_stable())
+        )
         self._new_success = self._success and not succeeded_before
         terms = self._reward_terms(tipped)
         self._end_step()
@@ -508,11 +532,48 @@ class HexapodEnv(gym.Env):
             keys.COG: self._cog.copy(),
             keys.DISTANCE: float(self._cog[0]) - self._start_cog_x,
             keys.TASK: dict(self.task),
+            keys.TILT_DEG: self._tilt_deg,
+            keys.MAX_TILT_DEG: self._max_tilt_deg,
+            keys.TIPPING_TIME_S: self._tipping_steps * self.control_dt,
+            keys.TIPPING_SHARE: self._tipping_steps / max(self._step_count, 1),
             **self._extra_info(unstable),
         }
         for name, value in terms.items():
             info[keys.REWARD_PREFIX + name] = value
         return info
+
+    # --- safety figures and the benchmark's rules -------------------------------------------
+    def _track_safety(self) -> None:
+        """Update the episode's safety figures after a step's measurement: the tilt and its
+        maximum, the steps on which the stability criterion failed, the run of steps at FASM
+        <= 0."""
+        self._tilt_deg = self._body_tilt_deg()
+        self._max_tilt_deg = max(self._max_tilt_deg, self._tilt_deg)
+        self._tipping_steps += bool(self._is_tipping())
+        self._steps_at_zero_margin = self._steps_at_zero_margin + 1 if self._fasm_deg <= 0 else 0
+
+    def _margin_lost(self) -> bool:
+        """The FASM has stayed at or below 0 for ``tip_over_margin_time`` (if set)."""
+        n = self._margin_steps_to_tip
+        return n is not None and self._steps_at_zero_margin >= n
+
+    def _stayed_stable(self) -> bool:
+        """The success rule's safety part: the episode's max tilt and share of time tipping
+        within ``success_max_tilt_deg`` and ``success_max_tipping_share`` (each if set)."""
+        s = self.settings
+        if s.success_max_tilt_deg is not None and self._max_tilt_deg > s.success_max_tilt_deg:
+            return False
+        share = self._tipping_steps / max(self._step_count, 1)
+        return s.success_max_tipping_share is None or share <= s.success_max_tipping_share
+
+    def _body_tilt_deg(self) -> float:
+        """The body's tilt from the vertical [deg] (`tilt_cos`)."""
+        return math.degrees(math.acos(min(1.0, max(-1.0, self._tilt_cos()))))
+
+    def _tilt_cos(self) -> float:
+        """cos of the angle between the body's up axis and the vertical (an env whose robot
+        stands on a moving support measures it from the support's up axis)."""
+        return self.sensors.tilt_cos()
 
     # --- hooks every env defines ----------------------------------------------------------
     def _setup(self) -> None:  # pragma: no cover - abstract
@@ -588,7 +649,7 @@ class HexapodEnv(gym.Env):
 
     def _is_tipped_over(self) -> bool:
         """True when the body's up axis leans more than ``tip_over_angle_deg`` from vertical."""
-        return self.sensors.tilt_cos() < self.tip_over_cos
+        return self._tilt_cos() < self.tip_over_cos
 
     def _is_tipping(self) -> bool:
         """The stability criterion fails: FASM below the robot's ξ."""

@@ -47,6 +47,7 @@ import numpy as np
 
 from ..terrain.cliff import CLIFF_SIDES, add_cliff
 from ..terrain.flat import add_flat
+from .difficulty import DifficultySpan
 from .heavy_duty import (
     TEST_PAYLOAD,
     TRAIN_PAYLOAD,
@@ -115,6 +116,16 @@ class CliffWalkEnv(HeavyDutyEnv):
     """Tripod walking toward a unilateral cliff (set ``terrain="flat"`` for plain ground)."""
 
     Settings = CliffWalkSettings
+    difficulty_spans = {
+        "cliff_x": DifficultySpan(easy=4.4, hard=2.8),
+        "cliff_edge_y": DifficultySpan(easy=-1.3, hard=-0.7),
+        "cliff_drop": DifficultySpan(easy=1.0, hard=5.0),
+        "friction": DifficultySpan(easy=1.2, hard=0.6),
+        "payload_mass": DifficultySpan(easy=0.0, hard=800.0),
+    }
+    """What makes a cliff task hard: the edge near (the robot meets it early and must go on
+    walking beside it), cutting deep into the walking path (the outer feet are at |y| = 1.9 m),
+    a deep drop, a slippery ground, a heavy payload."""
 
     def _setup(self) -> None:
         s = self.settings

@@ -107,6 +107,7 @@ from ..stability import _compiled as _stability
 from ..terrain.ditch import add_ditch
 from ..terrain.flat import add_flat
 from . import _compiled
+from .difficulty import DifficultySpan
 from .base import HexapodEnv
 from .sensors import RobotSensors
 from .settings import (
@@ -237,6 +238,13 @@ class DitchCrossingEnv(HexapodEnv):
 
     Settings = DitchCrossingSettings
     ends_on_success = True
+    difficulty_spans = {
+        "ditch_width": DifficultySpan(easy=0.25, hard=0.50),
+        "ditch_depth": DifficultySpan(easy=0.06, hard=0.15),
+        "friction": DifficultySpan(easy=1.2, hard=0.5),
+    }
+    """What makes a ditch hard: wide (shorter steps, the legs reach farther), deep (the legs
+    extend further into it), slippery ground."""
     stability_criterion = "static margin > 0 mm (CoG projection inside the support triangle)"
 
     def _setup(self) -> None:
@@ -607,11 +615,9 @@ class DitchCrossingEnv(HexapodEnv):
 
     def _extra_info(self, unstable: bool) -> dict:
         step, phase = self.schedule.phase(self._step_count)
-        up_z = min(1.0, max(-1.0, float(self.data.xmat[self._torso, 8])))
         return {
             "static_margin_m": self._static_margin,
             "actuator_power_w": self._power,
-            "tilt_deg": math.degrees(math.acos(up_z)),
             **self._episode_info,
             "ditch": self._ditch_info,  # a new dict every step (callers may keep infos)
             "gait_step": step,

@@ -140,6 +140,7 @@ from ..terrain.flat import add_flat
 from ..terrain.irregular import PAPER_FRICTION, add_blocks, add_ramp
 from . import _compiled
 from .base import HexapodEnv, JointActionMap
+from .difficulty import DifficultySpan
 from .sensors import RobotSensors
 from .settings import (
     EnvSettings,
@@ -523,6 +524,20 @@ class IrregularTerrainEnv(HexapodEnv):
             "friction": float(s.friction),
             "servo_kp": float(s.servo_kp),
         }
+
+    def task_difficulty_spans(self) -> dict[str, DifficultySpan]:
+        """What makes a terrain task hard: on the blocks tall and small blocks, on the ramp a
+        steep slope; on both a slippery ground and servos far from their nominal stiffness."""
+        spans = {
+            "friction": DifficultySpan(easy=1.1, hard=0.5),
+            "servo_kp": DifficultySpan(easy=self.settings.servo_kp, hard=0.7 * self.settings.servo_kp),
+        }
+        if self.terrain == "blocks":
+            spans["block_height_max"] = DifficultySpan(easy=0.06, hard=0.15, weight=2.0)
+            spans["block_size"] = DifficultySpan(easy=0.35, hard=0.20)
+        elif self.terrain == "ramp":
+            spans["slope_deg"] = DifficultySpan(easy=5.0, hard=15.0, weight=2.0)
+        return spans
 
     def sample_task(self, rng: np.random.Generator, distribution: str) -> dict:
         r = self.task_ranges[distribution]

@@ -313,6 +313,16 @@ class EnvSettings(_Checked):
     """The robot's tipping threshold ξ on the FASM [deg] (`info["is_tipping"]` below it)."""
     tip_over_angle_deg: float = number(20.0, strict=True, high=90.0)
     """Tip-over (episode ends): the body's up axis leans more than this from vertical [deg]."""
+    tip_over_margin_time: float | None = number(None, strict=True, optional=True)
+    """Tip-over (episode ends) also when the FASM has stayed at or below 0 for this long [s]:
+    the net force has left the support polygon and the body is rotating about its edge, past
+    the point of no return once no foot can land in time (None: tilt only, the -v0 rule)."""
+    success_max_tilt_deg: float | None = number(None, strict=True, high=90.0, optional=True)
+    """A success also needs the episode's largest body tilt (`info["max_tilt_deg"]`) at or
+    below this [deg] (None: no tilt bound, the -v0 rule)."""
+    success_max_tipping_share: float | None = number(None, high=1.0, optional=True)
+    """A success also needs the share of the episode's steps on which the stability criterion
+    failed (`info["tipping_share"]`) at or below this (None: no bound, the -v0 rule)."""
     reset_noise_scale: float = number(0.01)
     """Size of the seed-dependent perturbation of the start state (env-specific units)."""
     task_distribution: str = choice("paper", TASK_DISTRIBUTIONS)

@@ -56,6 +56,7 @@ from ..robots.heavy_duty import LEG_NAMES, TRIPODS, joints_for_foot, within_limi
 from ..terrain.stewart import add_stewart_platform
 from ..terrain.stewart_kinematics import DEFAULT_PLATFORM
 from . import _compiled
+from .difficulty import DifficultySpan
 from .heavy_duty import (
     TEST_PAYLOAD,
     TRAIN_PAYLOAD,
@@ -148,6 +149,10 @@ class StewartTiltSettings(HeavyDutySettings):
     """Residual action 1 = this fraction of each joint's half range (2: any target)."""
     tip_over_angle_deg: float = number(10.0, strict=True, high=90.0)
     """Tip-over: the body leans more than this relative to the platform [deg]."""
+    swing_until_tipping: bool = choice(False, (False, True))
+    """The lifted tripod is in swing, so a success also needs every lifted foot off the
+    platform until the robot first tips (FASM below ξ): landing a leg is a recovery, not a
+    posture to take before the need (True in -v1; `info["early_landing"]`)."""
     train_ranges: TiltTaskRanges = option(TILT_TRAIN, kind=TiltTaskRanges, optional=False)
     test_ranges: TiltTaskRanges = option(TILT_TEST, kind=TiltTaskRanges, optional=False)
 
@@ -157,6 +162,13 @@ class StewartTiltEnv(HeavyDutyEnv):
 
     Settings = StewartTiltSettings
     walks = False
+    difficulty_spans = {
+        "tilt_rate_deg": DifficultySpan(easy=1.0, hard=20.0),
+        "platform_friction": DifficultySpan(easy=1.8, hard=0.9),
+        "payload_mass": DifficultySpan(easy=0.0, hard=800.0),
+    }
+    """What makes a tilt task hard: a fast tilt (less time from the alarm to tipping, eq. 15's
+    budget), a slippery platform, a heavy payload."""
 
     def _setup(self) -> None:
         s = self.settings
@@ -191,6 +203,7 @@ class StewartTiltEnv(HeavyDutyEnv):
     def _configure(self, scenario: str, stance: tuple[str, ...], rate: float, axis=None) -> None:
         self.stance = stance
         self.swing = tuple(leg for leg in LEG_NAMES if leg not in stance)
+        self._swing_ids = [LEG_NAMES.index(leg) for leg in self.swing]
         self.axis = tilt_axis(scenario, stance) if axis is None else axis
         self.rate = rate
         if self._max_tilt_arg is not None:
@@ -347,6 +360,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         self._first_tipping_time = None
         self._adjustment_leg = None
         self._recovery_time = None
+        self._early_landing = False
         super()._set_initial_state()
 
     def _before_physics(self) -> None:
@@ -357,10 +371,15 @@ class StewartTiltEnv(HeavyDutyEnv):
         self.data.ctrl[self._platform_act] = (pitch_rate, roll_rate)
 
     # --- stability, termination, reward ---------------------------------------------------
-    def _is_tipped_over(self) -> bool:
-        """Tipped when the body leans more than tip_over_angle_deg relative to the platform."""
+    def _tilt_cos(self) -> float:
+        """The body's tilt is measured from the platform's up axis (tipping about the feet)."""
         platform_up = self.data.xmat[self._platform_body, 2::3]
-        return bool(self.sensors.torso_up() @ platform_up < self.tip_over_cos)
+        return float(self.sensors.torso_up() @ platform_up)
+
+    def _is_success(self) -> bool:
+        """Standing to the end (no tip-over), without an early landing if
+        ``swing_until_tipping``."""
+        return not (self.settings.swing_until_tipping and self._early_landing)
 
     def _measure(self) -> None:
         super()._measure()
@@ -368,6 +387,8 @@ class StewartTiltEnv(HeavyDutyEnv):
             return
         if self._first_tipping_time is None and self._fasm_deg < self.tipping_threshold_deg:
             self._first_tipping_time = self.time
+        if self._first_tipping_time is None and not self._early_landing:
+            self._early_landing = any(self._loaded[i] for i in self._swing_ids)
         if self._first_tipping_time is not None and self._adjustment_leg is None:
             for i, leg in enumerate(LEG_NAMES):
                 if leg in self.swing and self._loaded[i]:
@@ -391,5 +412,6 @@ class StewartTiltEnv(HeavyDutyEnv):
             "platform_rpy": rpy,
             "actuator_lengths": lengths,
             "adjustment_leg": self._adjustment_leg,
+            "early_landing": self._early_landing,
             "recovery_time": self._recovery_time,
         }

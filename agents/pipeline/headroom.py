@@ -1,0 +1,184 @@
+"""Does a benchmark task need feedback? The baselines a ``-v1`` task must defeat, measured.
+
+On the benchmark's test tasks (`hexapod_envs.benchmark.BENCHMARK_SEEDS`) of one env id this runs
+the analytical controller, the zero action (the paper's motion without feedback), uniformly
+random actions and a search over constant actions (fixed action vectors: every entry at one
+bound, the mean of the analytical controller's actions, and seeded random vectors), and reports
+per policy the success rate, tip-overs, the median of the episodes' largest tilt and of their
+share of time tipping. docs/benchmark.md states the targets: the analytical controller succeeds
+on 40-85 % of the test tasks, the zero action on at most 40 %, random actions on at most 10 %,
+and no constant action reaches the analytical controller.
+
+`scripts/benchmark_headroom.py` prints the table for every ``-v1`` env; the tests run it on a few
+tasks.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
+
+import gymnasium as gym
+import numpy as np
+
+from hexapod_envs import info_keys as keys
+
+from ..policy import Policy, RandomPolicy, ZeroPolicy
+from ..registry import ANALYTICAL_ENV_KWARGS, analytical_factory
+
+
+@dataclass(frozen=True)
+class Episode:
+    """One episode's outcome and safety figures."""
+
+    seed: int
+    success: bool
+    tipped_over: bool
+    max_tilt_deg: float
+    tipping_share: float
+    difficulty: float
+
+
+@dataclass
+class Baseline:
+    """One policy's episodes on the tasks."""
+
+    name: str
+    episodes: list[Episode] = field(default_factory=list)
+
+    @property
+    def success_rate(self) -> float:
+        return float(np.mean([e.success for e in self.episodes]))
+
+    @property
+    def tip_over_rate(self) -> float:
+        return float(np.mean([e.tipped_over for e in self.episodes]))
+
+    def median(self, figure: str) -> float:
+        return float(np.median([getattr(e, figure) for e in self.episodes]))
+
+
+class ConstantPolicy:
+    """Always the same action vector."""
+
+    def __init__(self, action: np.ndarray):
+        self.action = np.asarray(action, dtype=np.float32)
+
+    def reset(self) -> None:
+        pass
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        return self.action.copy()
+
+
+class _Recording:
+    """A policy that keeps the actions it returns (to average the analytical controller's)."""
+
+    def __init__(self, policy: Policy):
+        self.policy, self.actions = policy, []
+
+    def reset(self) -> None:
+        self.policy.reset()
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        action = self.policy(observation)
+        self.actions.append(np.asarray(action, dtype=float))
+        return action
+
+
+def run_baseline(
+    env_id: str,
+    name: str,
+    make_policy: Callable[[gym.Env], Policy],
+    seeds: Iterable[int],
+    env_kwargs: dict | None = None,
+    distribution: str = "test",
+) -> Baseline:
+    """Episodes of `make_policy(env)` from ``reset(seed=s)`` for s in `seeds`."""
+    env = gym.make(env_id, task_distribution=distribution, **(env_kwargs or {}))
+    policy, result = make_policy(env), Baseline(name)
+    try:
+        for seed in seeds:
+            obs, info = env.reset(seed=int(seed))
+            if isinstance(policy, RandomPolicy):
+                policy.seed = int(seed)
+            policy.reset()
+            done = False
+            while not done:
+                obs, _, terminated, truncated, info = env.step(policy(obs))
+                done = terminated or truncated
+            result.episodes.append(
+                Episode(
+                    seed=int(seed),
+                    success=bool(info[keys.IS_SUCCESS]),
+                    tipped_over=bool(info[keys.IS_TIPPED_OVER]),
+                    max_tilt_deg=float(info[keys.MAX_TILT_DEG]),
+                    tipping_share=float(info[keys.TIPPING_SHARE]),
+                    difficulty=float(info[keys.TASK].get("difficulty", np.nan)),
+                )
+            )
+    finally:
+        env.close()
+    return result
+
+
+def constant_actions(shape: tuple[int, ...], mean_analytical: np.ndarray | None, n_random: int):
+    """The constant actions searched: every entry at -1, at +1, the mean of the analytical
+    controller's actions (if given, in the env's default action mode) and `n_random` seeded
+    uniform vectors; name -> action."""
+    candidates = {"all -1": -np.ones(shape), "all +1": np.ones(shape)}
+    if mean_analytical is not None:
+        candidates["analytical mean"] = np.clip(mean_analytical, -1.0, 1.0)
+    rng = np.random.default_rng(0)
+    for k in range(n_random):
+        candidates[f"uniform #{k}"] = rng.uniform(-1.0, 1.0, shape)
+    return candidates
+
+
+def headroom(env_id: str, seeds: Iterable[int], n_random_constants: int = 4) -> list[Baseline]:
+    """The analytical controller, zero, random and the best constant action on `seeds` (test
+    tasks) of `env_id`; the best constant is named ``constant (<which>)``."""
+    seeds = list(seeds)
+    recorder: list[_Recording] = []
+
+    def analytical(env: gym.Env) -> Policy:
+        recorder.append(_Recording(analytical_factory(env_id)(env)))
+        return recorder[-1]
+
+    reference_kwargs = ANALYTICAL_ENV_KWARGS.get(env_id, {})
+    rows = [run_baseline(env_id, "analytical", analytical, seeds, reference_kwargs)]
+    rows.append(run_baseline(env_id, "zero", lambda env: ZeroPolicy(env.action_space), seeds))
+    rows.append(run_baseline(env_id, "random", lambda env: RandomPolicy(env.action_space), seeds))
+    # The analytical controller's mean action is a constant action only in the mode it runs in.
+    same_mode = not reference_kwargs.get("action_mode")
+    mean = np.mean(recorder[0].actions, axis=0) if same_mode else None
+    env = gym.make(env_id)
+    shape = env.action_space.shape  # the default action mode's
+    env.close()
+    best = None
+    for which, action in constant_actions(shape, mean, n_random_constants).items():
+        row = run_baseline(env_id, f"constant ({which})", _constant(action), seeds)
+        if best is None or row.success_rate > best.success_rate:
+            best = row
+    rows.append(best)
+    return rows
+
+
+def _constant(action: np.ndarray) -> Callable[[gym.Env], Policy]:
+    return lambda env: ConstantPolicy(action)
+
+
+def format_table(env_id: str, rows: list[Baseline]) -> str:
+    """A Markdown table: policy, success, tip-overs, median max tilt, median share tipping."""
+    lines = [
+        f"### {env_id} ({len(rows[0].episodes)} test tasks)",
+        "",
+        "| policy | success | tip-over | max tilt, median [deg] | time tipping, median |",
+        "|---|---|---|---|---|",
+    ]
+    for row in rows:
+        lines.append(
+            f"| {row.name} | {row.success_rate:.0%} | {row.tip_over_rate:.0%} | "
+            f"{row.median('max_tilt_deg'):.1f} | {row.median('tipping_share'):.0%} |"
+        )
+    return "\n".join(lines)
