@@ -29,17 +29,17 @@ BENCHMARK_SEEDS = range(50)
 """The benchmark's test tasks: ``env.reset(seed=s)`` on ``task_distribution="test"``."""
 
 CLIFF_TRAIN_V1 = CliffTaskRanges(
-    cliff_x=(2.8, 4.4),
+    cliff_x=(2.8, 5.0),
     edge_y=(-1.3, -0.7),
     drop=(1.0, 5.0),
     friction=(0.6, 1.2),
     payload_mass=(0.0, 800.0),
     payload_offset=0.25,
 )
-"""Training cliffs, easy to hard: the edge 0.15-1.75 m ahead of the front feet, cutting
+"""Training cliffs, easy to hard: the edge 0.15-2.35 m ahead of the front feet, cutting
 0.6-1.2 m into the outer feet's path, 1-5 m deep; friction 0.6-1.2; payload up to 800 kg."""
 CLIFF_TEST_V1 = CliffTaskRanges(
-    cliff_x=(2.8, 4.4),
+    cliff_x=(2.8, 5.0),
     edge_y=(-1.0, -0.7),
     drop=(3.0, 5.0),
     friction=(0.6, 0.9),
@@ -75,7 +75,6 @@ V1_KWARGS = MappingProxyType(
             "tip_over_margin_time": 1.0,
             "success_max_tilt_deg": 8.0,
             "success_max_tipping_share": 0.1,
-            "min_progress": 0.7,
             "train_ranges": CLIFF_TRAIN_V1,
             "test_ranges": CLIFF_TEST_V1,
         },
@@ -92,6 +91,9 @@ V1_KWARGS = MappingProxyType(
             "test_ranges": BLOCKS_TEST_V1,
         },
         "HexapodDitchCrossing-v1": {
+            "reference_plan": "flat",
+            "residual_limb_m": 0.05,
+            "residual_leg_m": 0.16,
             "tip_over_angle_deg": 10.0,
             "success_max_tilt_deg": 2.0,
             "success_max_tipping_share": 0.02,

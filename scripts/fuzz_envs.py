@@ -3,6 +3,9 @@ actions; count exceptions, non-finite observations/rewards and unstable steps.
 
 Not a CI test (it takes minutes): run it by hand after changing an env, e.g.
     PYTHONPATH=$PWD nice -n 10 python scripts/fuzz_envs.py --steps 20000
+    python scripts/fuzz_envs.py --envs HexapodCliffWalk-v1 HexapodStewartTilt-v1 \
+        HexapodIrregularTerrain-v1 HexapodDitchCrossing-v1 --distributions train test \
+        --steps 55600   # the v1 benchmark's 1 M steps
 Prints one line per combination and a total; exits 1 if any exception or non-finite value.
 """
 
@@ -24,6 +27,7 @@ ACTION_MODES = {
     "HexapodIrregularTerrain-v0": ("residual", "joint", "gains"),
     "HexapodDitchCrossing-v0": ("residual", "joint"),
 }
+ACTION_MODES.update({env_id.replace("-v0", "-v1"): m for env_id, m in ACTION_MODES.items()})
 DISTRIBUTIONS = ("paper", "train", "test")
 
 
@@ -70,12 +74,13 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--steps", type=int, default=20000, help="steps per combination")
     parser.add_argument("--seed", type=int, default=0)
-    parser.add_argument("--envs", nargs="*", default=list(ACTION_MODES))
+    parser.add_argument("--envs", nargs="*", default=list(ACTION_MODES), choices=ACTION_MODES)
+    parser.add_argument("--distributions", nargs="*", default=DISTRIBUTIONS, choices=DISTRIBUTIONS)
     args = parser.parse_args()
     total = dict(steps=0, exceptions=0, nonfinite=0, unstable=0)
     for env_id in args.envs:
         for mode in ACTION_MODES[env_id]:
-            for dist in DISTRIBUTIONS:
+            for dist in args.distributions:
                 t0 = time.perf_counter()
                 c = fuzz(env_id, mode, dist, args.steps, args.seed)
                 dt = time.perf_counter() - t0

@@ -17,6 +17,9 @@ from hexapod_envs.envs.irregular_terrain import TERRAIN_TEST, TERRAIN_TRAIN
 from hexapod_envs.envs.stewart_tilt import TILT_TEST, TILT_TRAIN
 
 ENV_IDS = sorted(k for k in gym.registry if k.startswith("Hexapod"))
+V0_IDS = [env_id for env_id in ENV_IDS if env_id.endswith("-v0")]
+"""The -v0 envs, whose test ranges lie outside the training ranges; the -v1 benchmark's test
+tasks are at least as hard instead (tests/test_benchmark_v1.py)."""
 
 
 def _settings_class(env_id):
@@ -310,7 +313,7 @@ def _tasks(env_id, distribution, n, seed0=0):
     return tasks
 
 
-@pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("env_id", V0_IDS)
 def test_train_resets_give_distinct_tasks_in_the_train_ranges(env_id):
     tasks = _tasks(env_id, "train", 20)
     distinct = {tuple(sorted(t.items())) for t in tasks}
@@ -319,7 +322,7 @@ def test_train_resets_give_distinct_tasks_in_the_train_ranges(env_id):
         assert all(_inside(t[key], train) for t in tasks), key
 
 
-@pytest.mark.parametrize("env_id", ENV_IDS)
+@pytest.mark.parametrize("env_id", V0_IDS)
 def test_test_tasks_lie_in_the_held_out_ranges(env_id):
     tasks = _tasks(env_id, "test", 8, seed0=100)
     for key, train, test in HELD_OUT[env_id]:
@@ -332,7 +335,7 @@ def test_test_tasks_lie_in_the_held_out_ranges(env_id):
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_paper_distribution_is_one_task(env_id):
     tasks = _tasks(env_id, "paper", 3)
-    if env_id == "HexapodStewartTilt-v0":  # the paper env's default scenario is "random"
+    if env_id.startswith("HexapodStewartTilt"):  # the paper env's default scenario is "random"
         tasks = [{k: v for k, v in t.items() if "tilt" not in k and k != "stance"} for t in tasks]
     assert tasks[0] == tasks[1] == tasks[2]
 

@@ -275,3 +275,21 @@ def test_a_difference_without_a_paired_interval_says_so():
     (bullet,), verdicts = verdict_lines(result, aggs)
     assert all(v.interval is None for v in verdicts if v.outcome != "tie")
     assert "distance per second 1 vs 0.5 (no paired interval)" in bullet
+
+
+def test_benchmark_scores_run_from_random_to_the_analytical_controller(tmp_path):
+    """With analytical and random on an env, the report scores every policy on that scale (the
+    IQM across envs beside it) and plots success against the task difficulty."""
+    out = tmp_path / "bench"
+    argv = ["--config", "configs/evaluate_benchmark_v1.yaml", "--envs", "HexapodStewartTilt-v1"]
+    argv += ["--episodes", "3", "--output-dir", str(out), "--no-progress"]
+    assert evaluate_main(argv) == 0
+    md = (out / "report.md").read_text()
+    section = md.split("## Benchmark scores\n", 1)[1].split("\n## ", 1)[0]
+    assert "| policy | HexapodStewartTilt-v1 | IQM [95 % CI] |" in section
+    assert "| `analytical` | 100 | 100 [100, 100] |" in section
+    assert "| `random` | 0 | 0 [0, 0] |" in section
+    assert (out / "figures" / "success_by_difficulty.png").is_file()
+    metrics = json.loads((out / "metrics.json").read_text())
+    episode = metrics["envs"]["HexapodStewartTilt-v1"]["policies"]["analytical"]["episodes"][0]
+    assert "difficulty" in json.dumps(episode)

@@ -154,6 +154,38 @@ def success_bars(result: SuiteResult) -> bytes | None:
     return _png(fig)
 
 
+def success_by_difficulty(result: SuiteResult, bins: int = 4) -> bytes | None:
+    """Success rate per policy against the task difficulty (``task["difficulty"]``, in [0, 1])
+    in `bins` equal bins, one panel per env that reports a difficulty; a marker per bin that
+    holds episodes."""
+    envs = [
+        r
+        for r in result.envs
+        if r.runs and any("difficulty" in e.task for run in r.runs.values() for e in run.episodes)
+    ]
+    if not envs:
+        return None
+    edges = np.linspace(0.0, 1.0, bins + 1)
+    centres = (edges[:-1] + edges[1:]) / 2
+    fig, axes = plt.subplots(1, len(envs), figsize=(3.6 * len(envs), 3.2), squeeze=False)
+    for ax, r in zip(axes[0], envs, strict=True):
+        for name, run in r.runs.items():
+            d = np.array([e.task.get("difficulty", np.nan) for e in run.episodes], dtype=float)
+            ok = np.array([bool(e.success) for e in run.episodes], dtype=float)
+            index = np.clip(np.digitize(d, edges) - 1, 0, bins - 1)
+            rates = [ok[index == b].mean() if np.any(index == b) else np.nan for b in range(bins)]
+            ax.plot(centres, rates, marker="o", label=_short(r.label(name), 28))
+        ax.set_xlim(0, 1)
+        ax.set_ylim(-0.05, 1.05)
+        ax.set_xlabel("task difficulty", fontsize=8)
+        ax.set_ylabel("success rate", fontsize=8)
+        ax.set_title(r.env_id, fontsize=8)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=6)
+    fig.tight_layout()
+    return _png(fig)
+
+
 def learning_curves(result: EnvResult) -> bytes | None:
     """Evaluation success rate and mean return against learner steps (env steps; gait cycles, in
     a row of their own, for a run that acts once per cycle) for every PPO policy whose

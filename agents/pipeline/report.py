@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from . import figures
+from . import benchmark_score, figures
 from .episode import POWER_KEY
 from .eval_config import DEFAULT_REFERENCES, PPO_PREFIX
 from .evaluation import EnvResult, SuiteResult
@@ -412,6 +412,53 @@ HOW_TO_READ = [
 ]
 
 
+def benchmark_section(result: SuiteResult) -> tuple[Table | None, str]:
+    """The normalised scores (0 = random actions, 100 = the analytical controller) per env and
+    policy, with the IQM across envs and its 95 % interval (`benchmark_score`); and a sentence
+    on what is left out. (None, reason) when no env ran both references."""
+    successes = {
+        r.env_id: {
+            r.label(name): [bool(e.success) for e in run.episodes]
+            for name, run in r.runs.items()
+        }
+        for r in result.envs
+        if r.runs
+    }
+    matrices, envs = benchmark_score.score_matrices(successes)
+    if not envs:
+        return None, (
+            "No normalised scores: they need `analytical` and `random` on an env, with the "
+            "analytical controller succeeding more often than random actions."
+        )
+    left_out = [env for env in successes if env not in envs]
+    try:
+        intervals = benchmark_score.iqm_intervals(matrices)
+    except ImportError as error:
+        intervals, note = {}, f" {error}."
+    else:
+        note = ""
+    table = Table(["policy", *envs, "IQM [95 % CI]"])
+    for policy, matrix in matrices.items():
+        cells = [f"{x:.0f}" for x in matrix.mean(axis=0)]
+        if policy in intervals:
+            iqm, low, high = intervals[policy]
+            cells.append(f"{iqm:.0f} [{low:.0f}, {high:.0f}]")
+        else:
+            cells.append("n/a")
+        table.rows.append([f"`{policy}`", *cells])
+    text = (
+        "Normalised success score per env: 0 = random actions, 100 = the analytical "
+        "controller, on the same tasks; the last column is the interquartile mean across envs "
+        "with its 95 % stratified-bootstrap interval (episodes resampled within each env)."
+    )
+    if left_out:
+        text += (
+            f" Left out (the analytical controller does not beat random actions there): "
+            f"{', '.join(f'`{e}`' for e in left_out)}."
+        )
+    return table, text + note
+
+
 def policy_kind(name: str) -> str:
     if name == "analytical":
         return "analytical controllers"
@@ -610,6 +657,15 @@ def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
         "success_rates.png",
         figures.success_bars(result),
         "Success and tip-over rate per env and policy (share of episodes)",
+    )
+    heading("Benchmark scores", 2)
+    scores, text = benchmark_section(result)
+    para(text)
+    table(scores)
+    figure(
+        "success_by_difficulty.png",
+        figures.success_by_difficulty(result),
+        "Success rate against the task's difficulty (info['task']['difficulty']), per env",
     )
 
     for r in result.envs:

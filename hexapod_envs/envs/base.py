@@ -292,6 +292,21 @@ class HexapodEnv(gym.Env):
         "render_fps": 50,
     }
 
+    evaluation_metrics: ClassVar[dict[str, Any]] = {
+        keys.MAX_TILT_DEG: {
+            "reduce": "last",
+            "better": "lower",
+            "description": "the episode's largest body tilt [deg]",
+        },
+        keys.TIPPING_SHARE: {
+            "reduce": "last",
+            "better": "lower",
+            "description": "share of the episode with the stability criterion failing",
+        },
+    }
+    """Per-episode metrics the evaluation reports (`agents.pipeline.episode`): the safety
+    figures of the success rule; an env extends the mapping with its own."""
+
     ends_on_success: ClassVar[bool] = False
     """Whether a successful step terminates the episode (a crossing) or success is a running
     status (walking on, staying up)."""

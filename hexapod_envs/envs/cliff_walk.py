@@ -36,6 +36,11 @@ offset) at every reset from the ``train_ranges`` / ``test_ranges`` settings (def
 friction, heavier payload). ``info["task"]`` holds the values.
 
 Action: see `HeavyDutyEnv` (``action_mode="joint"`` or ``"residual"``, 18 values in [-1, 1]).
+
+Version history: ``-v1`` (docs/benchmark.md) ends the episode at a 15° tilt or after 1 s at
+FASM <= 0, counts a success only with the tilt within 8° and at most 10 % of the episode below
+ξ_f, and draws cliffs 0.15-2.35 m ahead of the front feet (`hexapod_envs.benchmark`); ``-v0`` is
+the papers' reproduction.
 """
 
 from __future__ import annotations
@@ -117,7 +122,7 @@ class CliffWalkEnv(HeavyDutyEnv):
 
     Settings = CliffWalkSettings
     difficulty_spans = {
-        "cliff_x": DifficultySpan(easy=4.4, hard=2.8),
+        "cliff_x": DifficultySpan(easy=5.0, hard=2.8),
         "cliff_edge_y": DifficultySpan(easy=-1.3, hard=-0.7),
         "cliff_drop": DifficultySpan(easy=1.0, hard=5.0),
         "friction": DifficultySpan(easy=1.2, hard=0.6),

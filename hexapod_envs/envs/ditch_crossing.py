@@ -76,6 +76,12 @@ stance_legs, is_tipping (static_margin_m <= 0: the CoG projection is not inside 
 feet's polygon), is_tipped_over, is_success, sim_unstable, distance (CoG advance [m]), tilt_deg,
 planner_status, planner_reason, ditch (start_x, width, depth [m]; None on flat ground),
 finish_x [m], gait_step and gait_phase (the reference's plan step and phase), time, cog.
+
+Version history: ``-v1`` (docs/benchmark.md) makes the reference gait the flat-ground one
+(``reference_plan="flat"``: the zero action walks into the ditch blind), widens the residual to
+50 mm on the limbs and 160 mm on the legs so that a policy can adapt the steps, ends the episode
+at a 10° tilt and counts a crossing as a success only with the tilt within 2° and at most 2 % of
+the episode at a static margin <= 0; ``-v0`` is the papers' reproduction.
 """
 
 from __future__ import annotations
@@ -173,6 +179,10 @@ class DitchCrossingRewardScales(RewardScales):
     effort_weight: float = number(0.02)
 
 
+REFERENCE_PLANS = ("course", "flat")
+"""``reference_plan`` values: the plan for the episode's ditch, or the flat-ground gait."""
+
+
 @dataclasses.dataclass(frozen=True)
 class DitchCrossingSettings(EnvSettings):
     """Settings of HexapodDitchCrossing-v0 (SI units; see the module docstring)."""
@@ -208,6 +218,11 @@ class DitchCrossingSettings(EnvSettings):
     ditch_depth_range: tuple[float, float] | None = numbers(
         None, size=2, ordered=True, optional=True
     )
+    reference_plan: str = choice("course", REFERENCE_PLANS)
+    """The reference gait (the residual's base, the zero action's motion, the observation's
+    ``reference_action``): "course" plans for the episode's ditch (-v0: the zero action crosses
+    like the paper's planner), "flat" is the flat-ground gait to the same finish line, blind to
+    the ditch (-v1: crossing needs the ditch sensed and the steps adapted)."""
     action_mode: str = choice("residual", ACTION_MODES)
     residual_limb_m: float = number(0.002)
     """Residual action 1 on a limb [m]."""
@@ -385,7 +400,7 @@ class DitchCrossingEnv(HexapodEnv):
     def _plan_for(self, ditch: Ditch) -> GaitPlan:
         """The reference plan of `ditch` (cached by what it depends on: the ditch's geometry, or
         on flat ground the finish line `end_x`; not the friction)."""
-        on_ditch = self.terrain == "ditch"
+        on_ditch = self.terrain == "ditch" and self.settings.reference_plan == "course"
         key = (ditch.start_x, ditch.width, ditch.depth) if on_ditch else ("flat", ditch.end_x)
         if key not in self._plans:
             p, s = self.params, self.gait_settings

@@ -117,6 +117,11 @@ Gymnasium's vector envs' info batching). The seed's box plots are made from thes
 ``actuator_power_w`` (sum of |torque x joint speed|, W) and ``episode_metrics`` (at reset and
 whenever a cycle finishes: the lists so far of this episode's per-cycle height, pitch-rate and
 roll-rate RMS and mean ZMP margin) feed the evaluation pipeline (`evaluation_metrics`).
+
+Version history: ``-v1`` (docs/benchmark.md) walks the block bed (``terrain="blocks"``), ends the
+episode at a 45° tilt, counts a success only with the tilt within 25° and at most 30 % of the
+episode below ξ, and draws beds from easy to hard in training and from the harder half in test
+(`hexapod_envs.benchmark`); ``-v0`` is the papers' reproduction.
 """
 
 from __future__ import annotations
@@ -325,6 +330,7 @@ class IrregularTerrainEnv(HexapodEnv):
     """ATHENA on a ramp, a block test bed or flat ground; see the module docstring."""
 
     evaluation_metrics = {
+        **HexapodEnv.evaluation_metrics,
         "torso_collisions": {
             "reduce": "last",
             "better": "lower",

@@ -41,7 +41,12 @@ any joint target is reachable), ``"joint"`` gives targets directly. Reward terms
 HexapodCliffWalk-v0 without forward: stability, alive, tip_over, effort. `info` adds
 scenario and stance (the episode's: on the train/test distributions the sampled case),
 platform_tilt_deg, platform_rpy, actuator_lengths (6, m), adjustment_leg (the first lifted leg
-to land after tipping was flagged) and recovery_time [s].
+to land after tipping was flagged), early_landing (a lifted foot touched down before the robot
+first tipped) and recovery_time [s].
+
+Version history: ``-v1`` (docs/benchmark.md) counts a success only with the lifted tripod kept
+up until the robot first tips (``swing_until_tipping``) and the lean relative to the platform
+within 2.5°; ``-v0`` is the papers' reproduction.
 """
 
 from __future__ import annotations

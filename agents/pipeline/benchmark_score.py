@@ -1,0 +1,84 @@
+"""Normalised benchmark scores: 0 = random actions, 100 = the analytical controller.
+
+As D4RL normalises returns between a random and an expert policy, a policy's score on an env is
+``100 x (success - success_random) / (success_analytical - success_random)`` with the success
+rates measured on the same tasks (the reference rates are held fixed, as D4RL's are). Across
+envs the aggregate is the interquartile mean (IQM) of the per-env scores, with a 95 %
+stratified-bootstrap interval from rliable (Agarwal et al. 2021, "Deep RL at the edge of the
+statistical precipice"): every episode's success (0 or 1) is normalised with its env's scale,
+giving an (episodes x envs) matrix per policy; the bootstrap resamples episodes within each env,
+and the statistic is the IQM over envs of each env's mean (its normalised success rate).
+
+An env on which the analytical controller does not beat random actions has no scale: it is left
+out of the scores (and the report says so).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+
+import numpy as np
+
+RANDOM, ANALYTICAL = "random", "analytical"
+
+
+def env_scale(success: Mapping[str, float]) -> tuple[float, float] | None:
+    """(random, analytical) success rates of one env, or None without a usable scale."""
+    if RANDOM not in success or ANALYTICAL not in success:
+        return None
+    low, high = float(success[RANDOM]), float(success[ANALYTICAL])
+    return (low, high) if high > low else None
+
+
+def normalised(rate: float, scale: tuple[float, float]) -> float:
+    """100 x (rate - random) / (analytical - random)."""
+    low, high = scale
+    return 100.0 * (rate - low) / (high - low)
+
+
+def score_matrices(
+    successes: Mapping[str, Mapping[str, list[bool]]],
+) -> tuple[dict[str, np.ndarray], list[str]]:
+    """``{policy: (episodes x envs) normalised per-episode scores}`` over the envs with a scale
+    on which the policy ran the same number of episodes as every other; and those envs.
+    `successes` is ``{env: {policy: [success per episode]}}``."""
+    envs = [
+        env
+        for env, by_policy in successes.items()
+        if env_scale({p: float(np.mean(v)) for p, v in by_policy.items()}) is not None
+    ]
+    policies = sorted({p for env in envs for p in successes[env]})
+    out = {}
+    for policy in policies:
+        columns = []
+        for env in envs:
+            by_policy = successes[env]
+            if policy not in by_policy:
+                break
+            scale = env_scale({p: float(np.mean(v)) for p, v in by_policy.items()})
+            columns.append([normalised(float(s), scale) for s in by_policy[policy]])
+        if len(columns) == len(envs) and len({len(c) for c in columns}) == 1:
+            out[policy] = np.array(columns, dtype=float).T
+    return out, envs
+
+
+def iqm_intervals(
+    matrices: Mapping[str, np.ndarray], reps: int = 2000, seed: int = 0
+) -> dict[str, tuple[float, float, float]]:
+    """``{policy: (IQM, CI low, CI high)}`` of the score matrices (rliable, 95 % stratified
+    bootstrap over episodes). ImportError naming the extra if rliable is not installed."""
+    try:
+        from rliable import library as rly
+        from rliable import metrics
+    except ImportError as error:  # pragma: no cover - rliable ships with the [sweep] extra
+        raise ImportError(
+            "the aggregate benchmark score needs rliable: pip install 'hexapod_envs[sweep]'"
+        ) from error
+
+    def iqm(scores: np.ndarray) -> np.ndarray:  # (episodes x envs) -> IQM of the env means
+        return np.array([metrics.aggregate_iqm(scores.mean(axis=0, keepdims=True))])
+
+    # rliable 1.2 draws through NumPy's global generator: seed it for reproducible intervals.
+    np.random.seed(seed)
+    points, intervals = rly.get_interval_estimates(dict(matrices), iqm, reps=reps)
+    return {p: (float(points[p][0]), *map(float, intervals[p][:, 0])) for p in matrices}
