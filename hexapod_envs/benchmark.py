@@ -23,6 +23,7 @@ from __future__ import annotations
 from types import MappingProxyType
 
 from .envs.cliff_walk import CliffTaskRanges
+from .envs.ditch_crossing import DitchTaskRanges
 from .envs.irregular_terrain import TerrainTaskRanges
 
 BENCHMARK_SEEDS = range(50)
@@ -68,6 +69,11 @@ BLOCKS_TEST_V1 = TerrainTaskRanges(
 """Test block beds: the taller half of training's blocks, smaller, more slippery, servos far
 from nominal: harder than training on average."""
 
+DITCH_TEST_V1 = DitchTaskRanges(
+    start_x=(0.9, 1.1), width=(0.40, 0.55), depth=(0.12, 0.15), friction=(0.5, 0.8)
+)
+"""Test ditches: -v0's held-out ranges with widths up to 0.55 m (training: 0.25-0.40 m)."""
+
 V1_KWARGS = MappingProxyType(
     {
         "HexapodCliffWalk-v1": {
@@ -97,6 +103,7 @@ V1_KWARGS = MappingProxyType(
             "tip_over_angle_deg": 10.0,
             "success_max_tilt_deg": 2.0,
             "success_max_tipping_share": 0.02,
+            "test_ranges": DITCH_TEST_V1,
         },
     }
 )

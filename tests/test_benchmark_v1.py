@@ -154,7 +154,7 @@ def test_the_cliff_reference_can_resume_its_gait_after_a_recovery():
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("env_id", ["HexapodCliffWalk-v1", "HexapodStewartTilt-v1"])
+@pytest.mark.parametrize("env_id", V1_IDS)
 def test_no_baseline_reaches_the_reference_on_benchmark_tasks(env_id):
     """The headroom targets on 8 benchmark test tasks (the full 50-task table is
     scripts/benchmark_headroom.py): random actions never succeed, and neither the zero action

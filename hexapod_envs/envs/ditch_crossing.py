@@ -254,7 +254,7 @@ class DitchCrossingEnv(HexapodEnv):
     Settings = DitchCrossingSettings
     ends_on_success = True
     difficulty_spans = {
-        "ditch_width": DifficultySpan(easy=0.25, hard=0.50),
+        "ditch_width": DifficultySpan(easy=0.25, hard=0.55),
         "ditch_depth": DifficultySpan(easy=0.06, hard=0.15),
         "friction": DifficultySpan(easy=1.2, hard=0.5),
     }

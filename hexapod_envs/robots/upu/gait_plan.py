@@ -388,8 +388,12 @@ def _feasible_lift(params: UpuParams, settings: GaitSettings, moving: str, x0: f
     return float(candidates[1 + first[0]]) if first.size else None
 
 
+@lru_cache(maxsize=65536)
 def _transfer_margin(params: UpuParams, moving: str, x0: float, x1: float) -> float:
     """Min static margin while the `moving` centre goes from x0 to x1 relative to the other [m].
+
+    Cached like `_feasible_lift`: it depends on the robot and the relative step only, so the
+    plans of different ditches share it (a reset on sampled ditches plans anew every time).
 
     The CoG moves on a straight line and the margin inside a convex polygon is the minimum of
     the distances to its sides, each linear in the CoG position: a concave function, so its
