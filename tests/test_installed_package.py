@@ -75,7 +75,7 @@ def test_wheel_installed_in_a_fresh_venv_evaluates_from_an_empty_folder(tmp_path
 
     empty = tmp_path / "empty"
     empty.mkdir()
-    for script in ("hexapod-evaluate", "hexapod-train"):
+    for script in ("hexapod-evaluate", "hexapod-train", "hexapod-export"):
         helped = _run([str(bin_dir / script), "--help"], cwd=empty)
         assert helped.returncode == 0, helped.stderr[-3000:]
         assert helped.stdout.startswith(f"usage: {script}")

@@ -1,0 +1,105 @@
+"""`hexapod-export` (agents.export): the ONNX actor with the observation normalisation folded in
+gives the torch policy's deterministic actions, and its model card describes the model."""
+
+import json
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+import pytest
+
+import hexapod_envs  # noqa: F401  (registers the envs)
+from agents.export import card_paths, export_main, export_model
+from agents.hybrid import HybridPolicy
+from agents.ppo import PPOPolicy
+
+ort = pytest.importorskip("onnxruntime")
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _recorded_observations(env, policy, steps=60, seed=3):
+    """Observations of an episode driven by `policy`, then of random actions (a wider spread),
+    plus scaled copies whose normalised values hit the clip of the statistics."""
+    observations = []
+    obs, _ = env.reset(seed=seed)
+    policy.reset()
+    rng = np.random.default_rng(seed)
+    for step in range(steps):
+        observations.append(obs)
+        action = policy(obs) if step < steps // 2 else env.action_space.sample()
+        obs, _, terminated, truncated, _ = env.step(action)
+        if terminated or truncated:
+            obs, _ = env.reset(seed=seed + step)
+    recorded = np.array(observations, dtype=np.float64)
+    extreme = recorded[:5] * rng.uniform(-50, 50, size=recorded[:5].shape)
+    return np.concatenate([recorded, extreme])
+
+
+def _onnx_actions(path, observations):
+    session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    (action,) = session.run(["action"], {"observation": observations})
+    return action
+
+
+@pytest.mark.parametrize(
+    "model", ["HexapodCliffWalk-v0/ppo", "HexapodIrregularTerrain-v0/gains"]
+)  # a plain PPO model; a hybrid one whose learned part acts once per gait cycle
+def test_onnx_actions_equal_the_torch_policy(tmp_path, model):
+    model_dir = ROOT / "models" / model
+    result = export_model(model_dir, tmp_path / "actor.onnx")
+    card = result.card
+    env = gym.make(card["env"]["id"], **card["env"]["kwargs"])
+    try:
+        policy = PPOPolicy.load(model_dir, env)
+        learned = policy.learned if isinstance(policy, HybridPolicy) else policy
+        assert isinstance(policy, HybridPolicy) == model.endswith("gains")
+        observations = _recorded_observations(env, policy)
+    finally:
+        env.close()
+    assert learned.stats is not None and learned.stats.norm_obs  # the test covers the folding
+    expected = np.array([learned(o) for o in observations])
+    actions = _onnx_actions(result.onnx, observations)
+    assert actions.dtype == np.float32 and actions.shape == expected.shape
+    np.testing.assert_allclose(actions, expected, rtol=0, atol=1e-5)
+    assert np.ptp(expected, axis=0).max() > 0.1  # the observations move the actions
+    z = np.abs(learned.stats.normalize_obs(observations))
+    assert np.isclose(z, learned.stats.clip_obs).any()  # the clip of the statistics is exercised
+
+
+def test_model_card(tmp_path):
+    model_dir = ROOT / "models" / "HexapodCliffWalk-v0" / "hybrid"
+    out = tmp_path / "out" / "cliff.onnx"
+    result = export_model(model_dir, out, report=ROOT / "reports" / "shipped")
+    assert (result.card_json, result.card_md) == card_paths(out)
+    card = json.loads(result.card_json.read_text())
+    assert card == json.loads(json.dumps(result.card))
+    assert card["env"]["id"] == "HexapodCliffWalk-v0" and card["env"]["version"] == 0
+    layout = card["observation"]["layout"]
+    assert layout[0]["start"] == 0 and layout[-1]["stop"] == card["observation"]["shape"][0]
+    assert all(a["stop"] == b["start"] for a, b in zip(layout, layout[1:], strict=False))
+    assert "fasm_margin_deg" in {p["name"] for p in layout}
+    assert card["action"]["mode"] == card["env"]["kwargs"]["action_mode"] == "residual"
+    assert card["action"]["exported"].startswith("hybrid model: the file holds the learned actor")
+    assert card["action"]["output_space"]["low"] == [-1.0] * 18
+    meta = json.loads((model_dir / "meta.json").read_text())
+    assert card["training"]["num_timesteps"] == meta["num_timesteps"]
+    assert any("normalisation" in item for item in card["folded_in"])
+    assert card["training_evaluations"]["evaluations"] > 0
+    (score,) = card["benchmark"]
+    assert score["env_id"] == "HexapodCliffWalk-v0" and score["success_rate"] == 1.0
+    text = result.card_md.read_text()
+    for heading in ("Observation layout", "Folded into the graph", "Benchmark"):
+        assert f"## {heading}" in text
+
+
+def test_cli_refuses_to_overwrite_without_force(tmp_path, capsys):
+    out = tmp_path / "a.onnx"
+    argv = [str(ROOT / "models" / "HexapodCliffWalk-v0" / "ppo"), "--output", str(out)]
+    assert export_main(argv) == 0
+    assert out.is_file() and all(p.is_file() for p in card_paths(out))
+    assert export_main(argv) == 2
+    assert "--force" in capsys.readouterr().err
+    assert export_main([*argv, "--force"]) == 0
+    assert export_main([str(tmp_path / "nothing")]) == 2
+    assert "no PPO model" in capsys.readouterr().err
