@@ -67,10 +67,24 @@ def test_onnx_actions_equal_the_torch_policy(tmp_path, model):
     assert np.isclose(z, learned.stats.clip_obs).any()  # the clip of the statistics is exercised
 
 
+def _report(path, rates):
+    """A hexapod-evaluate metrics.json with these success rates on the cliff walk."""
+    policies = {
+        name: {"aggregate": {"episodes": 20, "success": {"mean": rate}}}
+        for name, rate in rates.items()
+    }
+    env = {"kwargs": {"task_distribution": "test"}, "policies": policies}
+    path.mkdir()
+    (path / "metrics.json").write_text(json.dumps({"envs": {"HexapodCliffWalk-v0": env}}))
+    return path
+
+
 def test_model_card(tmp_path):
     model_dir = ROOT / "models" / "HexapodCliffWalk-v0" / "hybrid"
     out = tmp_path / "out" / "cliff.onnx"
-    result = export_model(model_dir, out, report=ROOT / "reports" / "shipped")
+    rates = {"analytical": 0.8, "random": 0.2, "ppo:models/{env_id}/hybrid": 0.5}
+    rates["ppo:models/{env_id}/ppo"] = 1.0  # another model: not this card's
+    result = export_model(model_dir, out, report=_report(tmp_path / "report", rates))
     assert (result.card_json, result.card_md) == card_paths(out)
     card = json.loads(result.card_json.read_text())
     assert card == json.loads(json.dumps(result.card))
@@ -87,7 +101,8 @@ def test_model_card(tmp_path):
     assert any("normalisation" in item for item in card["folded_in"])
     assert card["training_evaluations"]["evaluations"] > 0
     (score,) = card["benchmark"]
-    assert score["env_id"] == "HexapodCliffWalk-v0" and score["success_rate"] == 1.0
+    assert score["env_id"] == "HexapodCliffWalk-v0" and score["success_rate"] == 0.5
+    assert score["benchmark_score"] == pytest.approx(50.0)  # halfway from random to analytical
     text = result.card_md.read_text()
     for heading in ("Observation layout", "Folded into the graph", "Benchmark"):
         assert f"## {heading}" in text
