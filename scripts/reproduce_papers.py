@@ -1,7 +1,8 @@
 """Regenerate the reproduction report: the three papers' headline numbers beside ours.
 
 Run: python scripts/reproduce_papers.py [--only 000|002|003] [--quick] [--out reports]
-Writes `reproduction.md` and `reproduction.json` under --out (rows: see agents/reproduction.py).
+Writes `reproduction.md` and `reproduction.json` under --out (rows: see
+experiments/reproduction/rows.py, and experiments/reproduction/README.md).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from agents.reproduction import collect, markdown  # noqa: E402
+from experiments.reproduction.rows import collect, markdown  # noqa: E402
 
 
 def main(argv: list[str] | None = None) -> list[dict]:

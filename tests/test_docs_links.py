@@ -11,6 +11,7 @@ PAGES = [
     ROOT / "README.md",
     ROOT / "benchmarks" / "README.md",
     *sorted((ROOT / "docs").glob("*.md")),
+    *sorted((ROOT / "experiments").glob("*/README.md")),
 ]
 LINK = re.compile(r"\]\(([^)\s]+)\)")
 

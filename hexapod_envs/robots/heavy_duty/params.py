@@ -71,9 +71,8 @@ class HeavyDutyParams:
     """Rotor inertia of each servo reflected to its joint: x [kg], leg length [kg], swing
     [kg·m²]. The paper gives none. The legs' fastest motions are the servo damping acting on the
     light legs; this inertia slows them enough for the 2 ms physics step to reproduce what the
-    former model, (20, 20, 50) at 1 ms, does in the paper scenarios' fidelity rows
-    (scripts/heavy_duty_armature_probe.py). Near a cliff's edge the two differ (benchmarks/
-    README.md, "The servo armature and the 2 ms step")."""
+    former model, (20, 20, 50) at 1 ms, does in the paper scenarios' fidelity rows. Near a
+    cliff's edge the two differ."""
     force_limit: tuple[float, float, float] = (6.0e4, 1.2e5, 2.0e5)
     """Servo force limits at the foot: [N], [N], [N·m]."""
     friction: float = 0.8

@@ -15,7 +15,7 @@ tolerance / iterations, and the collision midphase on and off - and prints, per 
 
   heavy-duty 5 t robot (HexapodCliffWalk-v0, HexapodStewartTilt-v0), seed 0: on flat ground
   the reference tripod gait's FASM standing (median) and its min / max while walking (the
-  protocol of `agents.reproduction.cliff_flat_walk_rows`; within 2 deg); on the paper cliff the
+  protocol of the reproduction's `cliff_flat_walk_rows`; within 2 deg); on the paper cliff the
   reference gait (zero residual) tips over or not, i.e. its body tilt exceeds the env's 20 deg
   (same outcome, tip-over time within 1 s), and its peak body tilt (within 2 deg; measured in
   the same episode, run with the tip-over limit at 60 deg so that it continues past 20 deg);
@@ -53,7 +53,8 @@ rows. A finer step is the better-resolved physics, so a row that it moves beyond
 one the default itself does not resolve: its value is partly a discretization effect (see
 benchmarks/README.md for the rows that are).
 
-Run: python benchmarks/physics_settings.py [--quick] [--finer] [--robot heavy-duty|athena|3-upu]
+Run: python experiments/physics_settings/physics_settings.py [--quick] [--finer]
+     [--robot heavy-duty|athena|3-upu]
 (about 17 minutes on one core, 15 of them ATHENA's; ``--quick``: 4 settings, shorter runs,
 about 1 minute; ``--finer --seconds 2 --repeats 1``: heavy-duty and 3-UPU about 1 minute,
 ATHENA about 5). Under ``--finer`` no recommendation is printed.
@@ -73,7 +74,7 @@ import gymnasium as gym
 import mujoco
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run as a script from anywhere
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # run as a script from anywhere
 
 import hexapod_envs  # noqa: E402, F401  (registers the env ids)
 from hexapod_envs.envs.base import INTEGRATOR_IDS as INTEGRATORS  # noqa: E402
@@ -99,7 +100,7 @@ class PhysicsSetting:
     armature: tuple[float, float, float] | None = None
     """The heavy-duty robot's servo armature, its envs' ``joint_armature`` setting (None: the
     env's default); a model parameter rather than a physics option, swept because a coarser
-    step needs a heavier one (scripts/heavy_duty_armature_probe.py)."""
+    step needs a heavier one (experiments/physics_settings/heavy_duty_armature_probe.py)."""
 
     def __post_init__(self):
         if self.integrator not in INTEGRATORS:
@@ -552,7 +553,7 @@ def athena_fidelity(setting: PhysicsSetting, quick: bool) -> list[Fidelity]:
 
 def posture_study_fidelity(setting: PhysicsSetting, quick: bool) -> list[Fidelity]:
     """The reproduction's ATHENA rows that depend on the servo dynamics (Coelho et al. §5.2, the
-    protocol of `agents.reproduction`): the simple controller's ramp sag (seeds 0-3 x 1200
+    protocol of `experiments.reproduction.rows`): the simple controller's ramp sag (seeds 0-3 x 1200
     steps, as row 11d) and, on 20 block beds (rows @seeds 0-19), the posture controller's change
     of the pitch- and roll-rate medians against the simple controller, with 95 % bootstrap
     intervals over the beds, and its beds with torso contact (quick: ramp seed 0, and 4 beds of
@@ -563,7 +564,7 @@ def posture_study_fidelity(setting: PhysicsSetting, quick: bool) -> list[Fidelit
     block rows are judged against the default's interval: on 4 beds the changes swing with
     settings that should not matter (solver tolerance 1e-6: +45 % -> -32 % pitch), on 20 they
     do not settle their sign."""
-    from agents.athena_study import change_interval, compare
+    from experiments.athena_posture.study import change_interval, compare
 
     env_id = "HexapodIrregularTerrain-v0"
     # The sag needs whole episodes (the robot reaches the slope's sagging part late).

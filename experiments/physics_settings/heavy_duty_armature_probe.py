@@ -1,28 +1,23 @@
 """The heavy-duty robot's physics step and servo armature: which pair keeps every fidelity row?
 
-Until 2026-11-27 the heavy-duty envs stepped MuJoCo at 1 ms with a servo armature of (20, 20,
-50) (x [kg], leg length [kg], swing [kg·m²]; `HeavyDutyParams.joint_armature`): about 65
-simulated seconds per wall second on the cliff walk, where the performance target is 100.
-`benchmarks/physics_settings.py` had shown that every coarser step with that armature loses
-fidelity rows: on the paper cliff the reference gait no longer tips over, and at 2 ms the
-recovery controller tips on two of the six Stewart cases. The legs' fastest motions are the
-servo damping acting on the light legs (for the leg-length slide 1.5e5 N·s/m on about 50 kg, a
-time constant of 0.3 ms), which a coarser step integrates coarsely; a heavier armature slows
-them. This probe runs the heavy-duty fidelity rows of `physics_settings.heavy_duty_fidelity`
-(flat-ground FASM standing and walking, the paper cliff's reference tip-over and peak tilt, the
-analytical controller on the six Stewart cases) for pairs of physics step and armature, judges
-each row against the former model (the first case) by the sweep's own tolerances, and times the
-cliff walk with random actions (`physics_settings.sim_rate`).
+The heavy-duty envs used to step MuJoCo at 1 ms with a servo armature of (20, 20, 50) (x [kg],
+leg length [kg], swing [kg·m²]; `HeavyDutyParams.joint_armature`): about 65 simulated seconds
+per wall second on the cliff walk, where the performance target is 100. `physics_settings.py`
+had shown that every coarser step with that armature loses fidelity rows: on the paper cliff the
+reference gait no longer tips over, and at 2 ms the recovery controller tips on two of the six
+Stewart cases. The legs' fastest motions are the servo damping acting on the light legs (for the
+leg-length slide 1.5e5 N·s/m on about 50 kg, a time constant of 0.3 ms), which a coarser step
+integrates coarsely; a heavier armature slows them. This probe runs the heavy-duty fidelity rows
+of `physics_settings.heavy_duty_fidelity` (flat-ground FASM standing and walking, the paper
+cliff's reference tip-over and peak tilt, the analytical controller on the six Stewart cases)
+for pairs of physics step and armature, judges each row against the former model (the first
+case) by the sweep's own tolerances, and times the cliff walk with random actions
+(`physics_settings.sim_rate`).
 
-Measured 2026-11-27 (idle, 2 workers; benchmarks/README.md, "The servo armature and the 2 ms
-step"): on the first 10 rows, at 2 ms the armature x5 and x6 hold every row at about 1.8x the
-former speed; x1 and x2 lose the cliff's tip-over (and x1 two Stewart cases), x3 and x4 hold
-the tip-over but not the peak tilt after it, x8 overshoots that peak. x5 became the envs'
-default. The 11th row, the reference gait's tip-overs on the 20 test cliffs, added afterwards:
-the former model tips on none, x5 on 2, x6 on 3; no pair at 2 ms holds all 11 (x3 fails only
-the peak tilt after the limit).
+Findings (dated): README.md beside this script.
 
-Run: python scripts/heavy_duty_armature_probe.py [--workers 2] [MS,SLIDE,HINGE ...]
+Run: python experiments/physics_settings/heavy_duty_armature_probe.py [--workers 2]
+     [MS,SLIDE,HINGE ...]
 """
 
 from __future__ import annotations
@@ -33,12 +28,12 @@ import sys
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from benchmarks import physics_settings as ps  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from experiments.physics_settings import physics_settings as ps  # noqa: E402
 from hexapod_envs.envs.heavy_duty import HeavyDutySettings  # noqa: E402
 
 FORMER_ARMATURE = (20.0, 20.0, 50.0)
-"""The servo armature (x, leg length, swing) of the model before 2026-11-27."""
+"""The servo armature (x, leg length, swing) of the former 1 ms model."""
 
 CASES = (
     (1.0, 1.0, 1.0),

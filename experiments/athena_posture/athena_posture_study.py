@@ -8,7 +8,8 @@ the per-gait-cycle RMS torso height, pitch-rate and roll-rate RMS and the ZMP st
 `reports/figures/athena_ramp_posture.png`, `athena_blocks_posture.png` and the numbers to
 `athena_posture_study.json`, and prints the medians next to the paper's changes.
 
-Run: python scripts/athena_posture_study.py [--seeds 3] [--steps 1200] [--out reports/figures]
+Run: python experiments/athena_posture/athena_posture_study.py [--seeds 3] [--steps 1200]
+     [--out reports/figures]
      [--block-size B]
 """
 
@@ -24,8 +25,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from agents.athena_study import PAPER_CHANGES, compare, percent_change, pooled  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from experiments.athena_posture.study import PAPER_CHANGES, compare, percent_change, pooled  # noqa: E402
 
 PANELS = (
     ("height", "torso height RMS per cycle [m]"),

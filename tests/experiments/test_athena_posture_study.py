@@ -2,7 +2,7 @@
 one default episode (60 s, 30 gait cycles) per seed; the directions of the paper's results.
 
 Measured with the default env (servo_kp 6.8 N·m/rad, calibrated to the paper's simple-control
-sag; 0.25 m blocks; 2.5 ms physics step; see agents/reproduction.py), 4 seeds: ramp: median
+sag; 0.25 m blocks; 2.5 ms physics step; see experiments/reproduction), 4 seeds: ramp: median
 height +49.3 %, pitch-rate RMS -50.8 %, roll-rate RMS +5.5 % (paper +60.77, -11.92, -35.98 %; the
 roll rate is the xfail). Blocks: the non-adaptive simple controller's torso is on the blocks in
 3093 of 4800 steps; posture control touches in 5 steps (1 of 4 episodes; paper: collision-free,
@@ -18,7 +18,8 @@ import json
 import numpy as np
 import pytest
 
-from agents.athena_study import EpisodeRecord, change_interval, compare, pooled
+from experiments.athena_posture import athena_gain_sweep, athena_posture_study
+from experiments.athena_posture.study import EpisodeRecord, change_interval, compare, pooled
 
 pytestmark = pytest.mark.slow
 
@@ -136,25 +137,14 @@ def test_blocks_runs_walk_and_stay_upright(blocks):
         assert all(r.distance > 0.5 and not r.tipped_over for r in blocks[name])
 
 
-def _script(name):
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).resolve().parents[1] / "scripts" / f"{name}.py"
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def test_study_and_sweep_scripts_write_their_outputs(tmp_path):
-    _script("athena_posture_study").main(["--seeds", "1", "--steps", "100", "--out", str(tmp_path)])
+    athena_posture_study.main(["--seeds", "1", "--steps", "100", "--out", str(tmp_path)])
     for name in ("athena_ramp_posture.png", "athena_blocks_posture.png"):
         assert (tmp_path / name).stat().st_size > 10_000
     numbers = json.loads((tmp_path / "athena_posture_study.json").read_text())
     for terrain in ("ramp", "blocks"):  # one change per metric, not the last loop value
         assert set(numbers[terrain]["change_pct"]) >= {"height", "pitch_rate", "roll_rate"}
     out = tmp_path / "sweep.md"
-    _script("athena_gain_sweep").main(["--cycles", "1", "--out", str(out)])
+    athena_gain_sweep.main(["--cycles", "1", "--out", str(out)])
     text = out.read_text()
     assert text.count("| k_z = ") == 10 and "paper's tuned (0.6, 0.4, 0.4)" in text

@@ -5,9 +5,9 @@ from pathlib import Path
 
 import pytest
 
-from agents.reproduction import _isclose, collect, markdown
+from experiments.reproduction.rows import _isclose, collect, markdown
 
-COMMITTED = Path(__file__).resolve().parents[1] / "reports" / "reproduction.json"
+COMMITTED = Path(__file__).resolve().parents[2] / "reports" / "reproduction.json"
 
 
 def test_cheap_rows_match_committed_report():
@@ -22,7 +22,7 @@ def test_cheap_rows_match_committed_report():
 
 def test_flat_walk_margin_rows_match_committed_report():
     committed = {r["id"]: r for r in json.loads(COMMITTED.read_text())}
-    from agents.reproduction import cliff_flat_walk_rows
+    from experiments.reproduction.rows import cliff_flat_walk_rows
 
     for row in cliff_flat_walk_rows():
         old = committed[row["id"]]
@@ -49,7 +49,7 @@ def test_bad_paper_id_is_rejected_with_choices():
 def test_stewart_eq15_side_rows_match_committed_report():
     """The calibration setting that exercises eq. 15 (one side case, about 2 s): t_s lies inside
     0.5-2.5 s and off the clamps, the margin holds after landing, as in the committed report."""
-    from agents.reproduction import STEWART_EQ15, stewart_rows
+    from experiments.reproduction.rows import STEWART_EQ15, stewart_rows
 
     committed = {r["id"]: r for r in json.loads(COMMITTED.read_text())}
     rows = stewart_rows(cases=[("side", "LF-LR-RM")], env_kwargs=STEWART_EQ15["side"])

@@ -1,6 +1,6 @@
 """A learned gains policy taught by the one-cycle look-ahead (teacher-student distillation).
 
-The look-ahead of `agents.gains_lookahead` beats the paper's fixed blocks gains by a wide margin
+The look-ahead (`lookahead`, this study) beats the paper's fixed blocks gains by a wide margin
 (pitch- and roll-rate medians -20 % and -13 %, 50 % fewer torso-contact steps on the held-out
 beds at the 2.5 ms default step; -25 %, -19 % and 87 % at 2 ms), but it needs a copy of the
 simulator. PPO on the privileged terrain scan
@@ -20,8 +20,8 @@ it observes):
    ``evaluate.py``'s ``ppo:<dir>`` runs it like a trained gains agent.
 
 Every simulated control step counts, the teacher's plays included (`Demonstrations.env_steps`),
-so the budget compares with a PPO run's env steps. What it achieved on the blocks is in
-``scripts/distill_gains.py``'s docstring.
+so the budget compares with a PPO run's env steps. What it achieved on the blocks: README.md
+beside this module.
 """
 
 from __future__ import annotations
@@ -33,8 +33,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..athena_policy import analytical_policy
-from ..gains_lookahead import (
+from agents.athena_policy import analytical_policy
+from agents.pipeline.envs import EnvSpec
+
+from .lookahead import (
     DEFAULT_COST,
     SCORED,
     CycleCost,
@@ -43,7 +45,6 @@ from ..gains_lookahead import (
     gain_grid,
     run_episode,
 )
-from .envs import EnvSpec
 
 
 @dataclass
@@ -442,8 +443,8 @@ def distill(config, demos: Demonstrations, validation: np.ndarray, **fit_kwargs)
     model of the training config `config` (`agents.pipeline.train_config.TrainConfig`, gains
     mode, plain hybrid residual) whose observation statistics are those of the training rows and
     whose actor is fitted by `fit_actor` (``fit_kwargs``)."""
-    from .model_files import NormalizationStats
-    from .training import untrained_model
+    from agents.pipeline.model_files import NormalizationStats
+    from agents.pipeline.training import untrained_model
 
     hybrid = config.hybrid
     if hybrid is None or hybrid.mode != "residual" or hybrid.safety_filter:

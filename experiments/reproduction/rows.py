@@ -3,8 +3,9 @@
 Every row is a dict with `id`, `paper`, `quantity`, `paper_value`, `value`, `unit`,
 `tolerance` (human phrase), `holds` (bool) and `setting` (how it was measured). Every value is
 simulated when the report is made, by the measurement code of the study scripts and tests
-(agents.athena_study, scripts/plot_stewart_recovery.py, scripts/plot_cliff_recovery.py);
-`quick` keeps the closed-form rows (Table II, 3-UPU limb length and IK).
+(experiments.athena_posture.study, scripts/plot_stewart_recovery.py,
+scripts/plot_cliff_recovery.py); `quick` keeps the closed-form rows (Table II, 3-UPU limb length
+and IK). The calibration findings behind the rows' settings are in README.md beside this file.
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _tag(env_kwargs: dict | None) -> str:
@@ -179,12 +180,13 @@ def athena_rows(
     blocks_kwargs: dict | None = None,
 ) -> list[dict]:
     """Rows 8-11 (Coelho et al. 2024 §5.2): posture vs simple control on the ramp and the block bed,
-    measured with agents.athena_study.compare (the posture study's protocol, default env).
+    measured with experiments.athena_posture.study.compare (the posture study's protocol, default
+    env).
 
     `env_kwargs` apply to both terrains, `blocks_kwargs` to the block bed only; each row's id gets
     the suffix "@" + the kwargs of its terrain.
     """
-    from agents.athena_study import compare
+    from experiments.athena_posture.study import compare
 
     d = {"seeds": list(seeds), "steps": steps}
     kwargs = {
@@ -373,9 +375,9 @@ def ditch_rows(env_kwargs: dict | None = None) -> list[dict]:
 
 # A quarter of the 3-UPU's and ATHENA's default physics steps (2 ms, 2.5 ms): rows with these
 # suffixes show which results are the default step's discretization (`python
-# benchmarks/physics_settings.py --finer`). The heavy-duty robot's rows were checked at a quarter
-# of its 2 ms default step (0.5 ms, `benchmarks/physics_settings.py --finer`) with no outcome
-# change, so it has no such rows.
+# experiments/physics_settings/physics_settings.py --finer`). The heavy-duty robot's rows were
+# checked at a quarter of its 2 ms default step (0.5 ms, `physics_settings.py --finer`) with no
+# outcome change, so it has no such rows.
 UPU_FINER_STEP = {"physics_dt": 0.0005}
 ATHENA_FINER_STEP = {"physics_dt": 0.000625}
 
@@ -534,37 +536,8 @@ end; 30 deg at 10 deg/s: 21.9 deg (climb/descend) and the side case falls to 0."
 
 ATHENA_PREVIOUS_DEFAULT = {"servo_kp": 8.0}
 ATHENA_PREVIOUS_BLOCKS = {"block_size": (0.1, 0.1)}
-"""The ATHENA env defaults before the calibration of 2026-11-24 (rows with these suffixes).
-
-The calibration below was measured at the 2 ms physics step, the default until 2026-11-25 (now
-2.5 ms; the rows of the report are measured at the current default).
-
-Servo stiffness. The env default, 6.8 N m/rad, is the stiffness at which the simple controller's
-median ramp torso height is the paper's 0.068 m (measured 0.0681 m over seeds 0-3; kp 8: 0.089 m,
-kp 6: 0.049 m). With it the ramp height gain is +48 % (kp 8: +14 %) but the ramp roll-rate RMS
-rises (+1.9 %; kp 8: -16.9 %; paper -36 %): the sagging simple control drags its torso on the slope
-(361 of 1200 steps, seed 0), which damps its roll.
-
-Block bed. The env default block edge, 0.25 m (the paper gives the heights, 0.04-0.13 m, not the
-size), measured with kp 6.8, posture vs simple control, episodes in which posture control touches
-the blocks (simple control touches in all but one):
-
-| block size | seeds 0-3 | seeds 0-7 | pitch / roll-rate change, seeds 0-7 |
-|---|---|---|---|
-| 0.10 m (previous default) | 4 of 4 | - | - |
-| 0.20 m | - | 6 of 8 | +277 % / +59 % |
-| 0.25 m | 1 of 4 | 3 of 8 | +68 % / +55 % (paper +54 % / +82 %) |
-| 0.30 m | 1 of 4 | 3 of 8 | +35 % / +24 % |
-| 0.35 m | - | 3 of 8 | -16 % / -51 % |
-
-Larger blocks leave fewer edges for the torso to meet, but posture control keeps touching in
-about 3 of 8 episodes; 0.25 m is the smallest size at that level and the one whose rate changes
-are nearest the paper's. With kp 8, 0.25 m blocks give 4 of 8 and rate changes of -42 % / -50 %.
-The rate changes of this table are from 8 beds: on 20 beds of the 0.25 m default they are
-+13.8 % / -10.8 % at 2 ms and -8.0 % / -21.7 % at 2.5 ms, with 95 % intervals spanning 0
-(`athena_block_beds_rows`), so the table ranks the sizes by their contacts, not by their rate
-changes.
-"""
+"""The ATHENA env defaults before its calibration (rows with these suffixes): servo_kp 8 and
+0.1 m blocks. How the defaults (kp 6.8, 0.25 m blocks) were chosen, measured: README.md."""
 
 
 BLOCK_BEDS = range(20)
@@ -573,10 +546,10 @@ BLOCK_BEDS = range(20)
 
 def athena_block_beds_rows(seeds=BLOCK_BEDS, steps: int = 1200) -> list[dict]:
     """Rows 11-11c again on 20 block beds, each change with its 95 % percentile-bootstrap
-    interval over the beds (`agents.athena_study.change_interval`): on 4 beds the pooled rate
-    medians swing too much to settle the sign of a change (a tighter solver tolerance alone
-    moves seeds 0-3's pitch change from +45 % to +39 %, a looser one to -32 %)."""
-    from agents.athena_study import change_interval, compare
+    interval over the beds (`experiments.athena_posture.study.change_interval`): on 4 beds the
+    pooled rate medians swing too much to settle the sign of a change (a tighter solver tolerance
+    alone moves seeds 0-3's pitch change from +45 % to +39 %, a looser one to -32 %)."""
+    from experiments.athena_posture.study import change_interval, compare
 
     result = compare("blocks", seeds, steps=steps)
     n = len(result["simple"])
@@ -757,17 +730,8 @@ STEWART_EQ15 = {
 at which the platform stops [deg]. The paper gives neither (its judgment times, 4.9-8.8 s after
 the tilt starts, fit a few deg/s). Eq. 15 forecasts the time for the margin to fall from xi_f to
 0 at its current rate, which in our model is 0.85-1.0 times the tilt rate, so the paper's t_s of
-0.74-2.31 s (with kappa 0.7) need 6-20 deg/s. Measured with the default controller (seed 0)
-under the Newton solver (Gauss-Seidel since: 2.24 s, 37.1-37.2 deg, side 2.32 s, 21.1 deg; at the
-2 ms step with the heavier armature, since 2026-11-27: 2.41 s, 37.0 deg, side 2.32 s, 21.1 deg):
-
-- climb / descend: 6 deg/s t_s 2.73 s, 6.5: 2.59 s, 7: 2.24 s (margin 37.3 deg 0.5 s after
-  landing with a stop at 15 deg, 35.5 at 17, 34.0 at 18); at 8 and 10 deg/s the fitted margin
-  acceleration is positive, the quadratic forecast never reaches 0 and t_s is the 3 s clamp;
-- side (judged at 27 deg of tilt, so the stop must lie beyond): 6 deg/s t_s 2.32 s, margin 21.1
-  deg after landing and to the end (stop 30), 6.5 deg/s 2.14 s but 12.4 deg, 7 deg/s 1.98 s and
-  the margin falls to 7 deg; a faster swing lands the foot less well.
-"""
+0.74-2.31 s (with kappa 0.7) need 6-20 deg/s. The measurements behind these rates and stops:
+README.md."""
 
 
 def stewart_eq15_rows() -> list[dict]:

@@ -1,4 +1,4 @@
-"""The per-cycle gains measurements (agents/gains_lookahead.py, scripts/gains_ceiling.py)."""
+"""The per-cycle gains measurements (experiments/gains_lookahead: lookahead, gains_ceiling)."""
 
 from __future__ import annotations
 
@@ -7,11 +7,11 @@ import copy
 import gymnasium as gym
 import numpy as np
 import pytest
-from test_athena_posture_study import _script
 
 import hexapod_envs  # noqa: F401
 from agents.athena_policy import PAPER_GAINS
-from agents.gains_lookahead import (
+from experiments.gains_lookahead import gains_ceiling, gains_footing_probe
+from experiments.gains_lookahead.lookahead import (
     CycleCost,
     CycleOutcome,
     Fixed,
@@ -159,7 +159,7 @@ def test_run_episode_collects_every_finished_cycle():
 
 
 def test_script_writes_the_table(tmp_path, monkeypatch):
-    script = _script("gains_ceiling")
+    script = gains_ceiling
     monkeypatch.setattr(script, "make_env", lambda terrain: _env(120))
     script.main(["--episodes", "1", "--levels", "0.5", "--out-dir", str(tmp_path)])
     text = (tmp_path / "gains_ceiling_blocks.md").read_text()
@@ -187,7 +187,7 @@ def test_script_writes_the_table(tmp_path, monkeypatch):
 
 
 def test_footing_probe_moves_only_the_blocks_away_from_the_feet():
-    probe = _script("gains_footing_probe")
+    probe = gains_footing_probe
     env = _env()
     env.reset(seed=0)
     base = env.unwrapped

@@ -1,16 +1,15 @@
 """Does a gait cycle on the blocks depend on blocks the feet do not already stand among?
 
 At the first cycle starts of test beds walked with the paper's gains, each cycle is played twice
-on copies of the env (`agents.gains_lookahead.play_cycle`): as it is, and with every block that
+on copies of the env (`lookahead.play_cycle`): as it is, and with every block that
 no foot stands on or comes within `FOOT_CLEARANCE` (plus the shift) of moved horizontally by a
 shift. Identical outcomes mean the cycle met only the blocks around the feet: what decides
 the cheapest gains of one cycle is then where the feet stand among those blocks, not the terrain
 further ahead (docs/results.md, "Why not on the blocks").
 
-Measured 2026-11-25 (default run: 5 beds x 4 cycle starts x 2 shifts of 3 cm x 2 gain
-settings, about 10 s): 57 of the 80 cycles unchanged.
+Findings (dated): README.md beside this script.
 
-Run: python scripts/gains_footing_probe.py [--beds 5] [--cycles 4]
+Run: python experiments/gains_lookahead/gains_footing_probe.py [--beds 5] [--cycles 4]
 """
 
 from __future__ import annotations
@@ -24,10 +23,10 @@ import gymnasium as gym
 import mujoco
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 import hexapod_envs  # noqa: E402, F401
 from agents.athena_policy import PAPER_GAINS  # noqa: E402
-from agents.gains_lookahead import gains_env, play_cycle  # noqa: E402
+from experiments.gains_lookahead.lookahead import gains_env, play_cycle  # noqa: E402
 
 FOOT_CLEARANCE = 0.03
 """[m] A block stays put when a foot lies within this distance (plus the shift) of its

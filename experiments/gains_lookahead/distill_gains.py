@@ -1,4 +1,4 @@
-"""Teach a gains policy with the one-cycle look-ahead (`agents.pipeline.gains_distill`).
+"""Teach a gains policy with the one-cycle look-ahead (`experiments.gains_lookahead.distill`).
 
 Collect once (the expensive step), then fit:
 
@@ -13,40 +13,14 @@ Collect once (the expensive step), then fit:
               trained on growing subsets of the others, optionally without some observation
               pieces (--drop)
 
-Measured on the blocks (2026-11-24, at the then default 2 ms physics step; CONFIG below; the
-look-ahead over the 3 x 3 x 3 lattice of 0.2/0.5/0.8 and the paper's gains on 56 training beds,
-seeds 0-55: about 1240 cycles and 1.95 M env steps including the teacher's plays, 18 min on 2
-cores; the last 11 beds held out):
-- Mean cycle cost on the held-out beds: the paper's gains 0.1670, the best fixed lattice setting
-  0.1646, the student 0.1641, the teacher 0.1423. `curve`: 0.1647, 0.1645 and 0.1646 from 11,
-  22 and 45 training beds. More demonstrations do not help: the student does not learn the
-  teacher's per-cycle advantage from the observation, the terrain scan included.
-- On the 20 test beds of configs/evaluate_gains_blocks.yaml (the paper's gains: pitch- and
-  roll-rate medians 0.11276 / 0.12618 rad/s, 2552 torso-contact steps, 6/20 successes): the
-  student 0.11981 / 0.12506, 1915 contact steps, 6/20.
-- With the clearance term (--clearance-cost 10 --clearance-margin 0.03, its own collection):
-  held-out cost 0.1671 (paper 0.1700, best constant 0.1659); on the test beds 0.12789 /
-  0.12920, 415 contact steps (-84 %), 8/20 (with --set "policy.pi=[64,64]": 0.11796 / 0.13609,
-  944, 8/20). The contact avoidance learned on the lower training blocks transfers to the
-  taller test blocks; a lower rate does not: the trade of the low-k_z fixed settings in
-  reports/gains_ceiling_blocks.md.
-
-`choose` on the blocks (2026-11-25, 2.5 ms physics; CONFIG with --set env.kwargs.foot_scan=true;
-reports/gains_footing/demos.npz: 112 training beds, 2480 cycles, 3.9 M env steps, 30 min on 2
-cores; test: the last 22 beds, the paper's gains 0.16889, the teacher's choices 0.14362): with
-22 / 45 / 90 beds the student's choices cost 0.17118 / 0.17019 / 0.16826 against its fixed
-setting's 0.16716 / 0.16857 / 0.16748 (--drop foot_scan: 0.16804 / 0.16818 / 0.16805; --drop
-foot_scan terrain_scan: 0.16951 / 0.16867 / 0.16855), mean of 3 seeds. Whatever it sees, it
-does no better than its fixed setting: the footing does not make the teacher's choice
-predictable for it. With --with-deviation (the posture controller's ground-plane estimate for
-the cycle's first phase, `ground_deviation_features`; 2026-11-26) and --drop foot_scan
-terrain_scan: 0.16775 / 0.16824 / 0.16824 against 0.16716 / 0.16857 / 0.16748; with both scans
-0.16963 / 0.16986 / 0.16850: still no better than the fixed setting.
+Findings (measured on the blocks, dated): README.md beside this script.
 
 Run (CONFIG: configs/irregular_terrain_gains_blocks_scan.yaml):
-    python scripts/distill_gains.py collect --config CONFIG --episodes 56 --workers 2 \
+    python experiments/gains_lookahead/distill_gains.py collect \
+        --config CONFIG --episodes 56 --workers 2 \
         --out runs/distill/demos.npz
-    python scripts/distill_gains.py fit --config CONFIG --demos runs/distill/demos.npz \
+    python experiments/gains_lookahead/distill_gains.py fit \
+        --config CONFIG --demos runs/distill/demos.npz \
         --out runs/distill/model
 """
 
@@ -59,12 +33,13 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 import numpy as np  # noqa: E402
 
-from agents.gains_lookahead import CycleCost  # noqa: E402
 from agents.pipeline.artifacts import command_line, save_model_dir  # noqa: E402
-from agents.pipeline.gains_distill import (  # noqa: E402
+from agents.pipeline.train_config import load_train_config  # noqa: E402
+from agents.pipeline.training import env_spec  # noqa: E402
+from experiments.gains_lookahead.distill import (  # noqa: E402
     Demonstrations,
     demonstrate,
     distill,
@@ -72,8 +47,7 @@ from agents.pipeline.gains_distill import (  # noqa: E402
     ground_deviation_features,
     held_out_rows,
 )
-from agents.pipeline.train_config import load_train_config  # noqa: E402
-from agents.pipeline.training import env_spec  # noqa: E402
+from experiments.gains_lookahead.lookahead import CycleCost  # noqa: E402
 
 
 def collect(args: argparse.Namespace) -> None:
@@ -247,7 +221,7 @@ def main(argv: list[str] | None = None) -> None:
     for p in (c, f, r, h):
         p.add_argument("--config", type=Path, required=True, help="training config (gains mode)")
         p.add_argument("--set", action="append", default=[], metavar="KEY=VALUE")
-        # the cycle cost (agents.gains_lookahead.CycleCost) the teacher or the student minimises
+        # the cycle cost (lookahead.CycleCost) the teacher or the student minimises
         p.add_argument("--contact-cost", type=float, default=1.0, help="rad/s per contact step")
         p.add_argument("--clearance-cost", type=float, default=0.0, help="rad/s per m short")
         p.add_argument("--clearance-margin", type=float, default=0.0, help="footprint clearance, m")

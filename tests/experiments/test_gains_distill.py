@@ -1,4 +1,4 @@
-"""Teaching a gains policy with the look-ahead (agents.pipeline.gains_distill, its script)."""
+"""Teaching a gains policy with the look-ahead (experiments.gains_lookahead.distill, its script)."""
 
 from __future__ import annotations
 
@@ -8,13 +8,12 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
-from test_athena_posture_study import _script
 
 import hexapod_envs  # noqa: F401
-from agents.gains_lookahead import CycleCost, gain_grid
 from agents.pipeline.env_settings import read_settings
 from agents.pipeline.envs import EnvSpec
-from agents.pipeline.gains_distill import (
+from experiments.gains_lookahead import distill_gains
+from experiments.gains_lookahead.distill import (
     Demonstrations,
     demonstrate,
     fit_actor,
@@ -22,6 +21,7 @@ from agents.pipeline.gains_distill import (
     interpolated_cost,
     lattice_costs,
 )
+from experiments.gains_lookahead.lookahead import CycleCost, gain_grid
 
 CONFIG = "configs/irregular_terrain_gains_blocks_scan.yaml"
 
@@ -134,7 +134,7 @@ def test_demonstrations_record_every_candidate_and_the_teachers_budget(tmp_path)
 def test_script_collects_fits_and_the_model_runs_in_the_evaluation(tmp_path, capsys):
     from agents.ppo import PPOPolicy
 
-    script = _script("distill_gains")
+    script = distill_gains
     demos = tmp_path / "demos.npz"
     script.main(
         [
@@ -244,7 +244,7 @@ def test_ground_deviation_features_match_the_controllers_estimate_at_each_cycle_
     a cycle's first phase agree with its estimate (its commands' horizontal feet aside). On
     the blocks the ground search waits for the landing feet, so the phases begin with four to
     six feet down, where the stance tripod decides which plane counts."""
-    from agents.pipeline.gains_distill import ground_deviation_features
+    from experiments.gains_lookahead.distill import ground_deviation_features
 
     env = gym.make("HexapodIrregularTerrain-v0", terrain="blocks", action_mode="gains")
     base = env.unwrapped

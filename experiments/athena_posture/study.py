@@ -18,8 +18,7 @@ import gymnasium as gym
 import numpy as np
 
 import hexapod_envs  # noqa: F401  (registers the env ids)
-
-from .athena_policy import PAPER_GAINS, AthenaPosturePolicy
+from agents.athena_policy import PAPER_GAINS, AthenaPosturePolicy
 
 ENV_ID = "HexapodIrregularTerrain-v0"
 SIMPLE = (0.0, 0.0, 0.0)

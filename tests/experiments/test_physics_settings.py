@@ -1,12 +1,8 @@
-"""benchmarks/physics_settings.py: the sweep's rows on one tiny setting (no timing assertions)."""
+"""experiments/physics_settings: the sweep's rows on one tiny setting (no timing assertions)."""
 
 import math
-import sys
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the benchmarks package
-
-from benchmarks.physics_settings import PhysicsSetting, sweep  # noqa: E402
+from experiments.physics_settings.physics_settings import PhysicsSetting, sweep
 
 SPEED_KEYS = {
     "kind",
@@ -48,7 +44,7 @@ def test_athena_fidelity_includes_the_servo_dependent_reproduction_rows():
     # The ramp walk alone let a 10 ms timestep through that sags the simple controller 8.6 mm
     # more; the posture-study rows (quick: ramp seed 0, 4 block beds of 400 steps) are there
     # for that. The block rows carry a bootstrap interval and are judged by it.
-    from benchmarks.physics_settings import DEFAULT, athena_fidelity
+    from experiments.physics_settings.physics_settings import DEFAULT, athena_fidelity
 
     rows = athena_fidelity(DEFAULT, quick=True)
     (sag,) = [f for f in rows if f.name.startswith("ramp, simple control")]
@@ -67,7 +63,12 @@ def test_athena_fidelity_includes_the_servo_dependent_reproduction_rows():
 def test_finer_timesteps_for_the_convergence_check():
     # --finer compares the default with 1/2 and 1/4 of its timestep; each must be an allowed
     # one (a whole number of substeps per control period, ATHENA's a multiple of 5).
-    from benchmarks.physics_settings import DEFAULT, FINER, candidate_settings, physics_dt_for
+    from experiments.physics_settings.physics_settings import (
+        DEFAULT,
+        FINER,
+        candidate_settings,
+        physics_dt_for,
+    )
 
     assert candidate_settings(quick=False, finer=True)[0] == DEFAULT
     for s in FINER:
@@ -85,7 +86,7 @@ def test_heavy_duty_rows_count_the_reference_tip_overs_on_the_test_cliffs():
     import gymnasium as gym
     import numpy as np
 
-    from benchmarks.physics_settings import DEFAULT, heavy_duty_fidelity
+    from experiments.physics_settings.physics_settings import DEFAULT, heavy_duty_fidelity
 
     rows = heavy_duty_fidelity(DEFAULT, quick=True)
     assert len({r.name for r in rows}) == len(rows)

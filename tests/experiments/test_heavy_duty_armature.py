@@ -1,9 +1,7 @@
 """The heavy-duty robot's servo armature: `HeavyDutyParams.joint_armature` reaches each joint of
 the model, the envs' ``joint_armature`` setting reaches the robot, and the physics sweep's
-``armature`` reaches the envs it makes (scripts/heavy_duty_armature_probe.py builds on it)."""
-
-import sys
-from pathlib import Path
+``armature`` reaches the envs it makes (experiments/physics_settings/heavy_duty_armature_probe.py
+builds on it)."""
 
 import gymnasium as gym
 import mujoco
@@ -11,12 +9,9 @@ import numpy as np
 import pytest
 
 import hexapod_envs  # noqa: F401
+from experiments.physics_settings.physics_settings import PhysicsSetting, make_env
 from hexapod_envs.robots.heavy_duty import HeavyDutyParams
 from hexapod_envs.robots.heavy_duty.model import add_heavy_duty
-
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the benchmarks package
-
-from benchmarks.physics_settings import PhysicsSetting, make_env  # noqa: E402
 
 
 def _armature_by_joint(model: mujoco.MjModel, handles) -> list[np.ndarray]:

@@ -1,0 +1,1 @@
+"""ATHENA posture control vs simple control, and the gain sweep (README.md)."""

@@ -1,0 +1,1 @@
+"""Physics settings per robot: speed against the fidelity rows (README.md)."""

@@ -1,0 +1,1 @@
+"""The reproduction of the three papers' headline numbers (README.md)."""
