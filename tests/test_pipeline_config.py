@@ -34,22 +34,24 @@ def test_shipped_training_configs_load_with_their_env_ids(name, env_id):
     assert config.vec_env.use_subprocess == (config.vec_env.n_envs > 1)
 
 
-def test_default_suite_names_all_four_envs_and_shipped_models():
+def test_default_suite_is_the_v1_benchmark_and_the_v0_suite_keeps_the_shipped_models():
     suite = load_suite(CONFIGS / "evaluate_default.yaml")
-    assert [e.id for e in suite.envs] == list(TRAIN_CONFIGS.values())
-    assert suite.policies == [
-        "analytical",
-        "zero",
-        "random",
+    v1_ids = [env_id.replace("-v0", "-v1") for env_id in TRAIN_CONFIGS.values()]
+    assert [e.id for e in suite.envs] == v1_ids
+    assert suite.policies == ["analytical", "zero", "random"]
+    assert all(e.kwargs["task_distribution"] == "test" for e in suite.envs)
+    full = load_suite(CONFIGS / "evaluate_full.yaml")
+    assert full.policies == suite.policies and full.envs == suite.envs
+    assert full.episodes >= 50 and full.output_dir == "reports/shipped"
+    assert suite.output_dir == "reports/default" and suite.missing_models == "skip"
+    v0 = load_suite(CONFIGS / "evaluate_v0_shipped.yaml")
+    assert [e.id for e in v0.envs] == list(TRAIN_CONFIGS.values())
+    assert v0.policies[3:] == [
         "ppo:models/{env_id}/ppo",
         "ppo:models/{env_id}/hybrid",
         "ppo:models/{env_id}/gains",
     ]
-    assert all(e.kwargs["task_distribution"] == "test" for e in suite.envs)
-    full = load_suite(CONFIGS / "evaluate_full.yaml")
-    assert full.policies == suite.policies and full.envs == suite.envs
-    assert full.episodes >= 20 and full.output_dir == "reports/shipped"
-    assert suite.output_dir == "reports/default" and suite.missing_models == "skip"
+    assert v0.output_dir == "reports/shipped_v0"
 
 
 @pytest.mark.parametrize("path", sorted(CONFIGS.glob("evaluate_*.yaml")), ids=lambda p: p.name)

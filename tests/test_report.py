@@ -115,7 +115,8 @@ def test_video_is_written_linked_and_embedded(tmp_path):
 
 def test_envs_option_keeps_the_suite_kwargs(tmp_path):
     out = tmp_path / "rep"
-    argv = ["--envs", "HexapodIrregularTerrain-v0", "--policies", "zero", "--episodes", "1"]
+    argv = ["--config", "configs/evaluate_v0_shipped.yaml", "--envs", "HexapodIrregularTerrain-v0"]
+    argv += ["--policies", "zero", "--episodes", "1"]
     argv += ["--max-episode-steps", "5", "--output-dir", str(out), "--no-progress"]
     assert evaluate_main(argv) == 0
     metrics = json.loads((out / "metrics.json").read_text())
@@ -281,7 +282,7 @@ def test_benchmark_scores_run_from_random_to_the_analytical_controller(tmp_path)
     """With analytical and random on an env, the report scores every policy on that scale (the
     IQM across envs beside it) and plots success against the task difficulty."""
     out = tmp_path / "bench"
-    argv = ["--config", "configs/evaluate_benchmark_v1.yaml", "--envs", "HexapodStewartTilt-v1"]
+    argv = ["--config", "configs/evaluate_default.yaml", "--envs", "HexapodStewartTilt-v1"]
     argv += ["--episodes", "3", "--output-dir", str(out), "--no-progress"]
     assert evaluate_main(argv) == 0
     md = (out / "report.md").read_text()

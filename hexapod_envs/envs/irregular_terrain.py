@@ -276,6 +276,9 @@ class IrregularTerrainSettings(EnvSettings):
     """A foot is loaded above this fraction of the weight (default: 0.5 N)."""
     tipping_threshold_deg: float = number(10.0, high=90.0)
     tip_over_angle_deg: float = number(60.0, strict=True, high=90.0)
+    camera_name: str | None = option("track", kind=str)
+    """The camera that follows the robot (None: the free camera of the heavy-duty envs, from
+    which the 0.3 m robot is a few pixels)."""
     terrain: str = choice("ramp", TERRAINS)
     action_mode: str = choice("residual", ACTION_MODES)
     residual_scale: float = number(0.25)
