@@ -589,3 +589,26 @@ def test_a_settings_note_names_the_model_of_its_env_not_the_template(run, tmp_pa
     expected = f"HexapodCliffWalk-v0: ppo:{models}/HexapodCliffWalk-v0 was trained on an env"
     assert [n for n in metrics["notes"] if n.startswith(expected)]
     assert f"- **note:** {expected}" in (tmp_path / "rep" / "report.md").read_text()
+
+
+def test_same_task_evaluations_log_the_change_since_step_0():
+    """With the same tasks at every evaluation, the success rate and mean return are logged as
+    changes against the run's first evaluation (step 0)."""
+    from agents.pipeline.callbacks import StatsEvalCallback
+
+    class Logger:
+        def __init__(self):
+            self.values = {}
+
+        def record(self, key, value):
+            self.values[key] = value
+
+    callback = StatsEvalCallback.__new__(StatsEvalCallback)
+    callback.evaluations_timesteps = [0, 256, 512]
+    callback.evaluations_successes = [[1, 0, 0, 0], [1, 1, 0, 0], [1, 1, 1, 0]]
+    callback.evaluations_results = [[10.0, 0.0], [10.0, 2.0], [12.0, 4.0]]
+    logger = Logger()
+    callback.model = type("Model", (), {"logger": logger})()
+    callback._log_change_since_start()
+    assert logger.values["eval/success_change_since_start"] == pytest.approx(0.5)
+    assert logger.values["eval/return_change_since_start"] == pytest.approx(3.0)

@@ -11,6 +11,7 @@ TensorBoard tags written besides SB3's own (``rollout/``, ``train/``, ``eval/``,
 | ``hexapod/<metric>`` | numeric env-specific episode metrics (see `episode`) |
 | ``reward_terms/reward_<term>`` | per-episode sum of each reward term from ``info`` |
 | ``eval/fasm_min_deg`` ... | the same FASM/success statistics over EvalCallback's episodes |
+| ``eval/success_change_since_start``, ``eval/return_change_since_start`` | with ``eval.same_tasks``: the change of the success rate and mean return since the run's first evaluation (step 0), on the same tasks |
 """
 
 from __future__ import annotations
@@ -158,6 +159,8 @@ class StatsEvalCallback(EvalCallback):
             self.eval_env.seed(self.task_seed)
         done_before = len(self.evaluations_timesteps)
         continue_training = super()._on_step()
+        if self.task_seed is not None and len(self.evaluations_timesteps) > done_before:
+            self._log_change_since_start()
         if self.select_saver is not None and len(self.evaluations_timesteps) > done_before:
             score = self.score(len(self.evaluations_timesteps) - 1)
             if self.best_score is None or score > self.best_score:
@@ -171,6 +174,14 @@ class StatsEvalCallback(EvalCallback):
                     eval_success_rate=score[0],
                 )
         return continue_training
+
+    def _log_change_since_start(self) -> None:
+        """On the same tasks at every evaluation, the paired change of the success rate and the
+        mean return of the latest evaluation against the first (step 0 of the run):
+        ``eval/success_change_since_start``, ``eval/return_change_since_start``."""
+        first, latest = self.score(0), self.score(len(self.evaluations_timesteps) - 1)
+        self.logger.record("eval/success_change_since_start", latest[0] - first[0])
+        self.logger.record("eval/return_change_since_start", latest[1] - first[1])
 
     def score(self, i: int) -> tuple[float, float]:
         """(success rate, mean return) of evaluation `i`; success 0 when the env reports none."""
