@@ -55,7 +55,9 @@ from typing import Any, Literal
 import gymnasium as gym
 import numpy as np
 
+from .env_kwargs import POLICY_SETTINGS, constructor_defaults
 from .policy import Policy
+from .registry import analytical_policy
 
 MODES = ("residual", "safety")
 DEFAULT_THRESHOLD_DEG = 20.0
@@ -133,8 +135,6 @@ class HybridCore:
     """
 
     def __init__(self, env: gym.Env, settings: HybridSettings, base: Policy | None = None):
-        from .registry import analytical_policy
-
         self.settings = settings
         self.space = _action_box(env)
         structure = getattr(env.unwrapped, "observation_structure", None)
@@ -287,17 +287,15 @@ def from_run_config(learned: Policy, env: gym.Env, config: dict[str, Any]) -> Po
     config has a ``hybrid`` section, unchanged otherwise (`agents.ppo.PPOPolicy.load`'s hook).
 
     A hybrid's learned action only means something with the env settings that say how an action
-    is read or what the observation holds (`agents.pipeline.evaluation.POLICY_SETTINGS`: the
+    is read or what the observation holds (`agents.env_kwargs.POLICY_SETTINGS`: the
     action mode, the residual scale and filter, ...), so one that differs on `env` is an error
     (ValueError) naming both values.
     """
     settings = settings_from_config(config.get("hybrid"))
     if settings is None:
         return learned
-    from .pipeline.evaluation import POLICY_SETTINGS, _constructor_defaults
-
     trained_kwargs = (config.get("env") or {}).get("kwargs") or {}
-    defaults = _constructor_defaults(env)
+    defaults = constructor_defaults(env)
     env_settings = getattr(env.unwrapped, "settings", None)
     for key in POLICY_SETTINGS:
         if env_settings is not None and hasattr(env_settings, key):

@@ -16,9 +16,11 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from .hybrid import from_run_config
 from .pipeline.artifacts import ModelFiles, find_model, other_env_error, read_meta
 from .pipeline.errors import UserError
 from .pipeline.model_files import NormalizationStats, load_ppo, load_stats, ppo_custom_objects
+from .pipeline.train_config import load_train_config
 from .policy import Policy
 
 
@@ -50,8 +52,6 @@ class PPOPolicy:
         `agents.pipeline.model_files`; pickled files of older runs only with ``trust_pickle``).
         A hybrid run's model comes back combined with `env`'s analytical controller as in
         training (`agents.hybrid.HybridPolicy`)."""
-        from .pipeline.train_config import load_train_config
-
         files = find_model(path)
         config = files.training_config()
         env_id = env.spec.id if env.spec is not None else None
@@ -104,8 +104,6 @@ class PPOPolicy:
 def _as_trained(policy: PPOPolicy, env: gym.Env, config: dict[str, Any]) -> Any:
     """The policy as its run used it: a hybrid run's ``hybrid`` config section re-creates the
     combination with the env's analytical controller (`agents.hybrid.from_run_config`)."""
-    from .hybrid import from_run_config
-
     try:
         return from_run_config(policy, env, config)
     except ValueError as exc:

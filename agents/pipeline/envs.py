@@ -17,6 +17,7 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from ..hybrid import wrap
 from .errors import UserError
 
 
@@ -94,8 +95,6 @@ class EnvSpec:
             message = str(exc).split(" was raised from the environment creator")[0]
             raise UserError(f"cannot create {self.id} with {self.kwargs}: {message}") from None
         if self.hybrid is not None:
-            from ..hybrid import wrap
-
             try:
                 env = wrap(env, self.hybrid)
             except ValueError as exc:

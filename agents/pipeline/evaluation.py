@@ -6,8 +6,6 @@ kwargs, missing or mismatched models), so a typo fails in seconds with one clear
 
 from __future__ import annotations
 
-import dataclasses
-import inspect
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -16,7 +14,9 @@ from typing import Any
 import gymnasium as gym
 import numpy as np
 
+from ..env_kwargs import POLICY_SETTINGS, constructor_defaults, registered_defaults
 from ..policy import Policy, RandomPolicy, ZeroPolicy
+from ..ppo import PPOPolicy
 from .artifacts import checkpoint_note, other_env_error
 from .env_settings import describe, differences, read_settings, resolved_settings, reward_only
 from .envs import EnvSpec, check_env_id, env_time_step, import_gym_packages
@@ -121,20 +121,6 @@ def _env_spec(suite: EvaluationSuite, env: SuiteEnv, **extra: Any) -> EnvSpec:
     return EnvSpec(env.id, {**env.kwargs, **extra}, suite.env_time_limit(env), suite.gym_packages)
 
 
-POLICY_SETTINGS = (
-    "action_mode",
-    "residual_scale",
-    "residual_filter_tau",
-    "residual_limb_m",
-    "residual_leg_m",
-    "gait_ground_search",
-    "terrain_scan",
-    "foot_scan",
-)
-"""Env kwargs that say how an action is read or what the observation holds (not which task is
-posed): a policy is evaluated with the ones it was built for, on the suite's task."""
-
-
 def policy_env_kwargs(name: str, env_id: str, suite_kwargs: dict | None = None) -> dict[str, Any]:
     """The env kwargs `name` needs on top of the suite's (`suite_kwargs`): the analytical
     controller's action mode (`agents.registry.ANALYTICAL_ENV_KWARGS`); a PPO run's trained
@@ -158,40 +144,9 @@ def policy_env_kwargs(name: str, env_id: str, suite_kwargs: dict | None = None) 
     extra = {k: trained[k] for k in POLICY_SETTINGS if k in trained}
     reset = [k for k in POLICY_SETTINGS if k in (suite_kwargs or {}) and k not in trained]
     if reset:
-        defaults = _registered_defaults(env_id)
+        defaults = registered_defaults(env_id)
         extra.update({k: defaults[k] for k in reset if k in defaults})
     return extra
-
-
-def _registered_defaults(env_id: str) -> dict[str, Any]:
-    """Keyword defaults of the registered env class and the registration's kwargs."""
-    spec = gym.spec(env_id)
-    creator = gym.envs.registration.load_env_creator(spec.entry_point)
-    defaults = _class_defaults(creator) if isinstance(creator, type) else {}
-    return {**defaults, **spec.kwargs}
-
-
-def _class_defaults(cls: type) -> dict[str, Any]:
-    """Default settings of an env class: the fields of its settings dataclass (the hexapod
-    envs' ``Settings``), else the keyword defaults of its constructors along its MRO."""
-    settings = getattr(cls, "Settings", None)
-    if dataclasses.is_dataclass(settings):
-        return {
-            f.name: f.default
-            for f in dataclasses.fields(settings)
-            if f.default is not dataclasses.MISSING
-        }
-    defaults: dict[str, Any] = {}
-    for klass in reversed(cls.__mro__):
-        init = klass.__dict__.get("__init__")
-        if init is None:
-            continue
-        try:
-            params = inspect.signature(init).parameters.values()
-        except (TypeError, ValueError):
-            continue
-        defaults.update({p.name: p.default for p in params if p.default is not p.empty})
-    return defaults
 
 
 def _ppo_path(name: str, env_id: str) -> Path:
@@ -218,8 +173,6 @@ def build_policy(
         entry = ANALYTICAL_POLICIES[env_id]
         source = entry if isinstance(entry, str) else getattr(entry, "__qualname__", repr(entry))
         return factory(env), str(source)
-    from ..ppo import PPOPolicy
-
     path = _ppo_path(name, env_id)
     policy = PPOPolicy.load(
         path, env, deterministic=suite.deterministic, trust_pickle=suite.trust_pickle
@@ -255,14 +208,6 @@ def _missing_reason(name: str, env_id: str) -> str | None:
     return None
 
 
-def _constructor_defaults(env: gym.Env) -> dict[str, Any]:
-    """Keyword defaults of the env class's constructors along its MRO, plus registered kwargs."""
-    defaults = _class_defaults(type(env.unwrapped))
-    if env.spec is not None and env.spec.id in gym.registry:
-        defaults.update(gym.spec(env.spec.id).kwargs)
-    return defaults
-
-
 def _kwargs_note(
     env: gym.Env,
     suite_env: SuiteEnv,
@@ -274,7 +219,7 @@ def _kwargs_note(
     suite's with `policy_kwargs` (its action and observation settings) on top."""
     if trained is None:
         return None
-    defaults = _constructor_defaults(env)
+    defaults = constructor_defaults(env)
     evaluated = {**suite_env.kwargs, **policy_kwargs}
     differing = {}
     # a held-out task distribution is the point of the evaluation, not a mismatch
