@@ -223,7 +223,8 @@ def test_identical_seeds_give_identical_episodes_across_policies(tmp_path):
     """Before the cliff, analytical (joint mode, its own env) and zero (the reference gait in the
     default residual mode) walk the same gait: same seeds, same tasks, the same episodes up to
     the joint mode's rounding of the gait's targets."""
-    extra = ("--set", "envs=[{id: HexapodCliffWalk-v0, kwargs: {task_distribution: train}}]")
+    extra = ("--config", "configs/evaluate_v0_shipped.yaml")
+    extra += ("--set", "envs=[{id: HexapodCliffWalk-v0, kwargs: {task_distribution: train}}]")
     assert evaluate(tmp_path / "rep", "analytical", "zero", extra=extra) == 0
     metrics = json.loads((tmp_path / "rep" / "metrics.json").read_text())
     policies = metrics["envs"]["HexapodCliffWalk-v0"]["policies"]

@@ -11,7 +11,8 @@ TensorBoard tags written besides SB3's own (``rollout/``, ``train/``, ``eval/``,
 | ``hexapod/<metric>`` | numeric env-specific episode metrics (see `episode`) |
 | ``reward_terms/reward_<term>`` | per-episode sum of each reward term from ``info`` |
 | ``eval/fasm_min_deg`` ... | the same FASM/success statistics over EvalCallback's episodes |
-| ``eval/success_change_since_start``, ``eval/return_change_since_start`` | with ``eval.same_tasks``: the change of the success rate and mean return since the run's first evaluation (step 0), on the same tasks |
+| ``eval/success_change_since_start`` | with ``eval.same_tasks``: success rate now - at step 0 |
+| ``eval/return_change_since_start`` | with ``eval.same_tasks``: mean return now - at step 0 |
 """
 
 from __future__ import annotations

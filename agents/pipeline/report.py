@@ -422,8 +422,7 @@ def benchmark_section(result: SuiteResult) -> tuple[Table | None, str]:
     on what is left out. (None, reason) when no env ran both references."""
     successes = {
         r.env_id: {
-            r.label(name): [bool(e.success) for e in run.episodes]
-            for name, run in r.runs.items()
+            r.label(name): [bool(e.success) for e in run.episodes] for name, run in r.runs.items()
         }
         for r in result.envs
         if r.runs

@@ -204,8 +204,8 @@ def _ppo_kwargs(config: TrainConfig) -> dict[str, Any]:
 
 def untrained_model(config: TrainConfig) -> tuple[Any, dict[str, Any] | None]:
     """`new_model` on the config's training vec env (VecNormalize on top when configured), for
-    models fitted outside PPO's own loop (`gains_distill`), and the env's resolved settings (to
-    record with the model, see `env_settings`)."""
+    models fitted outside PPO's own loop (e.g. by distillation), and the env's resolved
+    settings (to record with the model, see `env_settings`)."""
     _, settings = _probe(env_spec(config))
     venv, eval_env = _vec_envs(config, config.train.seed)
     if eval_env is not None:

@@ -87,7 +87,6 @@ the episode at a static margin <= 0; ``-v0`` is the papers' reproduction.
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import mujoco
 import numpy as np
@@ -113,8 +112,8 @@ from ..stability import _compiled as _stability
 from ..terrain.ditch import add_ditch
 from ..terrain.flat import add_flat
 from . import _compiled
-from .difficulty import DifficultySpan
 from .base import HexapodEnv
+from .difficulty import DifficultySpan
 from .sensors import RobotSensors
 from .settings import (
     EnvSettings,
@@ -192,8 +191,8 @@ class DitchCrossingSettings(EnvSettings):
     physics_dt: float = number(0.002, strict=True)
     """MuJoCo timestep [s]. The reference gait crosses the paper's ditch at every step from
     2.5 down to 0.8 ms (4 ms tips early) and tips at 0.667 ms and finer
-    (benchmarks/physics_settings.py ``--finer``): its 14 mm margin while the lower platform
-    lifts is held by this step's numerical damping of the servos."""
+    (experiments/physics_settings): its 14 mm margin while the lower platform lifts is held by
+    this step's numerical damping of the servos."""
     contact_threshold: float = number(0.005, strict=True, high=1.0)
     """A foot's pressure switch reads loaded above this fraction of the weight."""
     tipping_threshold_deg: float = number(0.0, high=90.0)

@@ -96,8 +96,7 @@ class HeavyDutySettings(EnvSettings):
     """ξ_f [deg]: FASM below it means the robot is tipping (the paper's judgment threshold)."""
     solver: str = choice("pgs", SOLVERS)
     """MuJoCo's constraint solver. Projected Gauss-Seidel: 1.24x Newton's speed on this robot
-    with every physics fidelity row holding (benchmarks/physics_settings.py); "newton" is the
-    default before 2026-11-25."""
+    with every physics fidelity row holding (experiments/physics_settings)."""
     action_mode: str = choice("residual", ACTION_MODES)
     residual_scale: float = number(0.25)
     """Residual action 1 = this fraction of each joint's half range."""

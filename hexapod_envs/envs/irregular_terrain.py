@@ -266,12 +266,12 @@ class IrregularTerrainSettings(EnvSettings):
     reward_class = IrregularTerrainRewardScales
     control_dt: float = number(0.05, strict=True)
     physics_dt: float = number(0.0025, strict=True)
-    """MuJoCo timestep [s]: 2.5 ms, the coarsest step at which every ATHENA fidelity row of
-    benchmarks/physics_settings.py holds (the ramp's pitch- and roll-rate RMS within 5 % of
-    their 2 ms values, the simple control's sag, the block-bed rate changes and contacts); 1.3x the
-    simulated seconds per wall second of ``physics_dt=0.002``, the default before 2026-11-25.
-    Not converged in one row: posture control's ramp roll-rate RMS is 12 % lower at 0.625 ms
-    (0.0391 against 0.0445 rad/s; `physics_settings.py --finer`)."""
+    """MuJoCo timestep [s]: 2.5 ms, the coarsest step at which every ATHENA physics fidelity row
+    holds (the ramp's pitch- and roll-rate RMS within 5 % of their 2 ms values, the simple
+    control's sag, the block-bed rate changes and contacts; experiments/physics_settings); 1.3x
+    the simulated seconds per wall second of ``physics_dt=0.002``. Not converged in one row:
+    posture control's ramp roll-rate RMS is 12 % lower at 0.625 ms (0.0391 against
+    0.0445 rad/s)."""
     contact_threshold: float = number(CONTACT_FORCE_N / (ATHENA.total_mass * 9.81), high=1.0)
     """A foot is loaded above this fraction of the weight (default: 0.5 N)."""
     tipping_threshold_deg: float = number(10.0, high=90.0)
@@ -309,8 +309,8 @@ class IrregularTerrainSettings(EnvSettings):
     block_height_range: tuple[float, float] = numbers((0.04, 0.13), size=2, ordered=True)
     """Block heights are drawn uniformly from this range [m]."""
     block_size: tuple[float, float] = numbers((0.25, 0.25), size=2)
-    """Block edge lengths (x, y) [m] (the paper gives only the heights; calibrated, see the
-    table under ATHENA_PREVIOUS_BLOCKS in agents/reproduction.py; 0.1 before 2026-11-24)."""
+    """Block edge lengths (x, y) [m] (the paper gives only the heights; calibrated against the
+    paper's block-bed rows, docs/reproduction.md)."""
     block_region: tuple[tuple[float, float], tuple[float, float]] = numbers(
         ((-0.4, 3.0), (-0.5, 0.5)), size=2, low=None, ordered=True
     )
@@ -537,9 +537,10 @@ class IrregularTerrainEnv(HexapodEnv):
     def task_difficulty_spans(self) -> dict[str, DifficultySpan]:
         """What makes a terrain task hard: on the blocks tall and small blocks, on the ramp a
         steep slope; on both a slippery ground and servos far from their nominal stiffness."""
+        kp = self.settings.servo_kp
         spans = {
             "friction": DifficultySpan(easy=1.1, hard=0.5),
-            "servo_kp": DifficultySpan(easy=self.settings.servo_kp, hard=0.7 * self.settings.servo_kp),
+            "servo_kp": DifficultySpan(easy=kp, hard=0.7 * kp),
         }
         if self.terrain == "blocks":
             spans["block_height_max"] = DifficultySpan(easy=0.06, hard=0.15, weight=2.0)

@@ -24,9 +24,8 @@ The paper gives neither its tilt rate nor its final tilt. At the default 2 deg/s
 too slowly for the recovery's time budget (eq. 15) to come off its 3 s clamp; the calibrated
 profile of the reproduction report exercises it: ``scenario="climb"`` or ``"descend"`` with
 ``tilt_rate_deg=7, max_tilt_deg=15``, ``scenario="side"`` with ``tilt_rate_deg=6,
-max_tilt_deg=30`` (`agents.reproduction.STEWART_EQ15`; t_s 2.24-2.32 s against the paper's
-0.74-2.31 s). ``hold_depth=1.79`` lets the paper's own reach model (eqs. 10-12) recover the side
-cases (`agents.reproduction.STEWART_PAPER_REACH`).
+max_tilt_deg=30`` (t_s 2.24-2.32 s against the paper's 0.74-2.31 s). ``hold_depth=1.79`` lets
+the paper's own reach model (eqs. 10-12) recover the side cases (docs/reproduction.md).
 
 Task distributions (``task_distribution=``): "paper" (default) runs `scenario`; "train" / "test"
 draw the held tripod, the tilt axis (one of the six paper cases or an arbitrary axis), the tilt
@@ -148,8 +147,7 @@ class StewartTiltSettings(HeavyDutySettings):
     platform_friction: float = number(1.5)
     hold_depth: float = number(HOLD_DEPTH, strict=True)
     """Feet below the coxa origins in the hold posture [m] (the paper does not give it; 1.79
-    puts the foothold of the paper's reach model at the paper's height, see
-    STEWART_PAPER_REACH in agents/reproduction.py)."""
+    puts the foothold of the paper's reach model at the paper's height, docs/reproduction.md)."""
     residual_scale: float = number(2.0)
     """Residual action 1 = this fraction of each joint's half range (2: any target)."""
     tip_over_angle_deg: float = number(10.0, strict=True, high=90.0)
