@@ -211,9 +211,11 @@ def test_evaluate_smoke_writes_json_markdown_and_html_rows(run, tmp_path, capsys
         assert all(e["episode_length"] == 60 for e in entry["episodes"])
         assert entry["aggregate"]["fasm_min_deg"]["n"] == 2
     md, page = (out / "report.md").read_text(), (out / "report.html").read_text()
-    for name in ("analytical", "zero", "random", ppo):
+    alias = Path(run[0]).name  # the report's short name of ppo:<run dir>
+    for name in ("analytical", "zero", "random", alias):
         assert f"| {name} |" in md and f"<td>{name}</td>" in page
-    assert f"- `{ppo}` vs the analytical controller (`analytical`): success" in md
+    assert f"- `{alias}` vs the analytical controller (`analytical`): success" in md
+    assert f"`{alias}`: {run[0]}" in md  # the sources name the path
     assert "data:image/png;base64," in page and "<img" in page
     assert metrics["envs"]["HexapodCliffWalk-v0"]["comparisons"]
     assert metrics["references"] == ["analytical", "zero"]  # the defaults: the suite names none

@@ -33,7 +33,8 @@ def test_report_has_no_placeholder_a_verdict_per_env_and_the_reading_guide(repor
     for env_id in ENVS:
         section = md.split(f"## {env_id}\n", 1)[1].split("\n## ", 1)[0]
         assert section.count("**Verdict:**") == 1
-        assert f"| ppo:models/{env_id}/hybrid |" in section
+        assert "| hybrid |" in section  # the short alias of ppo:models/{env_id}/hybrid
+        assert f"`hybrid`: ppo:models/{env_id}/hybrid" in section or f"models/{env_id}/hybrid" in section
         assert "\n| zero |" in section  # the reference-motion row
         assert "vs the reference motion (`zero`)" in section
     assert "static margin > 0 mm" in md
@@ -294,3 +295,18 @@ def test_benchmark_scores_run_from_random_to_the_analytical_controller(tmp_path)
     metrics = json.loads((out / "metrics.json").read_text())
     episode = metrics["envs"]["HexapodStewartTilt-v1"]["policies"]["analytical"]["episodes"][0]
     assert "difficulty" in json.dumps(episode)
+
+
+def test_ppo_policies_get_short_unambiguous_aliases():
+    from agents.pipeline.evaluation import policy_aliases
+
+    names = ["analytical", "ppo:models/{env_id}/ppo", "ppo:models/{env_id}/hybrid"]
+    names += ["ppo:runs/a/best", "ppo:runs/b/best", "ppo:runs/gains/final", "ppo:other/gains"]
+    aliases = policy_aliases(names)
+    assert aliases["ppo:models/{env_id}/ppo"] == "ppo"
+    assert aliases["ppo:models/{env_id}/hybrid"] == "hybrid"
+    assert aliases["ppo:runs/a/best"] == "a" and aliases["ppo:runs/b/best"] == "b"
+    # two policies would both be "gains": each keeps its full name
+    assert "ppo:runs/gains/final" not in aliases and "ppo:other/gains" not in aliases
+    assert "analytical" not in aliases
+    assert policy_aliases(["ppo:models/x/analytical", "analytical"]) == {}

@@ -58,10 +58,31 @@ class EnvResult:
     xi_deg: float | None = None  # the robot's FASM threshold ξ; None: FASM is not its criterion
     criterion: str = ""  # the robot's stability criterion, in words
     unranked: tuple[str, ...] = ()  # standard metrics without a verdict here (see `prepare`)
+    aliases: dict[str, str] = field(default_factory=dict)  # policy name -> short name
 
     def label(self, name: str) -> str:
-        """The policy name with ``{env_id}`` expanded (what a reader of this env sees)."""
-        return name.replace("{env_id}", self.env_id)
+        """What a reader of this env sees: the policy's short alias (`policy_aliases`), else
+        its name with ``{env_id}`` expanded."""
+        return self.aliases.get(name) or name.replace("{env_id}", self.env_id)
+
+
+_RUN_PARTS = {"best", "final", "model.zip", "checkpoints"}
+"""Path components that name a model inside a run rather than the run."""
+
+
+def policy_aliases(names: list[str]) -> dict[str, str]:
+    """Short names for the ``ppo:<path>`` policies of a suite: the path's last component that
+    names the model (``ppo:models/{env_id}/hybrid`` -> ``hybrid``; ``runs/<run>/best`` ->
+    ``<run>``). A policy whose alias would be ambiguous (another policy's alias or name) keeps
+    its full name; the report's sources list every path."""
+    short = {}
+    for name in names:
+        if name.startswith(PPO_PREFIX):
+            parts = [p for p in Path(name[len(PPO_PREFIX) :]).parts if p not in _RUN_PARTS]
+            if parts:
+                short[name] = parts[-1]
+    taken = [*short.values(), *(n for n in names if n not in short)]
+    return {name: alias for name, alias in short.items() if taken.count(alias) == 1}
 
 
 def stability_threshold(env: gym.Env, default_deg: float) -> tuple[float | None, str]:
@@ -288,6 +309,7 @@ def prepare(
             max_episode_steps=env.spec.max_episode_steps if env.spec else None,
             dt=env_time_step(env),
             specs=metric_specs(env),
+            aliases=policy_aliases(suite.policies),
         )
         result.xi_deg, result.criterion = stability_threshold(env, suite.xi_f_deg)
         if not getattr(env.unwrapped, "walks", True):  # a standing task (the Stewart tilt):
@@ -307,7 +329,12 @@ def prepare(
             files = getattr(getattr(policy, "learned", policy), "files", None)
             run.model_dir = getattr(files, "directory", None)
             note, harmless = _settings_note(
-                envs[key], suite_env, result.label(name), run.model_dir, policy, extra
+                envs[key],
+                suite_env,
+                name.replace("{env_id}", suite_env.id),
+                run.model_dir,
+                policy,
+                extra,
             )
             if note:
                 run.notes.append(note)
