@@ -1,9 +1,16 @@
-"""HexapodCliffWalk-v0: the heavy-duty hexapod walks a tripod gait toward a unilateral cliff.
+"""HexapodCliffWalk-v0 / -v1: the heavy-duty hexapod walks a tripod gait beside a unilateral cliff.
 
+## Description
 Zhang et al. 2024 §5.1: after 3 s of standing the robot walks on flat ground that, ahead of it,
-drops away
-on one side; a leg on that side steps into the void, the FASM falls below ξ_f = 20° and, without a
-recovery controller, the robot tips over.
+drops away on one side; a leg on that side steps into the void, the FASM falls below ξ_f = 20°
+and, without a recovery controller, the robot tips over.
+
+## Action Space
+18 values in [-1, 1] (J_x, J_z, J_theta per leg in LF LM LR RF RM RR order): joint targets in
+``action_mode="joint"``, or offsets from the reference tripod gait in ``"residual"`` (default;
+see `HeavyDutyEnv`).
+
+## Observation Space
 
 | Observation piece | size | unit |
 |---|---|---|
@@ -17,6 +24,8 @@ recovery controller, the robot tips over.
 | imu_quat | 4 | body orientation (w, x, y, z) |
 | gait_phase | 3 | sin, cos of the gait clock, 1 once walking |
 
+## Rewards
+
 | Reward term (info key) | meaning |
 |---|---|
 | reward_forward | forward_weight x clip(CoG speed along x / gait speed, -1, forward_cap) |
@@ -29,18 +38,30 @@ Every term is bounded and the alive term (forward_weight + stability_weight x 20
 effort_weight x 20) makes an upright step's reward >= 0, so an episode that ends by tipping over
 returns less than staying up, however badly the robot moves.
 
-Task distributions (``task_distribution=``): "paper" (default) is the scenario above; "train" /
-"test" draw cliff distance, side, edge offset, drop, ground friction and a payload (mass, CoG
-offset) at every reset from the ``train_ranges`` / ``test_ranges`` settings (defaults
-`CLIFF_TRAIN` / `CLIFF_TEST`) (held out: farther, deeper, nearer the centre line, lower
-friction, heavier payload). ``info["task"]`` holds the values.
+## Starting State
+The robot stands in the gait's first posture, its joints perturbed by up to
+``reset_noise_scale`` of their half range, and settles for ``settle_time``. Task distributions
+(``task_distribution=``): "paper" (default) is the scenario above; "train" / "test" draw cliff
+distance, side, edge offset, drop, ground friction and a payload (mass, CoG offset) at every
+reset from the ``train_ranges`` / ``test_ranges`` settings (defaults `CLIFF_TRAIN` /
+`CLIFF_TEST`; held out: farther, deeper, nearer the centre line, lower friction, heavier
+payload). ``info["task"]`` holds the values and their ``difficulty``.
 
-Action: see `HeavyDutyEnv` (``action_mode="joint"`` or ``"residual"``, 18 values in [-1, 1]).
+## Episode End
+Terminated on a tip-over: the body tilts past ``tip_over_angle_deg`` (-v0: 20°; -v1: 15°), or
+(-v1) the FASM stays at or below 0 for ``tip_over_margin_time`` (1 s). Truncated at 1500 steps
+(30 s). ``info["is_success"]`` at the last step: no tip-over and at least ``min_progress`` of the
+reference gait's distance; -v1 also needs the tilt within 8° and at most 10 % of the episode
+below ξ_f (docs/benchmark.md).
 
-Version history: ``-v1`` (docs/benchmark.md) ends the episode at a 15° tilt or after 1 s at
-FASM <= 0, counts a success only with the tilt within 8° and at most 10 % of the episode below
-ξ_f, and draws cliffs 0.15-2.35 m ahead of the front feet (`hexapod_envs.benchmark`); ``-v0`` is
-the papers' reproduction.
+## Arguments
+`CliffWalkSettings` and `HeavyDutySettings` (``gym.make(id, **kwargs)``; unknown keys are an
+error that lists the valid ones).
+
+## Version History
+- v1: termination at 15° or 1 s at FASM <= 0; success bounded in tilt (8°) and time below ξ_f
+  (10 %); cliffs 0.15-2.35 m ahead of the front feet (`hexapod_envs.benchmark`).
+- v0: the papers' reproduction.
 """
 
 from __future__ import annotations

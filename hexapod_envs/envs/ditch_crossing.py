@@ -1,5 +1,6 @@
-"""HexapodDitchCrossing-v0: the 3-UPU parallel-mechanism hexapod walks forward across a ditch.
+"""HexapodDitchCrossing-v0 / -v1: the 3-UPU parallel-mechanism hexapod walks across a ditch.
 
+## Description
 Li et al. 2018 §6-7 (Li et al., Robotics 2018): the robot walks with the "3-3" gait, one platform
 standing on its three legs while the other lifts its legs, travels along a quadratic path
 (eqs. 19-21) and lands; strides are at most l_max1 = 160 mm (eq. 17) and are shortened near
@@ -13,12 +14,16 @@ episode's terrain (made at reset, after any randomisation), timed by
 reference stands still and ``info["planner_status"]`` says why ("too_deep", "too_wide",
 "no_plan").
 
-Task distributions (``task_distribution=``): "paper" (default) is the ditch above (or the
-``ditch_*_range`` draws); "train" / "test" draw the ditch's start, width, depth and the ground
-friction at every reset from the ``train_ranges`` / ``test_ranges`` settings (defaults
-`DITCH_TRAIN` / `DITCH_TEST`) (held out: wider, deeper, farther, lower friction).
-``info["task"]`` holds the values; the stability criterion is a positive static margin
-(`tipping_threshold_deg` = 0 on the FASM).
+## Starting State
+The robot stands on its six legs in the standing pose, shifted and turned by up to
+``reset_noise_scale``. Task distributions (``task_distribution=``): "paper" (default) is the
+ditch above (or the ``ditch_*_range`` draws); "train" / "test" draw the ditch's start, width,
+depth and the ground friction at every reset from the ``train_ranges`` / ``test_ranges``
+settings (defaults `DITCH_TRAIN` / `DITCH_TEST`; held out: wider, deeper, farther, lower
+friction). ``info["task"]`` holds the values and their ``difficulty``; the stability criterion
+is a positive static margin (`tipping_threshold_deg` = 0 on the FASM).
+
+## Observation Space
 
 | Observation piece | size | unit |
 |---|---|---|
@@ -37,7 +42,8 @@ friction at every reset from the ``train_ranges`` / ``test_ranges`` settings (de
 The CoG is that of the kinematic model with the known masses (MuJoCo's subtree centre of mass,
 which is exactly that), so static_margin_m is the paper's d of Fig. 5 (eqs. 12-14).
 
-Actions: 9 values in [-1, 1], in the order of joint_pos. ``action_mode="joint"``: each is a
+## Action Space
+9 values in [-1, 1], in the order of joint_pos. ``action_mode="joint"``: each is a
 target normalised over its range (limb length over [l_min, l_max] = [0.365, 0.465] m, leg
 extension over [-leg_retract, leg_extend] = [-0.08, 0.16] m). ``"residual"`` (default): an
 offset from the reference gait's targets of up to residual_limb_m (limbs) and residual_leg_m
@@ -57,6 +63,8 @@ The reference gait (`hexapod_envs.robots.upu.gait_schedule.GaitTiming`) takes 5.
 platform step: unload 0.4, lift 0.8, hold 0.2, transfer 2.5, hold 0.3, land 0.6, hold 0.3.
 Crossing the default ditch takes 20 steps, 102 s (1017 control steps); the time limit is 1500.
 
+## Rewards
+
 | Reward term (info key) | meaning |
 |---|---|
 | reward_forward | forward_weight x CoG speed along x, clipped to ±0.1 m/s [m/s] |
@@ -69,6 +77,7 @@ Crossing the default ditch takes 20 steps, 102 s (1017 control steps); the time 
 Every term is bounded: an episode that ends by tipping over returns less than staying up, and
 one that stands still on the near side until the time limit returns less than crossing.
 
+## Episode End
 The episode ends (terminated) when the robot tips over (body tilt > tip_over_angle_deg) or
 succeeds: every foot past the far edge of the ditch (the finish line on flat ground), all six
 feet loaded, not tipped. `info`: the reward terms, fasm_margin_deg, static_margin_m,
@@ -77,11 +86,16 @@ feet's polygon), is_tipped_over, is_success, sim_unstable, distance (CoG advance
 planner_status, planner_reason, ditch (start_x, width, depth [m]; None on flat ground),
 finish_x [m], gait_step and gait_phase (the reference's plan step and phase), time, cog.
 
-Version history: ``-v1`` (docs/benchmark.md) makes the reference gait the flat-ground one
-(``reference_plan="flat"``: the zero action walks into the ditch blind), widens the residual to
-50 mm on the limbs and 160 mm on the legs so that a policy can adapt the steps, ends the episode
-at a 10° tilt and counts a crossing as a success only with the tilt within 2° and at most 2 % of
-the episode at a static margin <= 0; ``-v0`` is the papers' reproduction.
+## Arguments
+`DitchCrossingSettings` (``gym.make(id, **kwargs)``).
+
+## Version History
+- v1: the reference gait is the flat-ground one (``reference_plan="flat"``: the zero action
+  walks into the ditch blind); the residual reaches 50 mm on the limbs and 160 mm on the legs so
+  that a policy can adapt the steps; termination at a 10° tilt; a crossing is a success only
+  with the tilt within 2° and at most 2 % of the episode at a static margin <= 0; test ditches
+  up to 0.55 m wide (docs/benchmark.md).
+- v0: the papers' reproduction.
 """
 
 from __future__ import annotations

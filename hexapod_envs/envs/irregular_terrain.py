@@ -1,8 +1,8 @@
-"""HexapodIrregularTerrain-v0: ATHENA walks a tripod gait across a 10° ramp or a bed of blocks.
+"""HexapodIrregularTerrain-v0 / -v1: ATHENA walks a tripod gait across a ramp or a bed of blocks.
 
-Coelho et al. 2024 §5 (Coelho et al.): the 0.7 kg-body hexapod ATHENA walks forward (+x) with the
-tripod
-gait of eqs. (19)-(23) (t_g = 1 s per phase, control at 20 Hz) over
+## Description
+Coelho et al. 2024 §5: the 0.7 kg-body hexapod ATHENA walks forward (+x) with the tripod gait
+of eqs. (19)-(23) (t_g = 1 s per phase, control at 20 Hz) over
 
 | terrain | what | robot starts |
 |---|---|---|
@@ -13,16 +13,6 @@ gait of eqs. (19)-(23) (t_g = 1 s per phase, control at 20 Hz) over
 (1) body parallel to the slope, `ramp_start_x` = -0.4 m behind the slope's foot; a positive
 `ramp_start_x` starts it on the flat approach instead. (2) dropped onto the blocks under its feet.
 
-The block heights are drawn from the episode's ``np_random`` at every reset (one bed per seed);
-``block_layout_seed=<int>`` fixes one bed for all episodes.
-
-Task distributions (``task_distribution=``): "paper" (default) is the terrain above; "train" /
-"test" draw the slope, the block bed's highest block and block size, friction and servo
-stiffness at every reset from the ``train_ranges`` / ``test_ranges`` settings (defaults
-`TERRAIN_TRAIN` / `TERRAIN_TEST`) (held out: slopes 8.5-11.5 deg, taller and smaller blocks,
-lower friction, stiffness farther from nominal). ``info["task"]`` holds the values.
-``sensor_noise`` adds Gaussian noise to the observed foot forces and IMU.
-
 Servos and gait. The paper's joints are servos with a 1.89 N·m stall torque. Ours are
 proportional position servos with that torque limit, a stiffness ``servo_kp`` and viscous damping
 ``servo_damping``. The default stiffness, 6.8 N·m/rad, reaches the stall torque at 0.28 rad (15.9°)
@@ -30,11 +20,10 @@ of position error, a hobby servo's proportional band; a stance leg carrying a th
 the robot's weight sags by a few millimetres. The paper's own simple-control results (median torso
 height 0.068 m on the ramp against 0.104 m standing) show that its simulated servos sagged too
 (6.8 N·m/rad is calibrated to that sag: 0.0681 m over seeds 0-3 at the 2 ms step of the
-calibration, 0.0676 m at the 2.5 ms default; 8 N·m/rad, the default before 2026-11-24, gives
-0.089 m):
-because every phase starts from the *measured* feet (eq. 12 on the encoders) the sag accumulates
-and the torso slowly sinks unless the height correction k_z δz brings it back. The phase start
-uses the measured heights but the commanded horizontal positions (``gait_start_from=
+calibration, 0.0676 m at the 2.5 ms default; 8 N·m/rad gives 0.089 m): because every phase
+starts from the *measured* feet (eq. 12 on the encoders) the sag accumulates and the torso
+slowly sinks unless the height correction k_z δz brings it back. The phase start uses the
+measured heights but the commanded horizontal positions (``gait_start_from=
 "measured_height"``, see `hexapod_envs.robots.athena.gait.START_FROM`): with measured x, y too
 the stance legs' lag makes the footholds wander ~4 mm per cycle until the legs reach their limits.
 `reports/athena_gain_sweep.md` shows how the ramp results depend on ``servo_kp`` and this rule.
@@ -42,6 +31,8 @@ Landing legs that found no ground are extended until they touch only in phases t
 ground plane (k_α or k_β > 0; ``gait_ground_search``, see
 `hexapod_envs.robots.athena.gait.GROUND_SEARCH`), so that all gains 0 is the paper's
 non-adaptive "simple control".
+
+## Observation Space
 
 | Observation piece | size | unit |
 |---|---|---|
@@ -69,6 +60,7 @@ foot sphere's centre above the terrain at `FOOT_SCAN_X` (3 cm behind to 12 cm ah
 next steps land) x `FOOT_SCAN_Y`, 3 cm apart - the per-foot height samples of perceptive legged
 locomotion.
 
+## Action Space
 Action modes (``action_mode=``):
 
 - ``"residual"`` (default): 18 values in [-1, 1] added, times ``residual_scale`` x each joint's
@@ -87,6 +79,8 @@ Action modes (``action_mode=``):
   steps are ignored. Gains start at ``reference_gains``.
   `hexapod_envs.wrappers.GainsPerCycle` turns this into one env step per gait cycle.
 
+## Rewards
+
 | Reward term (info key) | meaning |
 |---|---|
 | reward_forward | forward_weight x torso CoG speed along +x, clipped to ±0.1 m/s [m/s] |
@@ -98,6 +92,22 @@ Action modes (``action_mode=``):
 
 Every term is bounded and the alive term makes an upright step's reward >= 0, so an episode that
 ends by tipping over returns less than staying up, however unsteadily the robot walks.
+
+## Starting State
+The robot stands in its standing posture (joints perturbed by up to ``reset_noise_scale`` of
+their half range) and settles for ``settle_time``. The block heights are drawn from the
+episode's ``np_random`` at every reset (one bed per seed); ``block_layout_seed=<int>`` fixes one
+bed for all episodes. Task distributions (``task_distribution=``): "paper" (default) is the
+terrain above; "train" / "test" draw the slope, the block bed's highest block and block size,
+friction and servo stiffness at every reset from the ``train_ranges`` / ``test_ranges``
+settings (defaults `TERRAIN_TRAIN` / `TERRAIN_TEST`; held out: slopes 8.5-11.5 deg, taller and
+smaller blocks, lower friction, stiffness farther from nominal). ``info["task"]`` holds the
+values and their ``difficulty``. ``sensor_noise`` adds Gaussian noise to the observed foot
+forces and IMU.
+
+## Episode End
+Terminated when the torso's up axis leans more than ``tip_over_angle_deg`` from vertical (-v0:
+60°, -v1: 45°); truncated at 1200 steps (60 s).
 
 `info` keys: the reward terms; ``fasm_margin_deg``, ``fasm_edge``, ``stance_legs`` (feet in
 contact), ``is_tipping`` (FASM below ``tipping_threshold_deg``), ``is_tipped_over`` (torso up axis
@@ -118,10 +128,14 @@ Gymnasium's vector envs' info batching). The seed's box plots are made from thes
 whenever a cycle finishes: the lists so far of this episode's per-cycle height, pitch-rate and
 roll-rate RMS and mean ZMP margin) feed the evaluation pipeline (`evaluation_metrics`).
 
-Version history: ``-v1`` (docs/benchmark.md) walks the block bed (``terrain="blocks"``), ends the
-episode at a 45° tilt, counts a success only with the tilt within 25° and at most 30 % of the
-episode below ξ, and draws beds from easy to hard in training and from the harder half in test
-(`hexapod_envs.benchmark`); ``-v0`` is the papers' reproduction.
+## Arguments
+`IrregularTerrainSettings` (``gym.make(id, **kwargs)``).
+
+## Version History
+- v1: the block bed (``terrain="blocks"``), termination at a 45° tilt, success only with the
+  tilt within 25° and at most 30 % of the episode below ξ; beds from easy to hard in training
+  and from the harder half in test (`hexapod_envs.benchmark`, docs/benchmark.md).
+- v0: the papers' reproduction (the 10° ramp by default).
 """
 
 from __future__ import annotations
@@ -297,8 +311,7 @@ class IrregularTerrainSettings(EnvSettings):
     foot_scan: bool = choice(False, (False, True))
     """Add the privileged ``foot_scan`` observation piece (see the module docstring)."""
     servo_kp: float = number(6.8, strict=True)
-    """Servo stiffness [N·m/rad] (calibrated to the paper's simple-control ramp sag, 0.068 m; 8
-    before 2026-11-24)."""
+    """Servo stiffness [N·m/rad] (calibrated to the paper's simple-control ramp sag, 0.068 m)."""
     servo_damping: float = number(0.2, strict=True)
     """Servo viscous damping [N·m·s/rad]."""
     friction: float = number(PAPER_FRICTION)

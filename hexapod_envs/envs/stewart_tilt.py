@@ -1,11 +1,10 @@
-"""HexapodStewartTilt-v0: the heavy-duty hexapod on a tilting 6-UPS Stewart platform.
+"""HexapodStewartTilt-v0 / -v1: the heavy-duty hexapod on a tilting 6-UPS Stewart platform.
 
-Zhang et al. 2024 §5.2.
-
-The robot stands on one tripod with the other tripod lifted in swing posture. After
-`tilt_start_time` (3 s) the platform tilts at `tilt_rate_deg` [deg/s] up to `max_tilt_deg` and holds
-there. Held on its tripod the robot tips over; a controller that lands a swing leg in time keeps
-it up. Scenarios are defined by what the robot feels:
+## Description
+Zhang et al. 2024 §5.2. The robot stands on one tripod with the other tripod lifted in swing
+posture. After `tilt_start_time` (3 s) the platform tilts at `tilt_rate_deg` [deg/s] up to
+`max_tilt_deg` and holds there. Held on its tripod the robot tips over; a controller that lands
+a swing leg in time keeps it up. Scenarios are defined by what the robot feels:
 
 | scenario | platform motion | the held tripod tips |
 |---|---|---|
@@ -27,25 +26,44 @@ profile of the reproduction report exercises it: ``scenario="climb"`` or ``"desc
 max_tilt_deg=30`` (t_s 2.24-2.32 s against the paper's 0.74-2.31 s). ``hold_depth=1.79`` lets
 the paper's own reach model (eqs. 10-12) recover the side cases (docs/reproduction.md).
 
-Task distributions (``task_distribution=``): "paper" (default) runs `scenario`; "train" / "test"
-draw the held tripod, the tilt axis (one of the six paper cases or an arbitrary axis), the tilt
-rate, the platform friction and a payload at every reset from the ``train_ranges`` /
-``test_ranges`` settings (defaults `TILT_TRAIN` / `TILT_TEST` (held out: rates 4-8 and 12-20
-deg/s). ``info["task"]`` holds the values.
+## Action Space
+18 values in [-1, 1]: ``"residual"`` (default) offsets the hold posture by residual_scale x half
+range (default 2, so any joint target is reachable), ``"joint"`` gives targets directly.
 
-Observation: as HexapodCliffWalk-v0 without the gait phase (joint_pos, joint_vel, foot_force,
-foot_contact, fasm_margin_deg, imu_gyro, imu_accel, imu_quat). Action: 18 values in [-1, 1];
-``"residual"`` (default) offsets the hold posture by residual_scale x half range (default 2, so
-any joint target is reachable), ``"joint"`` gives targets directly. Reward terms as
-HexapodCliffWalk-v0 without forward: stability, alive, tip_over, effort. `info` adds
-scenario and stance (the episode's: on the train/test distributions the sampled case),
-platform_tilt_deg, platform_rpy, actuator_lengths (6, m), adjustment_leg (the first lifted leg
-to land after tipping was flagged), early_landing (a lifted foot touched down before the robot
-first tipped) and recovery_time [s].
+## Observation Space
+As HexapodCliffWalk-v0 without the gait phase: joint_pos, joint_vel, foot_force, foot_contact,
+fasm_margin_deg, imu_gyro, imu_accel, imu_quat.
 
-Version history: ``-v1`` (docs/benchmark.md) counts a success only with the lifted tripod kept
-up until the robot first tips (``swing_until_tipping``) and the lean relative to the platform
-within 2.5°; ``-v0`` is the papers' reproduction.
+## Rewards
+The terms of HexapodCliffWalk-v0 without forward: stability, alive, tip_over, effort.
+
+## Starting State
+The robot stands on its held tripod in the hold posture on the level platform, its joints
+perturbed by up to ``reset_noise_scale`` of their half range. Task distributions
+(``task_distribution=``): "paper" (default) runs `scenario`; "train" / "test" draw the held
+tripod, the tilt axis (one of the six paper cases or an arbitrary axis), the tilt rate, the
+platform friction and a payload at every reset from the ``train_ranges`` / ``test_ranges``
+settings (defaults `TILT_TRAIN` / `TILT_TEST`; held out: rates 4-8 and 12-20 deg/s).
+``info["task"]`` holds the values and their ``difficulty``.
+
+## Episode End
+Terminated when the body leans more than ``tip_over_angle_deg`` (10°) relative to the platform;
+truncated at 1600 steps (32 s). ``info["is_success"]``: no tip-over to the end; -v1 also needs
+the lean within 2.5° and the lifted tripod kept up until the robot first tips.
+
+`info` adds scenario and stance (the episode's: on the train/test distributions the sampled
+case), platform_tilt_deg, platform_rpy, actuator_lengths (6, m), adjustment_leg (the first lifted
+leg to land after tipping was flagged), early_landing (a lifted foot touched down before the
+robot first tipped) and recovery_time [s].
+
+## Arguments
+`StewartTiltSettings` and `HeavyDutySettings`.
+
+## Version History
+- v1: success needs the lifted tripod kept up until the robot first tips
+  (``swing_until_tipping``) and the lean relative to the platform within 2.5°
+  (docs/benchmark.md).
+- v0: the papers' reproduction.
 """
 
 from __future__ import annotations
