@@ -526,8 +526,8 @@ def plan_ditch_crossing(
             [all(foot_ok(x_start + i * g + o) for o in offsets) for i in range(n_x + n_d + 1)]
         )
 
-    ok_upper = platform_ok(upper_offsets)
-    ok_lower = platform_ok(lower_offsets)
+    ok_upper = platform_ok(upper_offsets).tolist()  # lists: the search indexes them ~1e5 times
+    ok_lower = platform_ok(lower_offsets).tolist()
 
     @cache
     def move(moving: str, j0: int, j1: int):
@@ -542,6 +542,15 @@ def plan_ditch_crossing(
         margin = _transfer_margin(params, moving, x0, x1)
         return None if margin < settings.min_margin else (lift, margin)
 
+    # The feasible relative moves from each offset j, in the order the search tries them
+    # (longest first): they depend on j only, not on where the robot stands.
+    upper_moves = [
+        [j1 for j1 in range(n_d, j, -1) if move("upper", j, j1) is not None] for j in range(n_d + 1)
+    ]
+    lower_moves = [
+        [s for s in range(j, 0, -1) if move("lower", j, j - s) is not None] for j in range(n_d + 1)
+    ]
+
     # State: (i_lower, j = (x_upper - x_lower) / g, next mover). Start standing, upper first.
     start = (0, 0, "upper")
     parent = {start: None}
@@ -551,16 +560,11 @@ def plan_ditch_crossing(
         state = queue.popleft()
         i, j, mover = state
         if mover == "upper":
-            successors = [
-                (i, j1, "lower")
-                for j1 in range(n_d, j, -1)
-                if ok_upper[i + j1] and move("upper", j, j1) is not None
-            ]
+            successors = [(i, j1, "lower") for j1 in upper_moves[j] if ok_upper[i + j1]]
         else:
-            successors = []
-            for s in range(j, 0, -1):
-                if i + s < n_x and ok_lower[i + s] and move("lower", j, j - s) is not None:
-                    successors.append((i + s, j - s, "upper"))
+            successors = [
+                (i + s, j - s, "upper") for s in lower_moves[j] if i + s < n_x and ok_lower[i + s]
+            ]
         for nxt in successors:
             if nxt in parent:
                 continue
