@@ -1,0 +1,88 @@
+"""A difficulty curriculum for the sampled tasks (``task_distribution="train"``).
+
+Legged-robot RL commonly starts on easy terrain and raises the difficulty as the policy
+succeeds (e.g. Rudin et al. 2022's terrain curriculum). `DifficultyCurriculum` does this with
+the difficulty every env reports in ``info["task"]["difficulty"]`` (0 easy, 1 hard): at each
+reset it draws tasks until one is at most the current `level` (rejection sampling through the
+env's own ``np_random``, so a seeded run stays reproducible), and after every `window` episodes
+it raises the level by `step` when the success rate of those episodes reached `promote_at`
+(and lowers it by `step` below `demote_at`).
+
+    env = DifficultyCurriculum(gym.make("HexapodCliffWalk-v1", task_distribution="train"))
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+
+from .checks import check_number
+
+
+class DifficultyCurriculum(gym.Wrapper):
+    """Tasks no harder than `level`, raised with success (see the module docstring).
+
+    Args:
+        env: a hexapod env with ``task_distribution="train"`` (or "test").
+        level: the first difficulty cap in [0, 1].
+        step: how much the cap moves at a promotion or demotion.
+        window: episodes per decision.
+        promote_at: success rate of a window that raises the cap.
+        demote_at: success rate below which the cap is lowered (0: never).
+        max_draws: tasks drawn at most per reset; the last one is kept if none is under the
+            cap (the env's ranges may hold no task that easy).
+    """
+
+    def __init__(
+        self,
+        env: gym.Env,
+        level: float = 0.3,
+        step: float = 0.1,
+        window: int = 20,
+        promote_at: float = 0.8,
+        demote_at: float = 0.0,
+        max_draws: int = 50,
+    ):
+        super().__init__(env)
+        if getattr(env.unwrapped, "task_distribution", None) == "paper":
+            raise ValueError(
+                "DifficultyCurriculum draws sampled tasks: make the env with "
+                'task_distribution="train" (or "test"), not "paper"'
+            )
+        for name, value in (("level", level), ("step", step)):
+            if not 0.0 <= check_number(name, value) <= 1.0:
+                raise ValueError(f"{name} must be in [0, 1], got {value!r}")
+        if not 0.0 <= check_number("demote_at", demote_at) < promote_at <= 1.0:
+            raise ValueError(
+                f"need 0 <= demote_at < promote_at <= 1, got {demote_at!r}, {promote_at!r}"
+            )
+        if int(window) < 1 or int(max_draws) < 1:
+            raise ValueError(f"window and max_draws must be >= 1, got {window!r}, {max_draws!r}")
+        self.level, self.level_step = float(level), float(step)
+        self.window, self.max_draws = int(window), int(max_draws)
+        self.promote_at, self.demote_at = float(promote_at), float(demote_at)
+        self._results: list[bool] = []
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        obs, info = self.env.reset(seed=seed, options=options)
+        for _ in range(self.max_draws - 1):
+            if info["task"]["difficulty"] <= self.level:
+                break
+            obs, info = self.env.reset(options=options)  # the next task from np_random
+        return obs, {**info, "curriculum_level": self.level}
+
+    def step(self, action):
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        if terminated or truncated:
+            self._record(bool(info.get("is_success")))
+        return obs, reward, terminated, truncated, {**info, "curriculum_level": self.level}
+
+    def _record(self, success: bool) -> None:
+        self._results.append(success)
+        if len(self._results) < self.window:
+            return
+        rate = sum(self._results) / len(self._results)
+        if rate >= self.promote_at:
+            self.level = min(1.0, self.level + self.level_step)
+        elif rate < self.demote_at:
+            self.level = max(0.0, self.level - self.level_step)
+        self._results.clear()
