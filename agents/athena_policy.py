@@ -27,7 +27,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
-from hexapod_envs.envs.base import JointActionMap
+from hexapod_envs.envs.actions import JointActionMap
 from hexapod_envs.robots.athena.gait import AthenaPostureController, AthenaSensors
 
 from .policy import ObservationReader

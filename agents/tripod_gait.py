@@ -9,7 +9,7 @@ from __future__ import annotations
 import gymnasium as gym
 import numpy as np
 
-from hexapod_envs.envs.base import JointActionMap
+from hexapod_envs.envs.actions import JointActionMap
 from hexapod_envs.robots.heavy_duty.gait import TripodGait
 
 from .policy import ObservationReader

@@ -9,7 +9,7 @@ import gymnasium as gym
 import mujoco
 import numpy as np
 
-from hexapod_envs.envs.base import step_sensing_last
+from hexapod_envs.envs.physics import step_sensing_last
 
 ENV_RAW_TARGET = 0.92
 """Issue 14's target for env steps per wall second against bare `mj_step` over the same motion."""
@@ -26,7 +26,7 @@ class ReplayRates(NamedTuple):
     raw: float
     """Bare `mj_step` calls with every sensor evaluated at every step (MuJoCo's default)."""
     raw_sensing_last: float
-    """The same steps as the hexapod envs run them (`hexapod_envs.envs.base.step_sensing_last`):
+    """The same steps as the hexapod envs run them (`hexapod_envs.envs.physics.step_sensing_last`):
     the sensors evaluated only in the last step of a control period."""
     env: float
     """`env.step` with its substeps counted."""

@@ -8,7 +8,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from hexapod_envs.envs.base import set_physics_options
+from hexapod_envs.envs.physics import set_physics_options
 from hexapod_envs.robots.athena.gait import AthenaPostureController, AthenaSensors
 from hexapod_envs.robots.athena.model import add_athena
 from hexapod_envs.robots.athena.params import ATHENA, JOINT_NAMES, LEG_NAMES

@@ -7,7 +7,7 @@ import mujoco
 import numpy as np
 import pytest
 
-from hexapod_envs.envs.base import set_physics_options
+from hexapod_envs.envs.physics import set_physics_options
 from hexapod_envs.robots.athena.model import add_athena
 from hexapod_envs.robots.athena.params import ATHENA
 from hexapod_envs.terrain.irregular import add_blocks, add_ramp

@@ -11,7 +11,7 @@ from gymnasium.utils.env_checker import check_env as gym_check_env
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 import hexapod_envs  # noqa: F401
-from hexapod_envs.envs import base
+from hexapod_envs.envs import physics
 
 ENV_IDS = sorted(k for k in gym.registry if k.startswith("Hexapod"))
 IRREGULAR = "HexapodIrregularTerrain-v0"
@@ -69,7 +69,7 @@ def test_sensing_in_the_last_substep_only_leaves_every_step_unchanged(env_id, kw
     """The envs skip the sensors in all but the last physics step of a control period (ATHENA:
     of each contact check); observations, rewards and infos equal those of sensing every step."""
     skipping = _random_rollout(env_id, **kwargs)
-    monkeypatch.setattr(base, "_SENSORS_OFF", 0)  # "disable nothing": sensors at every step
+    monkeypatch.setattr(physics, "_SENSORS_OFF", 0)  # "disable nothing": sensors at every step
     np.testing.assert_array_equal(skipping, _random_rollout(env_id, **kwargs))
 
 

@@ -237,7 +237,7 @@ def test_offset_targets_is_the_numpy_sum_to_the_bit():
 def test_stewart_actuator_lengths_are_the_platforms_to_the_bit():
     """The tilt env's compiled actuator lengths are StewartPlatform.actuator_lengths' numbers
     for random poses about every axis, level and yawed ones among them."""
-    from hexapod_envs.envs._compiled import stewart_actuator_lengths
+    from hexapod_envs.terrain._compiled import stewart_actuator_lengths
     from hexapod_envs.terrain.stewart_kinematics import DEFAULT_PLATFORM as platform
 
     rng = np.random.default_rng(4)

@@ -9,11 +9,11 @@ import numpy as np
 import pytest
 
 import hexapod_envs  # noqa: F401
-from hexapod_envs.envs.base import SOLVER_IDS
 from hexapod_envs.envs.cliff_walk import CLIFF_TEST, CLIFF_TRAIN, CliffTaskRanges
 from hexapod_envs.envs.ditch_crossing import DITCH_TEST, DITCH_TRAIN
 from hexapod_envs.envs.heavy_duty import HeavyDutySettings
 from hexapod_envs.envs.irregular_terrain import TERRAIN_TEST, TERRAIN_TRAIN
+from hexapod_envs.envs.physics import SOLVER_IDS
 from hexapod_envs.envs.stewart_tilt import TILT_TEST, TILT_TRAIN
 
 ENV_IDS = sorted(k for k in gym.registry if k.startswith("Hexapod"))

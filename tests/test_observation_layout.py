@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from hexapod_envs.envs.base import ObservationLayout, PieceGroup
+from hexapod_envs.envs.observation import ObservationLayout, PieceGroup
 
 
 def _group_writer(out):

@@ -89,7 +89,7 @@ from agents.tipping.trajectory import (
     zero_crossing_time,
 )
 from hexapod_envs.checks import check_number
-from hexapod_envs.envs.base import JointActionMap
+from hexapod_envs.envs.actions import JointActionMap
 from hexapod_envs.robots.heavy_duty.kinematics import joints_for_foot
 from hexapod_envs.robots.heavy_duty.params import LEG_NAMES, HeavyDutyParams
 from hexapod_envs.stability import fasm_from_feet, plane_normal

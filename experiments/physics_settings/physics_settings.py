@@ -77,8 +77,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # run as a script from anywhere
 
 import hexapod_envs  # noqa: E402, F401  (registers the env ids)
-from hexapod_envs.envs.base import INTEGRATOR_IDS as INTEGRATORS  # noqa: E402
-from hexapod_envs.envs.base import SOLVER_IDS as SOLVERS  # noqa: E402
+from hexapod_envs.envs.physics import INTEGRATOR_IDS as INTEGRATORS  # noqa: E402
+from hexapod_envs.envs.physics import SOLVER_IDS as SOLVERS  # noqa: E402
 
 
 @dataclasses.dataclass(frozen=True)

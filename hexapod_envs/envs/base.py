@@ -1,18 +1,20 @@
-"""The episode skeleton every hexapod env shares (`HexapodEnv`), and its small helpers.
+"""The episode skeleton every hexapod env shares (`HexapodEnv`).
 
 `HexapodEnv` owns `reset` and `step`: typed settings, seeding, task draws, building and
 rebuilding the model, the settle phase, the step counter and time, action validation, physics
 with instability detection, termination and truncation, ``reward = sum of the named terms`` and
 the common `info` keys (`hexapod_envs.info_keys`). A concrete env supplies the hooks listed in
-`HexapodEnv`'s docstring; docs/architecture.md explains the layering.
+`HexapodEnv`'s docstring; docs/architecture.md explains the layering. Its parts live next to
+it: `physics` (solver options, stepping), `observation` (the layout), `actions` (the joint
+action map), `task` (the task description), `safety` (the safety figures and the benchmark's
+rules on them) and `rendering`.
 """
 
 from __future__ import annotations
 
 import copy
-import dataclasses
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Mapping
 from itertools import compress
 from types import MappingProxyType
 from typing import Any, ClassVar, NamedTuple
@@ -25,237 +27,42 @@ from gymnasium import spaces
 from .. import info_keys as keys
 from . import _compiled
 from .difficulty import DifficultySpan, task_difficulty
-from .settings import RENDER_MODES, TASK_DISTRIBUTIONS, EnvSettings, check_choice
+from .observation import ObservationLayout, PieceGroup, Reader
+from .physics import (
+    UNSTABLE_WARNINGS,
+    set_physics_options,
+    step_sensing_last,
+    step_without_sensors,
+    substeps_for,
+)
+from .rendering import check_camera, make_renderer, set_visual_options
+from .safety import SafetyFigures
+from .settings import RENDER_MODES, EnvSettings
+from .task import TaskDescription
 
-__all__ = [
-    "TASK_DISTRIBUTIONS",
-    "HexapodEnv",
-    "JointActionMap",
-    "ObservationLayout",
-    "PieceGroup",
-    "TaskDescription",
-    "check_choice",
-    "step_sensing_last",
-    "step_without_sensors",
-]
+__all__ = ["HexapodEnv", "Measurement"]
 
-_SENSORS_OFF = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
 _RK4 = int(mujoco.mjtIntegrator.mjINT_RK4)
 
 
-def step_sensing_last(model: mujoco.MjModel, data: mujoco.MjData, nstep: int) -> None:
-    """`nstep` MuJoCo steps, evaluating the sensors in the last one only.
+class Measurement(NamedTuple):
+    """What `_measure` returns each step, stored by the skeleton as ``_forces``, ``_loaded``,
+    ``_fasm_deg``, ``_fasm_edge`` and ``_cog``. The arrays may be the sensors' buffers, which
+    the next measurement overwrites."""
 
-    Sensors never act on the dynamics, and the envs read `data.sensordata` only after the
-    steps, so the state and the final readings are bit-identical to evaluating them every step,
-    while the skipped evaluations (the foot-force and accelerometer sensors need an extra
-    dynamics pass, ATHENA's rangefinders cast rays) cost 5-10 % of a physics step.
-    """
-    if nstep > 1:
-        step_without_sensors(model, data, nstep - 1)
-        nstep = 1
-    mujoco.mj_step(model, data, nstep=nstep)
-
-
-def step_without_sensors(model: mujoco.MjModel, data: mujoco.MjData, nstep: int) -> None:
-    """`nstep` MuJoCo steps with the sensors disabled (`data.sensordata` keeps its values)."""
-    opt = model.opt
-    flags = opt.disableflags
-    opt.disableflags = flags | _SENSORS_OFF
-    try:
-        mujoco.mj_step(model, data, nstep=nstep)
-    finally:
-        opt.disableflags = flags
+    forces: np.ndarray
+    """(n_legs, 3) ground reaction on each foot, world frame [N]."""
+    loaded: np.ndarray
+    """(n_legs,) bool: the foot is loaded (in contact)."""
+    fasm_deg: float
+    """FASM over the loaded feet [deg]."""
+    fasm_edge: tuple[int, int] | None
+    """Its edge as leg indices, None without a support polygon."""
+    cog: np.ndarray
+    """(3,) the robot's centre of gravity, world frame [m]."""
 
 
-DEFAULT_CAMERA = {"distance": 14.0, "elevation": -20.0, "azimuth": 135.0, "trackbodyid": 1}
-
-
-class JointActionMap:
-    """Maps normalised actions in [-1, 1] to joint targets in the robot's units and back."""
-
-    def __init__(self, ranges: np.ndarray):
-        ranges = np.asarray(ranges, dtype=float)
-        self.low, self.high = ranges[:, 0], ranges[:, 1]
-        self.center = (self.low + self.high) / 2
-        self.half = (self.high - self.low) / 2
-
-    def to_joints(self, action: np.ndarray) -> np.ndarray:
-        return self.center + self.half * np.asarray(action)
-
-    def to_action(self, joints: np.ndarray) -> np.ndarray:
-        return np.clip((np.asarray(joints).reshape(-1) - self.center) / self.half, -1.0, 1.0)
-
-
-def substeps_for(control_dt: float, physics_dt: float) -> int:
-    """Physics steps per control step; the ratio must be a whole number."""
-    if control_dt <= 0 or physics_dt <= 0:
-        raise ValueError(f"control_dt and physics_dt must be > 0, got {control_dt}, {physics_dt}")
-    n = round(control_dt / physics_dt)
-    if n < 1 or abs(n * physics_dt - control_dt) > 1e-9 * max(1.0, control_dt):
-        raise ValueError(
-            f"control_dt={control_dt} s is not a whole multiple of physics_dt={physics_dt} s"
-        )
-    return n
-
-
-Reader = Callable[[], Any]
-"""Returns one observation piece's current value (an array, a float or a tuple of floats)."""
-
-
-class PieceGroup(NamedTuple):
-    """Consecutive observation pieces written by one call (e.g. a compiled one): `sizes` is
-    name -> size in order, `write(out)` fills `out`, the group's slice of the observation."""
-
-    sizes: Mapping[str, int]
-    write: Callable[[np.ndarray], Any]
-
-
-class ObservationLayout:
-    """Named pieces laid out in one flat vector, in order: name -> (size, reader), or a
-    `PieceGroup` under a label (its pieces take the group's place).
-
-    The layout is the single table of the observation: it gives the slices
-    (`observation_structure`, the docs, the policies' readers) and writes the vector, each
-    piece by its reader (or each group by its writer), straight into a preallocated buffer
-    (`write`).
-    """
-
-    def __init__(self, pieces: Mapping[str, tuple[int, Reader] | PieceGroup]):
-        self.slices: dict[str, slice] = {}
-        self._writers: list[tuple[slice, Callable, bool]] = []
-        start = 0
-        for name, piece in pieces.items():
-            if isinstance(piece, PieceGroup):
-                group_start = start
-                for member, size in piece.sizes.items():
-                    start = self._add_slice(member, start, size)
-                self._writers.append((slice(group_start, start), piece.write, True))
-            else:
-                size, read = piece
-                self._writers.append((slice(start, start + size), read, False))
-                start = self._add_slice(name, start, size)
-        self.size = start
-
-    def _add_slice(self, name: str, start: int, size: int) -> int:
-        if name in self.slices:
-            raise ValueError(f"observation piece {name!r} appears twice")
-        self.slices[name] = slice(start, start + size)
-        return start + size
-
-    def write(self, out: np.ndarray) -> np.ndarray:
-        """Write every piece's current value into `out` (size `size`) and return it."""
-        for sl, write, is_group in self._writers:
-            if is_group:
-                write(out[sl])
-            else:
-                out[sl] = write()
-        return out
-
-    def unpack(self, observation: np.ndarray) -> dict[str, np.ndarray]:
-        return {name: observation[..., sl] for name, sl in self.slices.items()}
-
-
-SOLVER_IDS = {
-    "newton": mujoco.mjtSolver.mjSOL_NEWTON,
-    "cg": mujoco.mjtSolver.mjSOL_CG,
-    "pgs": mujoco.mjtSolver.mjSOL_PGS,
-}
-"""MuJoCo constraint solvers by the names of the ``solver`` setting."""
-
-INTEGRATOR_IDS = {
-    "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
-    "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
-    "euler": mujoco.mjtIntegrator.mjINT_EULER,
-    "rk4": mujoco.mjtIntegrator.mjINT_RK4,
-}
-"""MuJoCo integrators by the names of the ``integrator`` setting."""
-
-
-def set_physics_options(
-    spec: mujoco.MjSpec,
-    timestep: float,
-    integrator: str = "implicitfast",
-    iterations: int | None = None,
-    ls_iterations: int | None = None,
-    tolerance: float | None = None,
-    solver: str = "newton",
-    midphase: bool = True,
-) -> None:
-    """The solver options of an env: `timestep` [s], the `integrator` (`INTEGRATOR_IDS`), the
-    constraint `solver` (`SOLVER_IDS`) and its `iterations`, `ls_iterations` and `tolerance`
-    (None: MuJoCo's 100, 50 and 1e-8), and elliptic friction cones with a high impedance ratio
-    (the default pyramidal cone lets a loaded foot creep down a slope at several cm/s, far
-    below its friction limit). `midphase` False disables the collision midphase. The envs pass
-    their settings of the same names (``physics_dt``, ``integrator``, ``solver``, ``solver_*``,
-    ``midphase``)."""
-    spec.option.timestep = timestep
-    spec.option.integrator = INTEGRATOR_IDS[integrator]
-    spec.option.solver = SOLVER_IDS[solver]
-    for name, value in (
-        ("iterations", iterations),
-        ("ls_iterations", ls_iterations),
-        ("tolerance", tolerance),
-    ):
-        if value is not None:
-            setattr(spec.option, name, value)
-    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
-    spec.option.impratio = 10.0
-    if not midphase:
-        spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_MIDPHASE)
-
-
-@dataclasses.dataclass(frozen=True)
-class TaskDescription:
-    """What a controller may know about the env's task, declared by the env (instead of reading
-    its attributes): robot, action mapping, timing, stability criterion, the episode's course
-    and the reference gait. Per-step information comes through the observation.
-
-    The course (and for some envs the reference) changes at every reset with a sampled task:
-    a controller reads ``env.unwrapped.task_description`` on its first call after a reset."""
-
-    robot: Any
-    """The robot's parameters (frozen dataclass of its `params` module)."""
-    action_mode: str
-    control_dt: float
-    """Control period [s]."""
-    joint_low: tuple[float, ...]
-    """Joint (command) target at action -1, per action entry, robot units ("joint" mode)."""
-    joint_high: tuple[float, ...]
-    """Joint (command) target at action +1."""
-    tipping_threshold_deg: float
-    stability_criterion: str
-    course: Mapping[str, Any]
-    """The episode's task parameters (`info["task"]`, read-only)."""
-    reference: Mapping[str, Any]
-    """Env-specific reference gait and timing (see the env's `_reference_description`)."""
-    observation_structure: Mapping[str, slice]
-    """Name -> slice of every piece of the flat observation (what a controller reads)."""
-
-    def __reduce__(self):
-        """Deep-copied and pickled with plain dicts in place of the read-only mappings (neither
-        `copy.deepcopy` nor pickle takes a mappingproxy), which the copy makes read-only again."""
-        fields = {f.name: getattr(self, f.name) for f in dataclasses.fields(self)}
-        fields.update({name: dict(fields[name]) for name in _READ_ONLY})
-        return _task_description, (fields,)
-
-
-_READ_ONLY = ("course", "reference", "observation_structure")
-
-
-def _task_description(fields: dict[str, Any]) -> TaskDescription:
-    read_only = {name: MappingProxyType(fields[name]) for name in _READ_ONLY}
-    return TaskDescription(**{**fields, **read_only})
-
-
-_W = mujoco.mjtWarning
-if {_W.mjWARN_BADQPOS, _W.mjWARN_BADQVEL, _W.mjWARN_BADQACC, _W.mjWARN_BADCTRL} != set(
-    range(_W.mjWARN_BADQPOS, _W.mjWARN_BADCTRL + 1)
-):  # pragma: no cover - MuJoCo's enum order; HexapodEnv._UNSTABLE_WARNINGS relies on it
-    raise ImportError("this MuJoCo orders mjtWarning differently; update _UNSTABLE_WARNINGS")
-
-
-class HexapodEnv(gym.Env):
+class HexapodEnv(SafetyFigures, gym.Env):
     """The episode skeleton: `reset` and `step` live here; a concrete env supplies hooks.
 
     Construction (``gym.make(id, **kwargs)``): the keyword arguments build ``self.settings``, an
@@ -279,9 +86,9 @@ class HexapodEnv(gym.Env):
     Hooks with a default here: `_apply_task`, `_set_initial_state`, `_start_episode`,
     `_run_physics`, `midphase_pays`, `_end_step`, `_is_tipped_over`, `_is_tipping`, `_extra_info`,
     `_reference_description`. Hooks every env defines: `_setup`, `_build_spec`, `_bind_model`,
-    `_observation_pieces`, `_apply_action`, `_measure` (sets ``_forces``, ``_loaded``,
-    ``_fasm_deg``, ``_fasm_edge``, ``_cog``), `_is_success`, `_reward_terms`,
-    `step_cost_bound`, `paper_task`, `sample_task`.
+    `_observation_pieces`, `_apply_action`, `_measure` (returns a `Measurement`, stored as
+    ``_forces``, ``_loaded``, ``_fasm_deg``, ``_fasm_edge``, ``_cog``), `_is_success`,
+    `_reward_terms`, `step_cost_bound`, `paper_task`, `sample_task`.
     """
 
     Settings: ClassVar[type[EnvSettings]] = EnvSettings
@@ -356,12 +163,7 @@ class HexapodEnv(gym.Env):
         self.model: mujoco.MjModel | None = None
         self.data: mujoco.MjData | None = None
         self._setup()
-        cameras = [self.model.camera(i).name for i in range(self.model.ncam)]
-        if self._camera_name is not None and self._camera_name not in cameras:
-            raise ValueError(
-                f"camera_name {self._camera_name!r} is not a camera of the model; valid: "
-                f"{cameras}, or None (the free camera)"
-            )
+        check_camera(self.model, self._camera_name)
         self._action_low = np.asarray(self.action_space.low, dtype=np.float64)
         self._action_high = np.asarray(self.action_space.high, dtype=np.float64)
         self._action = np.empty_like(self._action_low)
@@ -390,13 +192,7 @@ class HexapodEnv(gym.Env):
             s.solver,
             self.midphase_pays() if s.midphase is None else s.midphase,
         )
-        spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
-        spec.visual.headlight.diffuse = [0.65, 0.65, 0.65]
-        spec.worldbody.add_light(
-            name="sun", pos=[0, 0, 30], dir=[0.3, 0.2, -1.0], diffuse=[0.5, 0.5, 0.5]
-        )
-        spec.visual.global_.offwidth = max(self._render_size[0], 640)
-        spec.visual.global_.offheight = max(self._render_size[1], 480)
+        set_visual_options(spec, self._render_size)
         self.model = spec.compile()
         self.data = mujoco.MjData(self.model)
         m = self.model
@@ -479,10 +275,8 @@ class HexapodEnv(gym.Env):
         self._step_count = 0
         self._tipped = False
         self._start_episode()
-        self._measure()
-        self._tilt_deg = self._max_tilt_deg = self._body_tilt_deg()
-        self._tipping_steps = 0
-        self._steps_at_zero_margin = 0
+        self._forces, self._loaded, self._fasm_deg, self._fasm_edge, self._cog = self._measure()
+        self._start_safety()
         self._start_cog_x = self._prev_cog_x = float(self._cog[0])
         self._success = self._is_success()
         self._new_success = False
@@ -504,7 +298,7 @@ class HexapodEnv(gym.Env):
             # ended (stepped on after a tip-over or a crossing) stays terminated.
             info = self._info({}, unstable=True)
             return self._obs_buffer.copy(), 0.0, self._terminated, True, info
-        self._measure()
+        self._forces, self._loaded, self._fasm_deg, self._fasm_edge, self._cog = self._measure()
         self._track_safety()
         # The penalty is paid once, on the step the robot tips over; stepping on after the
         # episode terminated keeps `terminated` True and never pays it again.
@@ -557,39 +351,6 @@ class HexapodEnv(gym.Env):
             info[keys.REWARD_PREFIX + name] = value
         return info
 
-    # --- safety figures and the benchmark's rules -------------------------------------------
-    def _track_safety(self) -> None:
-        """Update the episode's safety figures after a step's measurement: the tilt and its
-        maximum, the steps on which the stability criterion failed, the run of steps at FASM
-        <= 0."""
-        self._tilt_deg = self._body_tilt_deg()
-        self._max_tilt_deg = max(self._max_tilt_deg, self._tilt_deg)
-        self._tipping_steps += bool(self._is_tipping())
-        self._steps_at_zero_margin = self._steps_at_zero_margin + 1 if self._fasm_deg <= 0 else 0
-
-    def _margin_lost(self) -> bool:
-        """The FASM has stayed at or below 0 for ``tip_over_margin_time`` (if set)."""
-        n = self._margin_steps_to_tip
-        return n is not None and self._steps_at_zero_margin >= n
-
-    def _stayed_stable(self) -> bool:
-        """The success rule's safety part: the episode's max tilt and share of time tipping
-        within ``success_max_tilt_deg`` and ``success_max_tipping_share`` (each if set)."""
-        s = self.settings
-        if s.success_max_tilt_deg is not None and self._max_tilt_deg > s.success_max_tilt_deg:
-            return False
-        share = self._tipping_steps / max(self._step_count, 1)
-        return s.success_max_tipping_share is None or share <= s.success_max_tipping_share
-
-    def _body_tilt_deg(self) -> float:
-        """The body's tilt from the vertical [deg] (`tilt_cos`)."""
-        return math.degrees(math.acos(min(1.0, max(-1.0, self._tilt_cos()))))
-
-    def _tilt_cos(self) -> float:
-        """cos of the angle between the body's up axis and the vertical (an env whose robot
-        stands on a moving support measures it from the support's up axis)."""
-        return self.sensors.tilt_cos()
-
     # --- hooks every env defines ----------------------------------------------------------
     def _setup(self) -> None:  # pragma: no cover - abstract
         """Robot, action space and mappings from ``self.settings``; then `_build_model()`."""
@@ -629,9 +390,9 @@ class HexapodEnv(gym.Env):
         """Write the servo commands of a validated action into ``self.data``."""
         raise NotImplementedError
 
-    def _measure(self) -> None:  # pragma: no cover - abstract
-        """Read the robot's sensors; set ``_forces``, ``_loaded``, ``_fasm_deg``,
-        ``_fasm_edge``, ``_cog`` (and the env's own measurements)."""
+    def _measure(self) -> Measurement:  # pragma: no cover - abstract
+        """Read the robot's sensors: return the skeleton's `Measurement` (and set the env's own
+        measurements)."""
         raise NotImplementedError
 
     def _is_success(self) -> bool:  # pragma: no cover - abstract
@@ -733,11 +494,8 @@ class HexapodEnv(gym.Env):
             raise ValueError(f"action contains NaN or inf at indices {bad}")
         return self._action
 
-    _UNSTABLE_WARNINGS = slice(
-        int(mujoco.mjtWarning.mjWARN_BADQPOS), int(mujoco.mjtWarning.mjWARN_BADCTRL) + 1
-    )
-    """MuJoCo warnings that count as instability (`info["sim_unstable"]`, truncation): bad
-    qpos, qvel, qacc and ctrl, adjacent in `mjtWarning` (checked at import)."""
+    _UNSTABLE_WARNINGS = UNSTABLE_WARNINGS
+    """MuJoCo warnings that count as instability (`physics.UNSTABLE_WARNINGS`)."""
 
     def _simulate(self) -> bool:
         """Run the physics for one control period; False if the simulation went unstable.
@@ -784,18 +542,8 @@ class HexapodEnv(gym.Env):
             gym.logger.warn("render() called without a render_mode; pass render_mode= to make()")
             return None
         if self._renderer is None:
-            from gymnasium.envs.mujoco.mujoco_rendering import MujocoRenderer
-
-            cam_id = None
-            if self._camera_name is not None:
-                cam_id = self.model.camera(self._camera_name).id
-            self._renderer = MujocoRenderer(
-                self.model,
-                self.data,
-                default_cam_config=None if cam_id is not None else DEFAULT_CAMERA,
-                width=self._render_size[0],
-                height=self._render_size[1],
-                camera_id=cam_id,
+            self._renderer = make_renderer(
+                self.model, self.data, self._camera_name, self._render_size
             )
         return self._renderer.render(self.render_mode)
 

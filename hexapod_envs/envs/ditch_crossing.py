@@ -126,7 +126,7 @@ from ..stability import _compiled as _stability
 from ..terrain.ditch import add_ditch
 from ..terrain.flat import add_flat
 from . import _compiled
-from .base import HexapodEnv
+from .base import HexapodEnv, Measurement
 from .difficulty import DifficultySpan
 from .sensors import RobotSensors
 from .settings import (
@@ -552,7 +552,7 @@ class DitchCrossingEnv(HexapodEnv):
         d.ctrl[self._act] = (target - d.act[self._act_state]) * self._inv_dt
 
     # --- measurements ------------------------------------------------------------------------
-    def _measure(self) -> None:
+    def _measure(self) -> Measurement:
         d = self.data
         act = self._act
         # One compiled call (hexapod_envs.envs._compiled.upu_measure). Every foot site is
@@ -576,10 +576,10 @@ class DitchCrossingEnv(HexapodEnv):
         )
         if status == _stability.NOT_FINITE:
             raise ValueError("foot forces, feet or CoG contain NaN or infinite values")
-        self._forces, self._loaded, self._cog, self._power = forces, loaded, cog, power
-        self._fasm_deg, self._fasm_edge = margin, ((i, j) if status == _stability.OK else None)
+        self._power = power
         # Same computation as stability.static_stability_margin, gravity along -z.
         self._static_margin = static
+        return Measurement(forces, loaded, margin, (i, j) if status == _stability.OK else None, cog)
 
     def _is_success(self) -> bool:
         """Every foot past the far edge of the ditch (the finish line), all six loaded."""

@@ -23,7 +23,8 @@ from ..robots.heavy_duty import LEG_NAMES, HeavyDutyParams
 from ..robots.heavy_duty.gait import TripodGait, TripodGaitParams
 from ..robots.heavy_duty.model import add_heavy_duty
 from . import _compiled
-from .base import HexapodEnv, JointActionMap
+from .actions import JointActionMap
+from .base import HexapodEnv, Measurement
 from .sensors import RobotSensors
 from .settings import (
     SOLVERS,
@@ -288,11 +289,12 @@ class HeavyDutyEnv(HexapodEnv):
         return False
 
     # --- measurements ----------------------------------------------------------------------
-    def _measure(self) -> None:
+    def _measure(self) -> Measurement:
         reading = self.sensors.support(self._contact_force_sq)
-        self._forces, self._loaded, self._cog = reading.forces, reading.loaded, reading.cog
-        self._fasm_deg, self._fasm_edge = reading.fasm_deg, reading.fasm_edge
         self._power = reading.power
+        return Measurement(
+            reading.forces, reading.loaded, reading.fasm_deg, reading.fasm_edge, reading.cog
+        )
 
     # --- observation, reward, info ----------------------------------------------------------
     def _observation_pieces(self) -> dict:

@@ -158,7 +158,8 @@ from ..robots.athena.params import ATHENA, LEG_NAMES
 from ..terrain.flat import add_flat
 from ..terrain.irregular import PAPER_FRICTION, add_blocks, add_ramp
 from . import _compiled
-from .base import HexapodEnv, JointActionMap
+from .actions import JointActionMap
+from .base import HexapodEnv, Measurement
 from .difficulty import DifficultySpan
 from .sensors import RobotSensors
 from .settings import (
@@ -671,18 +672,19 @@ class IrregularTerrainEnv(HexapodEnv):
         self._touched_in_physics = bool(touched)
 
     # --- measurements --------------------------------------------------------------------
-    def _measure(self) -> None:
+    def _measure(self) -> Measurement:
         self._touched = self._touched_in_physics
         self._collisions += self._touched
         s = self.sensors
         self._joints = s.joint_positions()  # fancy indexing: already a copy
         reading = s.support(self._contact_force_sq)
-        self._forces, self._loaded, self._cog = reading.forces, reading.loaded, reading.cog
-        self._fasm_deg, self._fasm_edge = reading.fasm_deg, reading.fasm_edge
         self._power = reading.power
         self._height = float(self.data.sensordata[self._height_adr])
         self._gyro = s.gyro().copy()
-        self._zmp, self._zmp_margin = s.torso_frame_zmp(self._forces, self._loaded)
+        self._zmp, self._zmp_margin = s.torso_frame_zmp(reading.forces, reading.loaded)
+        return Measurement(
+            reading.forces, reading.loaded, reading.fasm_deg, reading.fasm_edge, reading.cog
+        )
 
     def _height_deviation(self) -> float:
         """Torso-height reading minus the standing reference, m (0 without a reading)."""

@@ -28,7 +28,7 @@ physical parameters sampled at every reset from the env's training or held-out t
 RENDER_MODES = ("human", "rgb_array", "depth_array")
 
 SOLVERS = ("newton", "cg", "pgs")
-"""``solver`` values: MuJoCo's constraint solvers (`hexapod_envs.envs.base.SOLVER_IDS`)."""
+"""``solver`` values: MuJoCo's constraint solvers (`hexapod_envs.envs.physics.SOLVER_IDS`)."""
 
 RENAMED = {
     "progress_weight": "forward_weight",

@@ -75,9 +75,10 @@ import mujoco
 import numpy as np
 
 from ..robots.heavy_duty import LEG_NAMES, TRIPODS, joints_for_foot, within_limits
+from ..terrain._compiled import stewart_actuator_lengths
 from ..terrain.stewart import add_stewart_platform
 from ..terrain.stewart_kinematics import DEFAULT_PLATFORM
-from . import _compiled
+from .base import Measurement
 from .difficulty import DifficultySpan
 from .heavy_duty import (
     TEST_PAYLOAD,
@@ -402,27 +403,29 @@ class StewartTiltEnv(HeavyDutyEnv):
         ``swing_until_tipping``."""
         return not (self.settings.swing_until_tipping and self._early_landing)
 
-    def _measure(self) -> None:
-        super()._measure()
+    def _measure(self) -> Measurement:
+        measured = super()._measure()
         if self._step_count == 0:
-            return
-        if self._first_tipping_time is None and self._fasm_deg < self.tipping_threshold_deg:
+            return measured
+        loaded = measured.loaded
+        if self._first_tipping_time is None and measured.fasm_deg < self.tipping_threshold_deg:
             self._first_tipping_time = self.time
         if self._first_tipping_time is None and not self._early_landing:
-            self._early_landing = any(self._loaded[i] for i in self._swing_ids)
+            self._early_landing = any(loaded[i] for i in self._swing_ids)
         if self._first_tipping_time is not None and self._adjustment_leg is None:
             for i, leg in enumerate(LEG_NAMES):
-                if leg in self.swing and self._loaded[i]:
+                if leg in self.swing and loaded[i]:
                     self._adjustment_leg = leg
                     self._recovery_time = self.time - self._first_tipping_time
                     break
+        return measured
 
     def _extra_info(self, unstable: bool) -> dict:
         pitch, roll = self.data.qpos[self._platform_qpos].tolist()
         up_z = min(1.0, self.data.xmat[self._platform_body, 8])  # the platform's up axis' z
         rpy = np.array([roll, pitch, 0.0])
         platform = self.platform  # its actuator lengths, in one compiled call:
-        lengths = _compiled.stewart_actuator_lengths(
+        lengths = stewart_actuator_lengths(
             platform.base_joints, platform.platform_joints, self._platform_centre, roll, pitch, 0.0
         )
         return {
