@@ -333,7 +333,7 @@ class HexapodEnv(SafetyFigures, gym.Env):
             keys.FASM_MARGIN_DEG: self._fasm_deg,
             keys.FASM_EDGE: None if edge is None else (legs[edge[0]], legs[edge[1]]),
             keys.STANCE_LEGS: tuple(compress(legs, self._loaded.tolist())),
-            keys.IS_TIPPING: self._is_tipping(),
+            keys.IS_TIPPING: self._tipping,
             keys.IS_TIPPED_OVER: self._tipped,
             keys.IS_SUCCESS: self._success and not unstable,
             keys.SIM_UNSTABLE: unstable,
@@ -344,7 +344,7 @@ class HexapodEnv(SafetyFigures, gym.Env):
             keys.TILT_DEG: self._tilt_deg,
             keys.MAX_TILT_DEG: self._max_tilt_deg,
             keys.TIPPING_TIME_S: self._tipping_steps * self.control_dt,
-            keys.TIPPING_SHARE: self._tipping_steps / max(self._step_count, 1),
+            keys.TIPPING_SHARE: self._tipping_share,
             **self._extra_info(unstable),
         }
         for name, value in terms.items():
@@ -425,7 +425,7 @@ class HexapodEnv(SafetyFigures, gym.Env):
 
     def _is_tipped_over(self) -> bool:
         """True when the body's up axis leans more than ``tip_over_angle_deg`` from vertical."""
-        return self._tilt_cos() < self.tip_over_cos
+        return self._tilt_cos_now < self.tip_over_cos  # read this step (`_read_posture`)
 
     def _is_tipping(self) -> bool:
         """The stability criterion fails: FASM below the robot's ξ."""
