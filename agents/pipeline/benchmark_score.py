@@ -42,22 +42,19 @@ def score_matrices(
     """``{policy: (episodes x envs) normalised per-episode scores}`` over the envs with a scale
     on which the policy ran the same number of episodes as every other; and those envs.
     `successes` is ``{env: {policy: [success per episode]}}``."""
-    envs = [
-        env
+    scales = {
+        env: env_scale({p: float(np.mean(v)) for p, v in by_policy.items()})
         for env, by_policy in successes.items()
-        if env_scale({p: float(np.mean(v)) for p, v in by_policy.items()}) is not None
-    ]
-    policies = sorted({p for env in envs for p in successes[env]})
+    }
+    envs = [env for env, scale in scales.items() if scale is not None]
     out = {}
-    for policy in policies:
-        columns = []
-        for env in envs:
-            by_policy = successes[env]
-            if policy not in by_policy:
-                break
-            scale = env_scale({p: float(np.mean(v)) for p, v in by_policy.items()})
-            columns.append([normalised(float(s), scale) for s in by_policy[policy]])
-        if len(columns) == len(envs) and len({len(c) for c in columns}) == 1:
+    for policy in sorted({p for env in envs for p in successes[env]}):
+        if not all(policy in successes[env] for env in envs):
+            continue
+        columns = [
+            [normalised(float(x), scales[env]) for x in successes[env][policy]] for env in envs
+        ]
+        if len({len(c) for c in columns}) == 1:
             out[policy] = np.array(columns, dtype=float).T
     return out, envs
 
