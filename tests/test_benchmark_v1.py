@@ -157,12 +157,15 @@ def test_the_cliff_reference_can_resume_its_gait_after_a_recovery():
 @pytest.mark.parametrize("env_id", V1_IDS)
 def test_no_baseline_reaches_the_reference_on_benchmark_tasks(env_id):
     """The headroom targets on 8 benchmark test tasks (the full 50-task table is
-    scripts/benchmark_headroom.py): random actions never succeed, and neither the zero action
-    nor the best of the searched constant actions reaches the analytical controller."""
-    analytical, zero, random, constant = headroom(env_id, range(8), n_random_constants=2)
+    scripts/benchmark_headroom.py): random actions never succeed, and neither the zero action,
+    the open-loop replay of the controller's actions nor the best of the searched constant
+    actions reaches the analytical controller."""
+    analytical, zero, random, replay, constant = headroom(env_id, range(8), n_random_constants=2)
     assert analytical.success_rate >= 0.375
     assert random.success_rate == 0.0
     assert zero.success_rate < analytical.success_rate
+    assert replay.name == "open-loop replay"
+    assert replay.success_rate < analytical.success_rate
     assert constant.name.startswith("constant (")
     assert constant.success_rate < analytical.success_rate
 

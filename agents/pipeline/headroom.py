@@ -2,12 +2,14 @@
 
 On the benchmark's test tasks (`hexapod_envs.benchmark.BENCHMARK_SEEDS`) of one env id this runs
 the analytical controller, the zero action (the paper's motion without feedback), uniformly
-random actions and a search over constant actions (fixed action vectors: every entry at one
-bound, the mean of the analytical controller's actions, and seeded random vectors), and reports
+random actions, an open-loop replay of the controller's actions (each task gets the sequence the
+controller produced on the next task) and a search over constant actions (fixed action vectors:
+every entry at one bound, the mean of the analytical controller's actions, and seeded random
+vectors), and reports
 per policy the success rate, tip-overs, the median of the episodes' largest tilt and of their
 share of time tipping. docs/benchmark.md states the targets: the analytical controller succeeds
 on 40-85 % of the test tasks, the zero action on at most 40 %, random actions on at most 10 %,
-and no constant action reaches the analytical controller.
+and neither the open-loop replay nor any constant action reaches the analytical controller.
 
 `scripts/benchmark_headroom.py` prints the table for every ``-v1`` env; the tests run it on a few
 tasks.
@@ -23,7 +25,7 @@ import numpy as np
 
 from hexapod_envs import info_keys as keys
 
-from ..policy import Policy, RandomPolicy, ZeroPolicy
+from ..policy import Policy, RandomPolicy, ZeroPolicy, episode_infos
 from ..registry import ANALYTICAL_ENV_KWARGS, analytical_factory
 
 
@@ -72,18 +74,37 @@ class ConstantPolicy:
 
 
 class _Recording:
-    """A policy that keeps the actions it returns (to average the analytical controller's)."""
+    """A policy that keeps the actions it returns, one list per episode (for the mean action
+    and the open-loop replay)."""
 
     def __init__(self, policy: Policy):
-        self.policy, self.actions = policy, []
+        self.policy, self.episodes = policy, []
 
     def reset(self) -> None:
         self.policy.reset()
+        self.episodes.append([])
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:
         action = self.policy(observation)
-        self.actions.append(np.asarray(action, dtype=float))
+        self.episodes[-1].append(np.asarray(action))
         return action
+
+
+class ReplayPolicy:
+    """Open loop: episode k replays the recorded action sequence k, holding its last action
+    once the sequence runs out."""
+
+    def __init__(self, sequences: list[list[np.ndarray]]):
+        self.sequences, self._episode, self._step = sequences, -1, 0
+
+    def reset(self) -> None:
+        self._episode, self._step = self._episode + 1, 0
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        actions = self.sequences[self._episode % len(self.sequences)]
+        action = actions[min(self._step, len(actions) - 1)]
+        self._step += 1
+        return action.copy()
 
 
 def run_baseline(
@@ -99,14 +120,9 @@ def run_baseline(
     policy, result = make_policy(env), Baseline(name)
     try:
         for seed in seeds:
-            obs, info = env.reset(seed=int(seed))
             if isinstance(policy, RandomPolicy):
                 policy.seed = int(seed)
-            policy.reset()
-            done = False
-            while not done:
-                obs, _, terminated, truncated, info = env.step(policy(obs))
-                done = terminated or truncated
+            info = episode_infos(env, policy, seed=int(seed))[-1]
             result.episodes.append(
                 Episode(
                     seed=int(seed),
@@ -136,8 +152,10 @@ def constant_actions(shape: tuple[int, ...], mean_analytical: np.ndarray | None,
 
 
 def headroom(env_id: str, seeds: Iterable[int], n_random_constants: int = 4) -> list[Baseline]:
-    """The analytical controller, zero, random and the best constant action on `seeds` (test
-    tasks) of `env_id`; the best constant is named ``constant (<which>)``."""
+    """The analytical controller, zero, random, the open-loop replay of the controller's actions
+    (each task gets the action sequence the controller produced on the next one) and the best
+    constant action on `seeds` (test tasks) of `env_id`; the best constant is named
+    ``constant (<which>)``."""
     seeds = list(seeds)
     recorder: list[_Recording] = []
 
@@ -149,9 +167,16 @@ def headroom(env_id: str, seeds: Iterable[int], n_random_constants: int = 4) -> 
     rows = [run_baseline(env_id, "analytical", analytical, seeds, reference_kwargs)]
     rows.append(run_baseline(env_id, "zero", lambda env: ZeroPolicy(env.action_space), seeds))
     rows.append(run_baseline(env_id, "random", lambda env: RandomPolicy(env.action_space), seeds))
+    # Open loop: on each task, the actions the controller took on the next task (in its mode).
+    recorded = recorder[0].episodes
+    shifted = recorded[1:] + recorded[:1]
+    replay = run_baseline(
+        env_id, "open-loop replay", lambda env: ReplayPolicy(shifted), seeds, reference_kwargs
+    )
+    rows.append(replay)
     # The analytical controller's mean action is a constant action only in the mode it runs in.
     same_mode = not reference_kwargs.get("action_mode")
-    mean = np.mean(recorder[0].actions, axis=0) if same_mode else None
+    mean = np.mean([a for ep in recorded for a in ep], axis=0) if same_mode else None
     env = gym.make(env_id)
     shape = env.action_space.shape  # the default action mode's
     env.close()
