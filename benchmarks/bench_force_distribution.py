@@ -10,7 +10,7 @@ Prints median and 90th-percentile times [µs] per back end for
     daqp.solve directly, see force_distribution._solve_dense),
   - build (geometry, cone and constraint assembly from feet, CoG and wrench), with issue 14's
     target (<= 30 µs) beside it and, as "build, before", the assembly as it was before that
-    issue (the verbatim copy in tests/reference_force_distribution.py, when the tests are
+    issue (the verbatim copy in tests/helpers/reference_force_distribution.py, when the tests are
     there), timed in the same run,
   - the full build + solve of one control step.
 
@@ -69,12 +69,12 @@ BUILD_TARGET_US = 30.0  # issue 14
 
 
 def reference_build():
-    """The pre-issue-14 ForceDistributor.build (tests/reference_force_distribution.py), or
+    """The pre-issue-14 ForceDistributor.build (tests/helpers/reference_force_distribution.py), or
     None when the tests are not next to the benchmarks."""
     tests = Path(__file__).resolve().parents[1] / "tests"
     sys.path.insert(0, str(tests))
     try:
-        from reference_force_distribution import reference_build as build
+        from helpers.reference_force_distribution import reference_build as build
     except ImportError:
         return None
     finally:

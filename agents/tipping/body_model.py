@@ -128,7 +128,7 @@ class HeavyDutyBodyModel:
         A compiled kernel (:func:`agents.tipping._compiled.body_feet_and_cog`): on six legs
         numpy's per-call overhead cost more than the arithmetic. Its operations and summation
         order are those of the former array expressions, so the numbers are bit-identical to
-        them (tests/test_tipping_recovery.py).
+        them (tests/agents/tipping/test_tipping_recovery.py).
         """
         j = np.asarray(joints, dtype=float).reshape(6, 3)
         return _compiled.body_feet_and_cog(j, self.hips, self.l1, self._cog_consts, self._hip_sums)

@@ -42,7 +42,7 @@ def _row(id_, paper, quantity, paper_value, value, unit, tolerance, holds, setti
 def cliff_flat_walk_rows(cycles: int = 5) -> list[dict]:
     """Rows 1-3 (Zhang et al. 2024 §5.1): FASM standing, at the tripod switch, and its walking band.
 
-    Same protocol as tests/test_cliff_walk.py: 150 standing steps then `cycles` tripod cycles.
+    Same protocol as tests/hexapod_envs/envs/test_cliff_walk.py: 150 standing steps then `cycles` tripod cycles.
     """
     import gymnasium as gym
 

@@ -1,13 +1,13 @@
 """The cheap rows of the reproduction report, recomputed and compared with the committed JSON."""
 
 import json
-from pathlib import Path
 
 import pytest
+from helpers.paths import REPO
 
 from experiments.reproduction.rows import _isclose, collect, markdown
 
-COMMITTED = Path(__file__).resolve().parents[2] / "reports" / "reproduction.json"
+COMMITTED = REPO / "reports" / "reproduction.json"
 
 
 def test_cheap_rows_match_committed_report():

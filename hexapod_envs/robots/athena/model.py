@@ -21,7 +21,7 @@ first geom below, -1 if none; in the standing posture on flat ground it reads
 reads, in the site frame, the force that the foot body receives from its parent (the tibia); for a
 foot at rest that is minus the ground reaction force (plus the foot's 0.087 N weight), so
 rotate it to the world frame and multiply by `FOOT_FORCE_SIGN` (-1) to get the ground reaction
-(`tests/test_athena_model.py` checks this on a standing robot).
+(`tests/hexapod_envs/robots/athena/test_athena_model.py` checks this on a standing robot).
 
 Collisions: robot geoms have contype 1 / conaffinity 0 and terrain geoms contype 0 /
 conaffinity 1 (the convention of `hexapod_envs.terrain`), so the robot touches the terrain and
@@ -48,7 +48,7 @@ _FOOT_RGBA = [0.1, 0.1, 0.1, 1.0]
 FOOT_FORCE_SIGN = -1.0
 """Multiply the `L_foot_force` reading (rotated from the site to the world frame) by this to get
 the ground reaction force acting on the foot, up to the foot's own weight and inertia (0.087 N).
-Measured in `tests/test_athena_model.py`."""
+Measured in `tests/hexapod_envs/robots/athena/test_athena_model.py`."""
 
 
 @dataclass(frozen=True)

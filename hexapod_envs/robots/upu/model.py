@@ -28,7 +28,7 @@ Structure (names follow the package's model-building contract where it applies):
   force sensor reads the force the leg exerts on the foot, in the site frame (parallel to its
   platform's frame); for a foot at rest the ground reaction force on it is
   -R_site @ sensor - foot_mass * g with g = (0, 0, -9.81) m/s^2 (world frame), checked by
-  tests/test_upu_model.py.
+  tests/hexapod_envs/robots/upu/test_upu_model.py.
 
 Command modes (`add_upu(..., command=...)`): ``"position"`` (default): each actuator's ctrl is
 its target (limb length or leg extension [m]). ``"interpolated"``: the servo target is the

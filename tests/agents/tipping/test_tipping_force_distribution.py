@@ -310,8 +310,8 @@ def test_build_is_bit_identical_to_the_original_assembly():
     The compiled products call scipy's BLAS where the original called numpy's; the test skips
     itself where those two differ in the last bit (not on the machines this was built on).
     """
-    from blas_bits import REASON, numba_blas_matches_numpy
-    from reference_force_distribution import reference_build
+    from helpers.blas_bits import REASON, numba_blas_matches_numpy
+    from helpers.reference_force_distribution import reference_build
 
     if not numba_blas_matches_numpy():
         pytest.skip(REASON)

@@ -3,7 +3,7 @@
 import gymnasium as gym
 import numpy as np
 import pytest
-from blas_bits import REASON, numba_blas_matches_numpy
+from helpers.blas_bits import REASON, numba_blas_matches_numpy
 
 import hexapod_envs  # noqa: F401
 from hexapod_envs.envs._compiled import (

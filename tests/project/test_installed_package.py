@@ -11,17 +11,16 @@ import sys
 from pathlib import Path
 
 import pytest
+from helpers.paths import REPO
 
 from agents.pipeline.shipped import resolve_shipped, shipped_root
-
-ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_shipped_configs_and_models_resolve_from_another_folder(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
-    assert shipped_root() == ROOT  # a source checkout reads the repository root
+    assert shipped_root() == REPO  # a source checkout reads the repository root
     config = resolve_shipped("configs/evaluate_default.yaml")
-    assert config == ROOT / "configs" / "evaluate_default.yaml"
+    assert config == REPO / "configs" / "evaluate_default.yaml"
     model = resolve_shipped(Path("models", "HexapodCliffWalk-v0", "ppo"))
     assert (model / "model.zip").is_file()
     assert resolve_shipped("configs/no_such.yaml") == Path("configs/no_such.yaml")  # as given
@@ -45,7 +44,7 @@ def _source_copy(dest: Path) -> Path:
         ".git", "build", "dist", "reports", "runs", "*.egg-info", "__pycache__", ".*cache",
         ".venv", "_shipped",
     )  # fmt: skip
-    shutil.copytree(ROOT, dest, ignore=ignore)
+    shutil.copytree(REPO, dest, ignore=ignore)
     return dest
 
 

@@ -9,37 +9,13 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import yaml
+from helpers.paths import REPO
+from helpers.stewart_hybrid_runs import STEWART, TINY, train
 
 from agents.hybrid import HybridPolicy
 from agents.pipeline.cli import evaluate_main, train_main
 from agents.pipeline.learning_curve import load_learning_curve
 from agents.ppo import PPOPolicy
-
-ROOT = Path(__file__).resolve().parents[1]
-STEWART = str(ROOT / "configs" / "stewart_tilt_hybrid.yaml")
-TINY = [
-    "vec_env.n_envs=1",
-    "ppo.n_steps=128",
-    "ppo.batch_size=64",
-    "ppo.n_epochs=1",
-    "policy.pi=[16, 16]",
-    "policy.vf=[16, 16]",
-    "train.total_timesteps=256",
-    "env.max_episode_steps=64",
-    "eval.freq=128",
-    "eval.n_episodes=2",
-    "checkpoint.freq=0",
-    "logging.progress_bar=false",
-    "logging.tensorboard=false",
-]
-
-
-def train(tmp: Path, name: str, *overrides: str, config: str = STEWART) -> Path:
-    argv = ["--config", config, "--output-dir", str(tmp), "--run-name", name]
-    for o in [*TINY, *overrides]:
-        argv += ["--set", o]
-    assert train_main(argv) == 0
-    return tmp / name
 
 
 def evaluate(
@@ -132,7 +108,7 @@ def test_evaluate_runs_a_hybrid_in_its_trained_action_mode(tmp_path):
     """The cliff hybrid trains in the residual mode with residual_scale 2: evaluate.py builds
     that env for it (the suite's env keeps the defaults), and a direct load into an env in
     another action mode is refused with both modes named."""
-    run = train(tmp_path, "cliff", config=str(ROOT / "configs" / "cliff_walk_hybrid.yaml"))
+    run = train(tmp_path, "cliff", config=str(REPO / "configs" / "cliff_walk_hybrid.yaml"))
     assert evaluate(tmp_path / "rep", "zero", f"ppo:{run}", env="HexapodCliffWalk-v0") == 0
     metrics = json.loads((tmp_path / "rep" / "metrics.json").read_text())
     assert metrics["envs"]["HexapodCliffWalk-v0"]["policies"][f"ppo:{run}"]["episodes"]

@@ -5,7 +5,7 @@ import math
 
 import numpy as np
 import pytest
-from blas_bits import REASON, numba_blas_matches_numpy
+from helpers.blas_bits import REASON, numba_blas_matches_numpy
 
 from hexapod_envs.robots.athena import kinematics as kin
 from hexapod_envs.robots.athena.params import (

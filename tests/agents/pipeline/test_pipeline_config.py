@@ -1,12 +1,11 @@
 """Pipeline building blocks without training: typed configs, overrides, schedules, episode
 statistics, the env evaluation-metrics hook, aggregates and verdicts, the analytical registry."""
 
-from pathlib import Path
-
 import gymnasium as gym
 import numpy as np
 import pytest
 import yaml
+from helpers.paths import REPO
 
 import hexapod_envs  # noqa: F401
 from agents.pipeline.configtools import apply_overrides, dump_yaml, from_mapping
@@ -18,7 +17,7 @@ from agents.pipeline.summary import aggregate, compare, paired_difference_interv
 from agents.pipeline.train_config import TrainConfig, load_train_config
 from agents.registry import analytical_factory, analytical_policy
 
-CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+CONFIGS = REPO / "configs"
 TRAIN_CONFIGS = {
     "cliff_walk_ppo.yaml": "HexapodCliffWalk-v0",
     "stewart_tilt_ppo.yaml": "HexapodStewartTilt-v0",

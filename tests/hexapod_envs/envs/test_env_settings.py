@@ -19,7 +19,7 @@ from hexapod_envs.envs.stewart_tilt import TILT_TEST, TILT_TRAIN
 ENV_IDS = sorted(k for k in gym.registry if k.startswith("Hexapod"))
 V0_IDS = [env_id for env_id in ENV_IDS if env_id.endswith("-v0")]
 """The -v0 envs, whose test ranges lie outside the training ranges; the -v1 benchmark's test
-tasks are at least as hard instead (tests/test_benchmark_v1.py)."""
+tasks are at least as hard instead (tests/hexapod_envs/test_benchmark_v1.py)."""
 
 
 def _settings_class(env_id):

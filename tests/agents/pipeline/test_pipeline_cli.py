@@ -11,41 +11,13 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import yaml
+from helpers.cliff_ppo_runs import CONFIG, TINY, evaluate, meta, train
+from helpers.paths import REPO
 
 from agents.pipeline import callbacks
 from agents.pipeline.cli import evaluate_main, train_main
 from agents.pipeline.env_settings import read_settings, resolved_settings
 from agents.ppo import PPOPolicy
-
-ROOT = Path(__file__).resolve().parents[1]
-CONFIG = str(ROOT / "configs" / "cliff_walk_ppo.yaml")
-TINY = [
-    "vec_env.n_envs=1",
-    "ppo.n_steps=256",
-    "ppo.batch_size=64",
-    "ppo.n_epochs=1",
-    "policy.pi=[32, 32]",
-    "policy.vf=[32, 32]",
-    "train.total_timesteps=1024",
-    "env.max_episode_steps=100",
-    "eval.freq=512",
-    "eval.n_episodes=1",
-    "checkpoint.freq=512",
-    "logging.progress_bar=false",
-]
-
-
-def sets(overrides):
-    return [arg for o in overrides for arg in ("--set", o)]
-
-
-def train(tmp, name, *extra, overrides=TINY):
-    argv = ["--config", CONFIG, "--output-dir", str(tmp), "--run-name", name]
-    return train_main([*argv, *sets(overrides), *extra])
-
-
-def meta(path: Path) -> dict:
-    return json.loads((path / "meta.json").read_text())
 
 
 @pytest.fixture(scope="module")
@@ -183,7 +155,7 @@ def test_env_id_typo_lists_registered_hexapod_ids(tmp_path, capsys):
 def test_cli_user_errors_have_no_traceback(tmp_path):
     result = subprocess.run(
         [sys.executable, "train.py", "--config", CONFIG, "--set", "env.id=NoSuchEnv-v0"],
-        cwd=ROOT,
+        cwd=REPO,
         capture_output=True,
         text=True,
     )
@@ -193,12 +165,6 @@ def test_cli_user_errors_have_no_traceback(tmp_path):
 
 
 # --- evaluate.py ---------------------------------------------------------------------------------
-def evaluate(out, *policies, extra=()):
-    argv = ["--envs", "HexapodCliffWalk-v0", "--episodes", "2", "--max-episode-steps", "60"]
-    argv += ["--output-dir", str(out), "--no-progress", "--policies", *policies]
-    return evaluate_main([*argv, *extra])
-
-
 def test_evaluate_smoke_writes_json_markdown_and_html_rows(run, tmp_path, capsys):
     ppo = f"ppo:{run[0]}"
     assert evaluate(tmp_path / "rep", "analytical", "zero", "random", ppo) == 0

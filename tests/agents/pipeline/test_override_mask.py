@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 import torch
 import yaml
+from helpers.stewart_hybrid_runs import STEWART, train
 from stable_baselines3.common.buffers import RolloutBuffer
-from test_hybrid_pipeline import STEWART, train
 
 from agents.pipeline.model_files import load_ppo, ppo_custom_objects
 from agents.pipeline.override_mask import OverrideMaskedRolloutBuffer

@@ -19,7 +19,8 @@ import cloudpickle
 import gymnasium as gym
 import numpy as np
 import pytest
-from test_pipeline_cli import CONFIG, ROOT, TINY, evaluate, meta, sets, train
+from helpers.cliff_ppo_runs import CONFIG, TINY, evaluate, meta, sets, train
+from helpers.paths import REPO
 
 from agents.pipeline import callbacks, training
 from agents.pipeline.cli import train_main
@@ -115,7 +116,7 @@ def test_shipped_models_load_without_pickle():
 
     import hexapod_envs  # noqa: F401  (registers the env ids)
 
-    model_dirs = sorted(p.parent for p in (ROOT / "models").glob("*/*/model.zip"))
+    model_dirs = sorted(p.parent for p in (REPO / "models").glob("*/*/model.zip"))
     assert {d.name for d in model_dirs} >= {"ppo", "hybrid", "gains"}
     for model_dir in model_dirs:
         assert not list(model_dir.glob("*.pkl")), model_dir
@@ -359,9 +360,9 @@ def test_sigint_to_the_parent_alone_ends_training_with_a_loadable_checkpoint(tmp
         "checkpoint.freq=512",
         "eval.freq=0",
     ]
-    argv = [sys.executable, str(ROOT / "train.py"), "--config", CONFIG]
+    argv = [sys.executable, str(REPO / "train.py"), "--config", CONFIG]
     argv += ["--output-dir", str(tmp_path), "--run-name", "sig", *sets(overrides)]
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
     proc = subprocess.Popen(argv, cwd=tmp_path, env=env, stderr=subprocess.PIPE, text=True)
     try:
         deadline = time.monotonic() + 240
@@ -393,7 +394,7 @@ def test_a_second_interrupt_while_saving_exits_at_once(tmp_path):
         "    os.kill(os.getpid(), signal.SIGINT)\n"
         "    time.sleep(30)\n"
     )
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    env = {**os.environ, "PYTHONPATH": str(REPO)}
     start = time.monotonic()
     done = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, timeout=60)
     assert done.returncode == 130 and time.monotonic() - start < 20

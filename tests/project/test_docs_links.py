@@ -5,13 +5,13 @@ import re
 from pathlib import Path
 
 import pytest
+from helpers.paths import REPO
 
-ROOT = Path(__file__).resolve().parents[1]
 PAGES = [
-    ROOT / "README.md",
-    ROOT / "benchmarks" / "README.md",
-    *sorted((ROOT / "docs").glob("*.md")),
-    *sorted((ROOT / "experiments").glob("*/README.md")),
+    REPO / "README.md",
+    REPO / "benchmarks" / "README.md",
+    *sorted((REPO / "docs").glob("*.md")),
+    *sorted((REPO / "experiments").glob("*/README.md")),
 ]
 LINK = re.compile(r"\]\(([^)\s]+)\)")
 
@@ -31,7 +31,7 @@ def test_anchor_follows_github():
     assert anchor("Hybrid policies: learning on top") == "hybrid-policies-learning-on-top"
 
 
-@pytest.mark.parametrize("page", PAGES, ids=lambda p: str(p.relative_to(ROOT)))
+@pytest.mark.parametrize("page", PAGES, ids=lambda p: str(p.relative_to(REPO)))
 def test_relative_links_resolve(page):
     broken = []
     for target in LINK.findall(page.read_text()):
@@ -40,7 +40,7 @@ def test_relative_links_resolve(page):
         path, _, fragment = target.partition("#")
         file = (page.parent / path).resolve() if path else page
         if not file.exists():
-            broken.append(f"{target}: no file {file.relative_to(ROOT)}")
+            broken.append(f"{target}: no file {file.relative_to(REPO)}")
         elif fragment and file.suffix == ".md" and fragment not in anchors(file):
             broken.append(f"{target}: no heading with anchor #{fragment}")
-    assert not broken, f"{page.relative_to(ROOT)}: " + "; ".join(broken)
+    assert not broken, f"{page.relative_to(REPO)}: " + "; ".join(broken)

@@ -4,7 +4,7 @@ expressions they replaced, bit for bit (random inputs of the controller's sizes)
 import mujoco
 import numpy as np
 import pytest
-from blas_bits import REASON, numba_blas_matches_numpy
+from helpers.blas_bits import REASON, numba_blas_matches_numpy
 
 from agents.tipping import _compiled
 from agents.tipping.body_model import forces_to_body, quat_to_matrix

@@ -3,19 +3,15 @@ env skeleton's signatures (no timing assertions)."""
 
 import math
 import re
-import sys
-from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the benchmarks package
+import gymnasium as gym
 
-import gymnasium as gym  # noqa: E402
-
-import hexapod_envs  # noqa: E402, F401
-from benchmarks.bench_irregular_terrain import (  # noqa: E402
+import hexapod_envs  # noqa: F401
+from benchmarks.bench_irregular_terrain import (
     env_piece_costs,
     print_training_task_rates,
 )
-from benchmarks.common import (  # noqa: E402
+from benchmarks.common import (
     STEP_PIECES,
     random_action_rates,
     replay_step_rate,

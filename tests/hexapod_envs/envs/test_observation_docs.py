@@ -1,10 +1,10 @@
 """docs/observations.md is the rendering of the envs' observation_structure (kept in sync)."""
 
-from pathlib import Path
+from helpers.paths import REPO
 
 from hexapod_envs.observation_docs import render
 
-PAGE = Path(__file__).resolve().parents[1] / "docs" / "observations.md"
+PAGE = REPO / "docs" / "observations.md"
 
 
 def test_observation_page_matches_the_code():

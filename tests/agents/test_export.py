@@ -2,11 +2,11 @@
 gives the torch policy's deterministic actions, and its model card describes the model."""
 
 import json
-from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
 import pytest
+from helpers.paths import REPO
 
 import hexapod_envs  # noqa: F401  (registers the envs)
 from agents.export import card_paths, export_main, export_model
@@ -14,8 +14,6 @@ from agents.hybrid import HybridPolicy
 from agents.ppo import PPOPolicy
 
 ort = pytest.importorskip("onnxruntime")
-
-ROOT = Path(__file__).resolve().parents[1]
 
 
 def _recorded_observations(env, policy, steps=60, seed=3):
@@ -46,7 +44,7 @@ def _onnx_actions(path, observations):
     "model", ["HexapodCliffWalk-v0/ppo", "HexapodIrregularTerrain-v0/gains"]
 )  # a plain PPO model; a hybrid one whose learned part acts once per gait cycle
 def test_onnx_actions_equal_the_torch_policy(tmp_path, model):
-    model_dir = ROOT / "models" / model
+    model_dir = REPO / "models" / model
     result = export_model(model_dir, tmp_path / "actor.onnx")
     card = result.card
     env = gym.make(card["env"]["id"], **card["env"]["kwargs"])
@@ -80,7 +78,7 @@ def _report(path, rates):
 
 
 def test_model_card(tmp_path):
-    model_dir = ROOT / "models" / "HexapodCliffWalk-v0" / "hybrid"
+    model_dir = REPO / "models" / "HexapodCliffWalk-v0" / "hybrid"
     out = tmp_path / "out" / "cliff.onnx"
     rates = {"analytical": 0.8, "random": 0.2, "ppo:models/{env_id}/hybrid": 0.5}
     rates["ppo:models/{env_id}/ppo"] = 1.0  # another model: not this card's
@@ -110,7 +108,7 @@ def test_model_card(tmp_path):
 
 def test_cli_refuses_to_overwrite_without_force(tmp_path, capsys):
     out = tmp_path / "a.onnx"
-    argv = [str(ROOT / "models" / "HexapodCliffWalk-v0" / "ppo"), "--output", str(out)]
+    argv = [str(REPO / "models" / "HexapodCliffWalk-v0" / "ppo"), "--output", str(out)]
     assert export_main(argv) == 0
     assert out.is_file() and all(p.is_file() for p in card_paths(out))
     assert export_main(argv) == 2

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from sweep_helpers import REPO, free_port, is_gone, loopback_cluster, tiny_sweep, wait_until
+from helpers.sweep_helpers import REPO, free_port, is_gone, loopback_cluster, tiny_sweep, wait_until
 
 from agents.pipeline.cli import evaluate_main
 from agents.pipeline.errors import ConfigError

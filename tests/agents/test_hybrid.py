@@ -1,18 +1,17 @@
 """Hybrid policies (agents/hybrid.py): a zero residual is the analytical controller, exactly, in
 the action modes the shipped configs use; the safety override and its hysteresis."""
 
-from pathlib import Path
-
 import gymnasium as gym
 import numpy as np
 import pytest
+from helpers.paths import REPO
 
 import hexapod_envs  # noqa: F401  (registers the env ids)
 from agents.hybrid import HybridCore, HybridPolicy, HybridSettings, HybridWrapper
 from agents.pipeline.train_config import load_train_config
 from agents.registry import analytical_policy
 
-CONFIGS = Path(__file__).resolve().parents[1] / "configs"
+CONFIGS = REPO / "configs"
 HYBRID_CONFIGS = [  # residual mode: a zero learned action is the analytical controller
     "stewart_tilt_hybrid.yaml",
     "irregular_terrain_hybrid.yaml",
@@ -329,7 +328,7 @@ def test_a_hybrid_model_refuses_an_env_that_reads_its_action_otherwise():
     from agents.pipeline.errors import UserError
     from agents.ppo import PPOPolicy
 
-    model = Path(__file__).resolve().parents[1] / "models" / "HexapodCliffWalk-v0" / "hybrid"
+    model = REPO / "models" / "HexapodCliffWalk-v0" / "hybrid"
     with pytest.raises(UserError, match=r"residual_scale=2.0 but the env has residual_scale=0.25"):
         PPOPolicy.load(model, gym.make("HexapodCliffWalk-v0"))
     PPOPolicy.load(model, gym.make("HexapodCliffWalk-v0", residual_scale=2.0))

@@ -3,6 +3,7 @@
 import gymnasium as gym
 import numpy as np
 import pytest
+from helpers.paths import REPO
 
 import hexapod_envs  # noqa: F401  (registers the env ids)
 from hexapod_envs.wrappers import GainsPerCycle
@@ -138,12 +139,11 @@ def test_a_gait_cycle_run_trains_per_cycle_and_evaluates_per_step(tmp_path):
     """train.py with env.decision=gait_cycle: the learner's steps are gait cycles (64 of them,
     far more than 64 env steps), the evaluations play whole episodes of env steps, and the saved
     model plays the env at every step, as evaluate.py does."""
-    from pathlib import Path
 
     from agents.pipeline.cli import train_main
     from agents.ppo import PPOPolicy
 
-    config = Path(__file__).resolve().parents[1] / "configs" / "irregular_terrain_gains.yaml"
+    config = REPO / "configs" / "irregular_terrain_gains.yaml"
     overrides = [
         "ppo.n_steps=32",
         "ppo.batch_size=32",

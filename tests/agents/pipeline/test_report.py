@@ -128,7 +128,7 @@ def test_envs_option_keeps_the_suite_kwargs(tmp_path):
 
 
 def test_sampled_tasks_are_broken_down_and_run_dirs_give_learning_curves(tmp_path):
-    from test_pipeline_cli import TINY, train
+    from helpers.cliff_ppo_runs import TINY, train
 
     assert train(tmp_path, "tiny", overrides=TINY) == 0
     out = tmp_path / "rep"

@@ -17,7 +17,8 @@ import ast
 from functools import cache
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+from helpers.paths import REPO
+
 INSTALLED = ("hexapod_envs", "agents")
 PACKAGES = (*INSTALLED, "experiments")
 NOT_INSTALLED = ("experiments", "scripts", "benchmarks", "tests")
@@ -40,8 +41,8 @@ def modules() -> dict[str, Path]:
     """Dotted name -> file of every module of the project's packages."""
     found = {}
     for package in PACKAGES:
-        for path in (ROOT / package).rglob("*.py"):
-            parts = list(path.relative_to(ROOT).with_suffix("").parts)
+        for path in (REPO / package).rglob("*.py"):
+            parts = list(path.relative_to(REPO).with_suffix("").parts)
             if parts[-1] == "__init__":
                 parts.pop()
             found[".".join(parts)] = path
@@ -118,7 +119,7 @@ def cycles() -> list[set[str]]:
 
 
 def _where(module: str, target: str) -> str:
-    path = modules()[module].relative_to(ROOT)
+    path = modules()[module].relative_to(REPO)
     return f"{path}:{graph()[module][target]} imports {target}"
 
 
@@ -151,7 +152,7 @@ def test_installed_modules_import_no_study_script_benchmark_or_test():
             continue
         for name, line in imported_names(module, path):
             if name.split(".")[0] in NOT_INSTALLED:
-                offences.append(f"{path.relative_to(ROOT)}:{line} imports {name}")
+                offences.append(f"{path.relative_to(REPO)}:{line} imports {name}")
     assert not offences, "\n".join(offences)
 
 

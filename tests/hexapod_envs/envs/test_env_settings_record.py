@@ -4,6 +4,7 @@ difference, how it is worded, and the warning when a run is resumed on a changed
 from pathlib import Path
 
 import gymnasium as gym
+from helpers.paths import REPO
 
 from agents.pipeline.env_settings import (
     describe,
@@ -14,8 +15,6 @@ from agents.pipeline.env_settings import (
 )
 from agents.pipeline.train_config import load_train_config
 from agents.pipeline.training import _warn_if_settings_changed, env_spec
-
-ROOT = Path(__file__).resolve().parents[1]
 
 TRAINED = {
     "physics_dt": 0.002,
@@ -110,7 +109,7 @@ def test_a_model_saved_without_settings_drops_an_earlier_record(tmp_path):
 def test_every_shipped_agent_records_the_env_it_was_trained_on_and_the_code_still_builds_it():
     """A default changed in the code (a physics step, a servo gain) fails here for every shipped
     agent trained on the former one, instead of silently evaluating it on another env."""
-    models = sorted(p.parent for p in (ROOT / "models").glob("*/*/model.zip"))
+    models = sorted(p.parent for p in (REPO / "models").glob("*/*/model.zip"))
     assert len(models) >= 10
     for model_dir in models:
         recorded = read_settings(model_dir)
