@@ -1,8 +1,17 @@
-"""Argument checks shared by the robots, terrains and envs: one wording for every error."""
+"""Argument checks shared by the robots, terrains, envs and env settings: one wording for every
+error.
+
+Bad input raises a ValueError that names the argument and its valid range or choices
+(docs/architecture.md, "Conventions"). `check_number` checks a plain float argument of a robot,
+terrain or gait; the env settings (`hexapod_envs.envs.settings`) build their field checks from
+`check_real`, `within`, `range_text` and `check_choice`.
+"""
 
 from __future__ import annotations
 
 import math
+import numbers
+from typing import Any
 
 
 def check_number(name: str, value: float, *, low: float = 0.0, strict: bool = False) -> float:
@@ -12,7 +21,44 @@ def check_number(name: str, value: float, *, low: float = 0.0, strict: bool = Fa
         x = float(value)
     except (TypeError, ValueError):
         x = math.nan
-    if not (math.isfinite(x) and (x > low if strict else x >= low)):
-        bound = f"{'>' if strict else '>='} {low:g}"
+    if not (math.isfinite(x) and within(x, low, None, strict)):
+        bound = range_text(low, None, strict)
         raise ValueError(f"{name} must be a finite number {bound}, got {value!r}")
     return x
+
+
+def check_real(name: str, value: Any, shown: Any) -> float:
+    """`value` as a float if it is a finite real number (not a bool, string or complex);
+    otherwise a ValueError naming `name` and showing `shown` (the value, or the tuple it came
+    from)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise ValueError(f"{name} must be a real number, got {shown!r} ({type(value).__name__})")
+    x = float(value)
+    if not math.isfinite(x):
+        raise ValueError(f"{name} must be finite, got {shown!r}")
+    return x
+
+
+def check_choice(name: str, value: Any, choices) -> None:
+    """Raise a ValueError naming `name`, the bad value and the valid choices (a flag among
+    them takes a bool only: 1 is not True here)."""
+    is_flag = any(isinstance(c, bool) for c in choices)
+    if value not in choices or (is_flag and value is not None and not isinstance(value, bool)):
+        valid = sorted(choices, key=repr)
+        raise ValueError(f"{name} must be one of {valid}, got {value!r}")
+
+
+def within(x: float, low: float | None, high: float | None, strict: bool = False) -> bool:
+    """Whether `x` >= `low` (> with `strict`) and <= `high`; a bound of None is no bound."""
+    too_low = low is not None and (x <= low if strict else x < low)
+    return not (too_low or (high is not None and x > high))
+
+
+def range_text(low: float | None, high: float | None, strict: bool = False) -> str:
+    """The valid range as an error message states it: ">= 0", "> 0 and <= 90"."""
+    parts = []
+    if low is not None:
+        parts.append(f"{'>' if strict else '>='} {low:g}")
+    if high is not None:
+        parts.append(f"<= {high:g}")
+    return " and ".join(parts)

@@ -21,6 +21,8 @@ import numbers as _numbers
 from collections.abc import Callable, Mapping
 from typing import Any, ClassVar
 
+from ..checks import check_choice, check_real, range_text, within
+
 TASK_DISTRIBUTIONS = ("paper", "train", "test")
 """``task_distribution`` values: the paper's scenario (plus small reset noise), or task and
 physical parameters sampled at every reset from the env's training or held-out test ranges."""
@@ -34,33 +36,6 @@ RENAMED = {
     "progress_weight": "forward_weight",
 }
 """Settings that were renamed (old -> new), so that an old name gets a pointed message."""
-
-
-def check_choice(name: str, value: Any, choices) -> None:
-    """Raise a ValueError naming `name`, the bad value and the valid choices (a flag among
-    them takes a bool only: 1 is not True here)."""
-    is_flag = any(isinstance(c, bool) for c in choices)
-    if value not in choices or (is_flag and value is not None and not isinstance(value, bool)):
-        valid = sorted(choices, key=repr)
-        raise ValueError(f"{name} must be one of {valid}, got {value!r}")
-
-
-def _check_real(name: str, value: Any, shown: Any) -> float:
-    if isinstance(value, bool) or not isinstance(value, _numbers.Real):
-        raise ValueError(f"{name} must be a real number, got {shown!r} ({type(value).__name__})")
-    x = float(value)
-    if not math.isfinite(x):
-        raise ValueError(f"{name} must be finite, got {shown!r}")
-    return x
-
-
-def _range_text(low, high, strict) -> str:
-    parts = []
-    if low is not None:
-        parts.append(f"{'>' if strict else '>='} {low:g}")
-    if high is not None:
-        parts.append(f"<= {high:g}")
-    return " and ".join(parts)
 
 
 def number(
@@ -81,10 +56,9 @@ def number(
             return
         if integer and (isinstance(value, bool) or not isinstance(value, _numbers.Integral)):
             raise ValueError(f"{name} must be an integer, got {value!r} ({type(value).__name__})")
-        x = _check_real(name, value, value)
-        too_low = low is not None and (x <= low if strict else x < low)
-        if too_low or (high is not None and x > high):
-            raise ValueError(f"{name} must be {_range_text(low, high, strict)}, got {value!r}")
+        x = check_real(name, value, value)
+        if not within(x, low, high, strict):
+            raise ValueError(f"{name} must be {range_text(low, high, strict)}, got {value!r}")
 
     return dataclasses.field(default=default, metadata=_numeric(check, low))
 
@@ -115,10 +89,10 @@ def numbers(
             raise ValueError(f"{name} must have {size} entries, got {value!r}")
         items = [v for item in value for v in (item if isinstance(item, (tuple, list)) else [item])]
         for x in items:
-            x = _check_real(name, x, value)
-            if (low is not None and x < low) or (high is not None and x > high):
+            x = check_real(name, x, value)
+            if not within(x, low, high):
                 raise ValueError(
-                    f"{name} entries must be {_range_text(low, high, False)}, got {value!r}"
+                    f"{name} entries must be {range_text(low, high, False)}, got {value!r}"
                 )
         pairs = [value] if not isinstance(value[0], (tuple, list)) else value
         if ordered and any(len(p) != 2 or p[0] > p[1] for p in pairs):
@@ -216,7 +190,7 @@ class TaskRanges:
             value = _as_tuples(getattr(self, f.name))  # lists (e.g. from YAML) as tuples
             object.__setattr__(self, f.name, value)
             if _shape(value) == _NUMBER:
-                numbers = (_check_real(f.name, value, value),)
+                numbers = (check_real(f.name, value, value),)
             elif isinstance(value, tuple) and value and not isinstance(value[0], str):
                 pairs = value if isinstance(value[0], tuple) else (value,)
                 for pair in pairs:
@@ -240,11 +214,10 @@ class TaskRanges:
             return
         low, high, strict = f.metadata["bounds"]
         for x in numbers:
-            too_low = low is not None and (x <= low if strict else x < low)
-            if too_low or (high is not None and x > high):
+            if not within(x, low, high, strict):
                 raise ValueError(
                     f"{type(self).__name__}.{f.name} entries must be "
-                    f"{_range_text(low, high, strict)}, got {value!r}"
+                    f"{range_text(low, high, strict)}, got {value!r}"
                 )
 
 

@@ -1,11 +1,11 @@
-"""The shared argument check: finite numbers in range pass as floats, the rest name themselves."""
+"""The shared argument checks: finite numbers in range pass as floats, the rest name themselves."""
 
 import math
 
 import numpy as np
 import pytest
 
-from hexapod_envs.checks import check_number
+from hexapod_envs.checks import check_choice, check_number, check_real, range_text, within
 
 
 def test_in_range_values_come_back_as_floats():
@@ -21,3 +21,14 @@ def test_in_range_values_come_back_as_floats():
 def test_out_of_range_values_name_the_argument_and_the_bound(value, strict, bound):
     with pytest.raises(ValueError, match=f"servo_kp must be a finite number {bound}, got"):
         check_number("servo_kp", value, strict=strict)
+
+
+def test_the_settings_checks_share_the_wording():
+    assert within(0.0, 0.0, None) and not within(0.0, 0.0, None, strict=True)
+    assert not within(2.0, None, 1.0) and within(-5.0, None, 1.0)
+    assert range_text(0.0, 90.0, strict=True) == "> 0 and <= 90"
+    assert check_real("x", np.float64(2.0), 2.0) == 2.0
+    with pytest.raises(ValueError, match=r"x must be a real number, got \(1, 'a'\) \(str\)"):
+        check_real("x", "a", (1, "a"))
+    with pytest.raises(ValueError, match=r"flag must be one of \[False, True\], got 1"):
+        check_choice("flag", 1, (True, False))
