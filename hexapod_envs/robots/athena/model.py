@@ -37,7 +37,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from ..sensors import add_foot_force_sensor, add_imu_sensors
+from ..sensor_spec import add_foot_force_sensor, add_imu_sensors
 from .params import ATHENA, JOINT_NAMES, LEG_NAMES, AthenaParams
 
 _COLLIDE_GROUND = 1  # contype bit that terrain geoms accept (their conaffinity)

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from ..sensors import add_foot_force_sensor, add_imu_sensors
+from ..sensor_spec import add_foot_force_sensor, add_imu_sensors
 from .params import JOINT_NAMES, LEG_NAMES, HeavyDutyParams
 
 _COLLIDE_GROUND = 1  # contype/conaffinity bit shared with terrain geoms

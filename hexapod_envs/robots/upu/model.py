@@ -53,7 +53,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from ..sensors import add_foot_force_sensor, add_imu_sensors
+from ..sensor_spec import add_foot_force_sensor, add_imu_sensors
 from .kinematics import inverse_kinematics
 from .params import (
     LEG_NAMES,

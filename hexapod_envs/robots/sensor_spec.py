@@ -1,4 +1,5 @@
-"""The sensors every robot model carries, under the names `envs.sensors.RobotSensors` reads.
+"""The sensors every robot model carries, added to its `MjSpec` when the model is built, under the
+names `hexapod_envs.envs.sensors.RobotSensors` reads at run time.
 
 - IMU on site ``imu``: ``imu_gyro`` (angular velocity), ``imu_accel`` (accelerometer) and
   ``imu_quat`` (orientation of the site's body).
