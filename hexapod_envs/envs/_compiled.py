@@ -4,20 +4,21 @@ Every control step ends with the sensor model: foot forces rotated to the world 
 contact test, the CoG, the FASM over the loaded feet and the actuator power. As a dozen numpy
 calls right after MuJoCo's physics (which leaves the caches cold) it cost 35-50 µs per step,
 about a tenth of the cliff walk's physics. :func:`heavy_duty_measure` (the heavy-duty and
-ATHENA envs, through `RobotSensors.support`) and :func:`upu_measure` (the ditch) do it in one
-call with the same arithmetic in the same order: the rotations are ``np.dot`` calls, i.e. the
-BLAS routine numpy's ``@`` calls (numba binds it through scipy's BLAS; the same bits where the
-two libraries agree, as they do on the machines this was measured on), the power is summed in
-numpy's pairwise order, and the FASM and the static margin are the stability module's kernels.
-`heavy_duty_measure` writes into the caller's buffers rather than returning new arrays.
+ATHENA envs, through `RobotSensors.support`) does it in one call with the same arithmetic in the
+same order: the rotations are ``np.dot`` calls, i.e. the BLAS routine numpy's ``@`` calls (numba
+binds it through scipy's BLAS; the same bits where the two libraries agree, as they do on the
+machines this was measured on), the power is summed in numpy's pairwise order
+(`hexapod_envs._compiled.actuator_power`), and the FASM is the stability module's kernel. It
+writes into the caller's buffers rather than returning new arrays.
 
 The rest of a step's Python is compiled the same way where it is element-wise work on a few
 dozen numbers: the action check and clip (:func:`clip_action`), the residual modes' servo
 targets (:func:`filtered_residual_targets` with the heavy-duty envs' filter,
 :func:`offset_targets` on ATHENA's controller), the observation's sensor pieces
 (:func:`sensor_observation`), each with numpy's arithmetic (the tests compare them bit for
-bit). The Stewart platform's actuator lengths that the tilt env reports are compiled with the
-platform (`hexapod_envs.terrain._compiled`).
+bit). Kernels of one robot or terrain live with it: the 3-UPU robot's measurement
+(`hexapod_envs.robots.upu._compiled.upu_measure`) and the Stewart platform's actuator lengths
+that the tilt env reports (`hexapod_envs.terrain._compiled`).
 """
 
 from __future__ import annotations
@@ -25,44 +26,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from hexapod_envs.stability._compiled import (
-    OK,
-    fasm_from_feet,
-    hull_distance,
-    signed_distance_2d,
-    zmp_margin,
-)
-
-
-@njit(cache=True)
-def numpy_sum(a):
-    """Sum of the 1-D float array ``a`` in the order of numpy's ``a.sum()`` (its pairwise sum:
-    eight interleaved partial sums for 8-128 values, a plain loop below 8)."""
-    n = a.shape[0]
-    if n < 8:
-        total = 0.0
-        for i in range(n):
-            total += a[i]
-        return total
-    if n > 128:  # numpy splits longer arrays recursively; not needed here
-        raise ValueError("numpy_sum takes at most 128 values")
-    r = a[:8].copy()
-    i = 8
-    while i < n - n % 8:
-        for j in range(8):
-            r[j] += a[i + j]
-        i += 8
-    total = ((r[0] + r[1]) + (r[2] + r[3])) + ((r[4] + r[5]) + (r[6] + r[7]))
-    while i < n:
-        total += a[i]
-        i += 1
-    return 0.0 + total
-
-
-@njit(cache=True)
-def actuator_power(force, velocity):
-    """Σ |F v| [W] over the actuators, as numpy's ``np.abs(force * velocity).sum()``."""
-    return numpy_sum(np.abs(force * velocity))
+from hexapod_envs._compiled import actuator_power, numpy_sum
+from hexapod_envs.stability._compiled import OK, fasm_from_feet, zmp_margin
 
 
 @njit(cache=True)
@@ -138,68 +103,6 @@ def sensor_observation(
     for i in range(imu.shape[0]):
         out[k] = sensordata[imu[i]]
         k += 1
-
-
-@njit(cache=True)
-def upu_measure(
-    sensordata,
-    force_idx,
-    torso_xmat,
-    foot_weight,
-    touch_idx,
-    contact_force,
-    xpos,
-    foot_body,
-    torso_com,
-    actuator_force,
-    actuator_velocity,
-):
-    """One step's measurements of the 3-UPU hexapod (see HexapodDitchCrossingEnv._measure).
-
-    Returns (foot forces (6, 3) world frame [N], loaded (6,), CoG (3,) [m], FASM status,
-    margin [deg], edge i, edge j, static margin [m], actuator power Σ|F v| [W]). The foot sites
-    stay parallel to the torso, so its rotation takes every force reading to the world frame:
-    ground reaction = foot weight - R s. The static margin is the CoG's signed distance to the
-    loaded soles' polygon seen from above (0 without one); a tripod's hull is its triangle.
-    """
-    n = foot_body.shape[0]
-    local = np.empty((n, 3))
-    soles = np.empty((n, 3))
-    loaded = np.empty(n, dtype=np.bool_)
-    for i in range(n):
-        for j in range(3):
-            local[i, j] = sensordata[force_idx[i, j]]
-            soles[i, j] = xpos[foot_body[i], j]
-        loaded[i] = sensordata[touch_idx[i]] > contact_force
-    forces = foot_weight - np.dot(local, torso_xmat.reshape(3, 3).T)
-    cog = torso_com.copy()
-    status, margin, edge_i, edge_j = fasm_from_feet(soles, forces, cog, loaded)
-    static = _static_margin(soles, loaded, cog[0], cog[1])
-    power = actuator_power(actuator_force, actuator_velocity)
-    return forces, loaded, cog, status, margin, edge_i, edge_j, static, power
-
-
-@njit(cache=True)
-def _static_margin(soles, loaded, px, py):
-    """Signed distance [m] of (px, py) to the loaded soles' support polygon seen from above;
-    0 with fewer than 3 loaded soles or when they lie on a line."""
-    count = 0
-    for i in range(loaded.shape[0]):
-        count += loaded[i]
-    if count < 3:
-        return 0.0
-    xs, ys = np.empty(count), np.empty(count)
-    count = 0
-    for i in range(loaded.shape[0]):
-        if loaded[i]:
-            xs[count], ys[count] = soles[i, 0], soles[i, 1]
-            count += 1
-    if count == 3:  # a tripod (most steps): its hull is the triangle, ordered ccw
-        area2 = (xs[1] - xs[0]) * (ys[2] - ys[0]) - (ys[1] - ys[0]) * (xs[2] - xs[0])
-        if area2 != 0.0:
-            hull = np.array((0, 1, 2)) if area2 > 0 else np.array((0, 2, 1))
-            return signed_distance_2d(xs, ys, hull, px, py)
-    return hull_distance(xs, ys, px, py)
 
 
 @njit(cache=True)

@@ -106,6 +106,7 @@ import mujoco
 import numpy as np
 from gymnasium import spaces
 
+from ..robots.upu._compiled import upu_measure
 from ..robots.upu.gait_plan import (
     Ditch,
     GaitPlan,
@@ -125,7 +126,6 @@ from ..robots.upu.params import LEG_NAMES, UpuParams
 from ..stability import _compiled as _stability
 from ..terrain.ditch import add_ditch
 from ..terrain.flat import add_flat
-from . import _compiled
 from .base import HexapodEnv, Measurement
 from .difficulty import DifficultySpan
 from .sensors import RobotSensors
@@ -555,13 +555,13 @@ class DitchCrossingEnv(HexapodEnv):
     def _measure(self) -> Measurement:
         d = self.data
         act = self._act
-        # One compiled call (hexapod_envs.envs._compiled.upu_measure). Every foot site is
+        # One compiled call (hexapod_envs.robots.upu._compiled.upu_measure). Every foot site is
         # parallel to its platform and the platforms stay parallel (the mechanism only
         # translates), so one rotation takes all six force readings to the world frame: ground
         # reaction = -R s + m_foot g (see model.py). The contacts are the per-leg pressure
         # switch (paper §2): the touch sensor's normal contact force, free of the foot's own
         # inertia that the 3-D force sensor also measures.
-        forces, loaded, cog, status, margin, i, j, static, power = _compiled.upu_measure(
+        forces, loaded, cog, status, margin, i, j, static, power = upu_measure(
             d.sensordata,
             self._force_idx,
             d.xmat[self._torso],

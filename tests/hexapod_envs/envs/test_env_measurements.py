@@ -1,4 +1,5 @@
-"""The compiled per-step measurements (hexapod_envs.envs._compiled) against their numpy forms."""
+"""The compiled per-step measurements (hexapod_envs.envs._compiled, hexapod_envs._compiled, the
+UPU robot's hexapod_envs.robots.upu._compiled) against their numpy forms."""
 
 import gymnasium as gym
 import numpy as np
@@ -6,10 +7,10 @@ import pytest
 from helpers.blas_bits import REASON, numba_blas_matches_numpy
 
 import hexapod_envs  # noqa: F401
+from hexapod_envs._compiled import numpy_sum
 from hexapod_envs.envs._compiled import (
     clip_action,
     filtered_residual_targets,
-    numpy_sum,
     offset_targets,
 )
 from hexapod_envs.stability import fasm_from_feet, zmp_margin
