@@ -24,9 +24,8 @@ and its feet clear the ground by retracting the legs (`GaitSettings.lower_swing_
 from __future__ import annotations
 
 import math
-from collections import deque
 from dataclasses import dataclass
-from functools import cache, lru_cache
+from functools import lru_cache
 
 import numpy as np
 
@@ -477,62 +476,87 @@ def plan_ditch_crossing(
     reduced where needed) and `min_margin`.
     """
     settings = settings or GaitSettings()
-    g = settings.grid
-    band = params.foot_radius + settings.edge_clearance
-    limit = _stride_limit(params, settings)
-    reach = params.leg_extend
-    can_stand = ditch.depth <= reach and ditch.width >= 2 * band + g
-    can_step_over = ditch.width + 2 * band <= limit
-    step_over_note = (
-        f"stepping over needs a stride of width + 2 (foot radius + clearance) = "
-        f"{ditch.width + 2 * band:.3f} m > {limit:.3f} m (eq. 17)"
+    crossing = _Crossing(params, ditch, x_start, settings)
+    if not crossing.can_stand and not crossing.can_step_over:
+        return _unreachable(crossing, "")
+    crossing.check_start()
+    chain = _fewest_steps(crossing)
+    if chain is None:
+        return _unreachable(
+            crossing,
+            f"no sequence of steps <= {crossing.limit:.3f} m (eq. 17) keeps every foot "
+            f"{crossing.band:.3f} m from the ditch edges with margin >= {settings.min_margin} m",
+        )
+    steps = _platform_steps(crossing, chain)
+    how = "standing in the ditch" if crossing.can_stand else "stepping over it"
+    return GaitPlan(
+        "ok",
+        f"{len(steps)} steps cross the {ditch.width} m x {ditch.depth} m ditch, {how}",
+        steps,
+        ditch,
     )
-    if not can_stand and not can_step_over:
-        if ditch.depth > reach:
-            return GaitPlan(
-                "too_deep",
-                f"the ditch is {ditch.depth:.3f} m deep but a leg extends at most {reach:.3f} m, "
-                f"so no foot can stand on its bottom; {step_over_note}",
-                ditch=ditch,
+
+
+class _Crossing:
+    """What the ditch planner's search works on: the grid of platform-centre positions
+    (x_start + i grid, i < n_x), where each platform's feet may stand, and the goal."""
+
+    def __init__(self, params: UpuParams, ditch: Ditch, x_start: float, settings: GaitSettings):
+        self.params, self.ditch, self.x_start, self.settings = params, ditch, x_start, settings
+        self.grid = g = settings.grid
+        self.band = params.foot_radius + settings.edge_clearance
+        """Closest a foot's centre may land to a ditch edge [m]."""
+        self.limit = _stride_limit(params, settings)
+        self.can_stand = ditch.depth <= params.leg_extend and ditch.width >= 2 * self.band + g
+        """A foot can stand on the bottom: within the legs' reach and wide enough."""
+        self.can_step_over = ditch.width + 2 * self.band <= self.limit
+        self.upper_offsets = _foot_offsets_x(params, "upper")
+        self.lower_offsets = _foot_offsets_x(params, "lower")
+        rear = min(self.upper_offsets + self.lower_offsets)
+        goal_x = ditch.end_x + self.band - rear  # centre x putting the rearmost foot past it
+        self.n_goal = int(math.ceil((goal_x - x_start) / g - 1e-9))
+        """Both centres at grid index >= n_goal (and together): the crossing is done."""
+        self.n_d = int(math.floor(self.limit / g + 1e-9))
+        """Longest step in grid cells."""
+        self.n_x = self.n_goal + self.n_d + 1
+        """Grid positions the lower centre may take."""
+
+    def check_start(self) -> None:
+        front = self.x_start + max(self.upper_offsets + self.lower_offsets)
+        if front > self.ditch.start_x - self.band:
+            raise ValueError(
+                f"the robot must start with every foot before the ditch: its front feet at "
+                f"x = {front:.3f} m are within {self.band:.3f} m of (or past) the ditch start "
+                f"{self.ditch.start_x} m"
             )
-        return GaitPlan(
-            "too_wide",
-            f"the ditch ({ditch.width:.3f} m) is too narrow for a foot with "
-            f"{settings.edge_clearance} m clearance on each side, and {step_over_note}",
-            ditch=ditch,
-        )
 
-    def foot_ok(x: float) -> bool:
-        if not can_stand:
-            return not (ditch.start_x - band < x < ditch.end_x + band)
-        return all(abs(x - e) >= band for e in (ditch.start_x, ditch.end_x))
+    def footholds_ok(self, offsets: tuple[float, ...]) -> np.ndarray:
+        """(n_x + n_d + 1,) bool: a platform centred at grid index i has every foot on ground
+        it may land on (not within `band` of an edge; not in the ditch when no foot can stand
+        on its bottom)."""
+        i = np.arange(self.n_x + self.n_d + 1)
+        feet = self.x_start + i[:, None] * self.grid + np.asarray(offsets)[None, :]
+        d = self.ditch
+        if self.can_stand:
+            ok = (np.abs(feet - d.start_x) >= self.band) & (np.abs(feet - d.end_x) >= self.band)
+        else:
+            ok = ~((d.start_x - self.band < feet) & (feet < d.end_x + self.band))
+        return ok.all(axis=1)
 
-    upper_offsets = sorted({float(params.foot_offset(leg)[0]) for leg in PLATFORM_LEGS["upper"]})
-    lower_offsets = sorted({float(params.foot_offset(leg)[0]) for leg in PLATFORM_LEGS["lower"]})
-    rear = min(upper_offsets + lower_offsets)
-    if max(upper_offsets + lower_offsets) + x_start > ditch.start_x - band:
-        raise ValueError(
-            f"the robot must start with every foot before the ditch: its front feet at "
-            f"x = {x_start + max(upper_offsets + lower_offsets):.3f} m are within "
-            f"{band:.3f} m of (or past) the ditch start {ditch.start_x} m"
-        )
-    goal_x = ditch.end_x + band - rear  # centre x that puts the rearmost foot past the ditch
-    n_goal = int(math.ceil((goal_x - x_start) / g - 1e-9))
-    n_d = int(math.floor(limit / g + 1e-9))
-    n_x = n_goal + n_d + 1
 
-    def platform_ok(offsets):
-        return np.array(
-            [all(foot_ok(x_start + i * g + o) for o in offsets) for i in range(n_x + n_d + 1)]
-        )
+def _foot_offsets_x(params: UpuParams, platform: str) -> tuple[float, ...]:
+    """Distinct x offsets of a platform's feet from its centre, ascending [m]."""
+    return tuple(sorted({float(params.foot_offset(leg)[0]) for leg in PLATFORM_LEGS[platform]}))
 
-    ok_upper = platform_ok(upper_offsets).tolist()  # lists: the search indexes them ~1e5 times
-    ok_lower = platform_ok(lower_offsets).tolist()
 
-    @cache
+@lru_cache(maxsize=64)
+def _relative_moves(params: UpuParams, settings: GaitSettings, n_d: int) -> _RelativeMoves:
+    """The feasible steps from each relative offset j (x_upper - x_lower = j grid), for both
+    movers. They depend on the robot, the settings and j only, not on the ditch or on where the
+    robot stands, so every plan with these settings shares them."""
+    g = settings.grid
+
     def move(moving: str, j0: int, j1: int):
-        """(lift, margin) for the moving centre going from offset j0 g to j1 g relative to the
-        other platform's centre, or None if infeasible."""
         x0, x1 = j0 * g, j1 * g
         if moving == "lower":
             x0, x1 = -x0, -x1  # the lower centre relative to the upper one
@@ -542,86 +566,124 @@ def plan_ditch_crossing(
         margin = _transfer_margin(params, moving, x0, x1)
         return None if margin < settings.min_margin else (lift, margin)
 
-    # The feasible relative moves from each offset j, in the order the search tries them
-    # (longest first): they depend on j only, not on where the robot stands.
-    upper_moves = [
-        [j1 for j1 in range(n_d, j, -1) if move("upper", j, j1) is not None] for j in range(n_d + 1)
-    ]
-    lower_moves = [
-        [s for s in range(j, 0, -1) if move("lower", j, j - s) is not None] for j in range(n_d + 1)
-    ]
+    upper, lower = {}, {}
+    for j in range(n_d + 1):
+        for j1 in range(n_d, j, -1):  # longest first: the search's order on ties
+            if (found := move("upper", j, j1)) is not None:
+                upper[j, j1] = found
+        for step in range(j, 0, -1):
+            if (found := move("lower", j, j - step)) is not None:
+                lower[j, j - step] = found
+    return _RelativeMoves(upper, lower, _padded(upper, n_d), _padded(lower, n_d))
 
-    # State: (i_lower, j = (x_upper - x_lower) / g, next mover). Start standing, upper first.
-    start = (0, 0, "upper")
-    parent = {start: None}
-    queue = deque([start])
-    goal = None
-    while queue:
-        state = queue.popleft()
-        i, j, mover = state
+
+def _padded(moves: dict[tuple[int, int], tuple], n_d: int) -> np.ndarray:
+    """(n_d + 1, k) the targets j1 of the moves from each j, in the search's order, padded with
+    -1."""
+    rows = [[j1 for (j0, j1) in moves if j0 == j] for j in range(n_d + 1)]
+    table = np.full((n_d + 1, max(1, *map(len, rows))), -1, dtype=np.int64)
+    for j, row in enumerate(rows):
+        table[j, : len(row)] = row
+    return table
+
+
+@dataclass(frozen=True)
+class _RelativeMoves:
+    upper: dict[tuple[int, int], tuple[float, float]]
+    """(j0, j1) -> (lift [m], min margin [m]) of a feasible upper-platform step."""
+    lower: dict[tuple[int, int], tuple[float, float]]
+    """The same for the lower platform (j0 - j1 > 0 grid cells forward)."""
+    upper_targets: np.ndarray
+    lower_targets: np.ndarray
+
+
+def _fewest_steps(crossing: _Crossing) -> list[tuple[int, int, str]] | None:
+    """The breadth-first search over states (i_lower, j = (x_upper - x_lower) / grid, next
+    mover), starting standing with the upper platform first: the chain of states from the
+    start to the first goal found, or None.
+
+    It runs level by level (a level's states all share the mover, which alternates) with numpy,
+    and keeps a FIFO queue's order exactly: the next level is ordered by first discovery, and a
+    state's parent is the first state of the level (in that order) that reaches it, trying its
+    moves longest first. So the plan equals the one a one-state-at-a-time search finds.
+    """
+    n_d, n_x = crossing.n_d, crossing.n_x
+    moves = _relative_moves(crossing.params, crossing.settings, n_d)
+    ok = {
+        "upper": crossing.footholds_ok(crossing.upper_offsets),
+        "lower": crossing.footholds_ok(crossing.lower_offsets),
+    }
+    width = n_d + 1
+    seen = np.zeros((2, n_x * width), dtype=bool)  # [mover is lower, state]
+    frontier_i, frontier_j = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
+    seen[0, 0] = True
+    levels = []  # per level: (i, j, parent position in the previous level)
+    mover = "upper"
+    while frontier_i.size:
         if mover == "upper":
-            successors = [(i, j1, "lower") for j1 in upper_moves[j] if ok_upper[i + j1]]
+            targets = moves.upper_targets[frontier_j]  # (k, m), -1 padded
+            i_new = np.broadcast_to(frontier_i[:, None], targets.shape)
+            j_new = targets
+            valid = (targets >= 0) & ok["upper"][frontier_i[:, None] + np.maximum(targets, 0)]
         else:
-            successors = [
-                (i + s, j - s, "upper") for s in lower_moves[j] if i + s < n_x and ok_lower[i + s]
-            ]
-        for nxt in successors:
-            if nxt in parent:
-                continue
-            parent[nxt] = state
-            if nxt[1] == 0 and nxt[0] >= n_goal:
-                goal = nxt
-                queue.clear()
-                break
-            queue.append(nxt)
-    if goal is None:
-        search_note = (
-            f"no sequence of steps <= {limit:.3f} m (eq. 17) keeps every foot {band:.3f} m "
-            f"from the ditch edges with margin >= {settings.min_margin} m"
-        )
-        if not can_stand and ditch.depth > reach:
-            return GaitPlan(
-                "too_deep",
-                f"the ditch is {ditch.depth:.3f} m deep but a leg extends at most {reach:.3f} m, "
-                f"so no foot can stand on its bottom, and at {ditch.width:.3f} m it is too wide "
-                f"to step over: {search_note}",
-                ditch=ditch,
-            )
-        if not can_stand:
-            return GaitPlan(
-                "too_wide",
-                f"the ditch ({ditch.width:.3f} m) is too narrow for a foot with "
-                f"{settings.edge_clearance} m clearance on each side and too wide to step "
-                f"over: {search_note}",
-                ditch=ditch,
-            )
-        return GaitPlan("no_plan", search_note, ditch=ditch)
+            targets = moves.lower_targets[frontier_j]
+            step = frontier_j[:, None] - targets
+            i_new = frontier_i[:, None] + step
+            j_new = targets
+            valid = (targets >= 0) & (i_new < n_x)
+            valid &= ok["lower"][np.where(valid, i_new, 0)]
+        source = np.broadcast_to(np.arange(frontier_i.size)[:, None], targets.shape)[valid]
+        i_new, j_new = i_new[valid], j_new[valid]
+        index = i_new * width + j_new
+        next_mover = 1 if mover == "upper" else 0
+        fresh = ~seen[next_mover, index]
+        source, i_new, j_new, index = source[fresh], i_new[fresh], j_new[fresh], index[fresh]
+        _, first = np.unique(index, return_index=True)
+        first.sort()  # discovery order: a FIFO queue's order of the next level
+        source, i_new, j_new, index = source[first], i_new[first], j_new[first], index[first]
+        seen[next_mover, index] = True
+        levels.append((i_new, j_new, source))
+        at_goal = np.flatnonzero((j_new == 0) & (i_new >= crossing.n_goal))
+        if at_goal.size:
+            return _chain(levels, int(at_goal[0]))
+        frontier_i, frontier_j = i_new, j_new
+        mover = "lower" if mover == "upper" else "upper"
+    return None
 
+
+def _chain(levels, position: int) -> list[tuple[int, int, str]]:
+    """The states from the start to `position` in the last level, following parents back."""
     chain = []
-    state = goal
-    while state is not None:
-        chain.append(state)
-        state = parent[state]
+    for depth in range(len(levels) - 1, -1, -1):
+        i, j, source = levels[depth]
+        chain.append((int(i[position]), int(j[position]), "upper" if depth % 2 else "lower"))
+        position = int(source[position])
+    chain.append((0, 0, "upper"))
     chain.reverse()
+    return chain
 
+
+def _platform_steps(crossing: _Crossing, chain) -> tuple[PlatformStep, ...]:
+    """The plan's steps along the searched chain of states: world x of each move, the legs'
+    landing extensions (the depth where a foot lands on the bottom), and the support legs'
+    extensions left from their own last landing."""
+    params, settings, g, x0 = crossing.params, crossing.settings, crossing.grid, crossing.x_start
+    moves = _relative_moves(params, settings, crossing.n_d)
     extension = {leg: 0.0 for leg in PLATFORM_LEGS["upper"] + PLATFORM_LEGS["lower"]}
     steps = []
     for (i0, j0, mover), (i1, j1, _) in zip(chain, chain[1:], strict=False):
-        x_lower0 = x_start + i0 * g
-        x_upper0 = x_start + (i0 + j0) * g
-        x_lower1 = x_start + i1 * g
-        x_upper1 = x_start + (i1 + j1) * g
+        x_lower0, x_upper0 = x0 + i0 * g, x0 + (i0 + j0) * g
+        x_lower1, x_upper1 = x0 + i1 * g, x0 + (i1 + j1) * g
         if mover == "upper":
-            lift, margin = move("upper", j0, j1)
+            lift, margin = moves.upper[j0, j1]
             start_x, end_x, support_x = x_upper0, x_upper1, x_lower0
         else:
-            lift, margin = move("lower", j0, j1)
+            lift, margin = moves.lower[j0, j1]
             start_x, end_x, support_x = x_lower0, x_lower1, x_upper0
         landing = {}
         for leg in PLATFORM_LEGS[mover]:
             foot_x = end_x + float(params.foot_offset(leg)[0])
-            landing[leg] = ditch.depth if ditch.ground_height(foot_x) < 0 else 0.0
-        support = _other(mover)
+            landing[leg] = crossing.ditch.depth if crossing.ditch.ground_height(foot_x) < 0 else 0.0
         steps.append(
             PlatformStep(
                 moving=mover,
@@ -631,18 +693,51 @@ def plan_ditch_crossing(
                 lift=lift,
                 swing_extension=_swing_extension(mover, params, settings),
                 landing_extension=landing,
-                support_extension={leg: extension[leg] for leg in PLATFORM_LEGS[support]},
+                support_extension={leg: extension[leg] for leg in PLATFORM_LEGS[_other(mover)]},
                 min_margin=margin,
             )
         )
         extension.update(landing)
-    how = "standing in the ditch" if can_stand else "stepping over it"
-    return GaitPlan(
-        "ok",
-        f"{len(steps)} steps cross the {ditch.width} m x {ditch.depth} m ditch, {how}",
-        tuple(steps),
-        ditch,
+    return tuple(steps)
+
+
+def _unreachable(crossing: _Crossing, search_note: str) -> GaitPlan:
+    """The failed plan, with the reason: too deep to stand in and too wide to step over, too
+    narrow to stand in and too wide to step over, or (with `search_note`, after a search) no
+    step sequence."""
+    ditch, settings, band = crossing.ditch, crossing.settings, crossing.band
+    reach = crossing.params.leg_extend
+    step_over_note = (
+        f"stepping over needs a stride of width + 2 (foot radius + clearance) = "
+        f"{ditch.width + 2 * band:.3f} m > {crossing.limit:.3f} m (eq. 17)"
     )
+    if crossing.can_stand:
+        return GaitPlan("no_plan", search_note, ditch=ditch)
+    if not search_note:
+        if ditch.depth > reach:
+            reason = (
+                f"the ditch is {ditch.depth:.3f} m deep but a leg extends at most {reach:.3f} "
+                f"m, so no foot can stand on its bottom; {step_over_note}"
+            )
+            return GaitPlan("too_deep", reason, ditch=ditch)
+        reason = (
+            f"the ditch ({ditch.width:.3f} m) is too narrow for a foot with "
+            f"{settings.edge_clearance} m clearance on each side, and {step_over_note}"
+        )
+        return GaitPlan("too_wide", reason, ditch=ditch)
+    if ditch.depth > reach:
+        reason = (
+            f"the ditch is {ditch.depth:.3f} m deep but a leg extends at most {reach:.3f} m, "
+            f"so no foot can stand on its bottom, and at {ditch.width:.3f} m it is too wide "
+            f"to step over: {search_note}"
+        )
+        return GaitPlan("too_deep", reason, ditch=ditch)
+    reason = (
+        f"the ditch ({ditch.width:.3f} m) is too narrow for a foot with "
+        f"{settings.edge_clearance} m clearance on each side and too wide to step "
+        f"over: {search_note}"
+    )
+    return GaitPlan("too_wide", reason, ditch=ditch)
 
 
 def plan_flat_past(

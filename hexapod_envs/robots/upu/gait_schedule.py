@@ -160,7 +160,9 @@ class GaitSchedule:
         self.timing = timing or GaitTiming()
         ticks = [max(1, int(round(d / control_dt))) for d in self.timing.durations]
         self.phase_ticks: tuple[int, ...] = tuple(ticks)
-        rows, steps, phases, checkpoints = [], [], [], []
+        ramps = [quintic(np.arange(1, n + 1) / n)[:, None] for n in ticks]  # per phase, 0 -> 1
+        blocks, steps, phases, checkpoints = [], [], [], []
+        n_rows = 0
         current = standing_command(params)
         # Level offsets: extension each platform's legs need on level ground, beyond nominal,
         # because the executed relative height differs from the paper's 363 mm (see
@@ -190,9 +192,8 @@ class GaitSchedule:
                 landing = np.clip(
                     [step.landing_extension[leg] + level[step.moving] for leg in legs], lo, hi
                 )
-                for p, (name, n) in enumerate(zip(PHASES, ticks, strict=True)):
+                for p, (name, n, a) in enumerate(zip(PHASES, ticks, ramps, strict=True)):
                     block = np.repeat(current[None, :], n, axis=0)
-                    a = quintic(np.arange(1, n + 1) / n)[:, None]
                     if name == "unload":
                         block[:, cols] = start_ext + (unloaded - start_ext) * a
                     elif name == "lift":
@@ -203,17 +204,18 @@ class GaitSchedule:
                         block[:, cols] = swing + (landing - swing) * a
                     current = block[-1].copy()
                     if name in GATES and not (name == "loaded" and k == len(plan.steps) - 1):
-                        checkpoints.append(Checkpoint(len(rows) + n, k, GATES[name], legs))
-                    rows.extend(block)
-                    steps.extend([k] * n)
-                    phases.extend([p] * n)
-        if not rows:
-            rows, steps, phases = [current], [-1], [-1]
-        self.commands = np.array(rows)
+                        checkpoints.append(Checkpoint(n_rows + n, k, GATES[name], legs))
+                    blocks.append(block)
+                    n_rows += n
+                    steps.append(np.full(n, k))
+                    phases.append(np.full(n, p))
+        if not blocks:
+            blocks, steps, phases = [current[None, :]], [[-1]], [[-1]]
+        self.commands = np.concatenate(blocks)
         """(n_ticks, 9) command rows [m], columns `COMMAND_NAMES`."""
-        self.step_index = np.array(steps, dtype=int)
+        self.step_index = np.concatenate(steps).astype(int)
         """(n_ticks,) plan step of each row (-1: standing without a plan)."""
-        self.phase_index = np.array(phases, dtype=int)
+        self.phase_index = np.concatenate(phases).astype(int)
         """(n_ticks,) index into `PHASES` of each row (-1: standing without a plan)."""
         self.checkpoints: tuple[Checkpoint, ...] = tuple(checkpoints)
         self._gate_at = {c.tick: c for c in checkpoints}

@@ -276,3 +276,54 @@ def test_feasible_lift_matches_brute_force():
                 brute = float(candidate)
                 break
         assert lift == pytest.approx(brute)
+
+
+def _fifo_search(crossing):
+    """The planner's search one state at a time with a FIFO queue (its definition)."""
+    from collections import deque
+
+    from hexapod_envs.robots.upu.gait_plan import _relative_moves
+
+    moves = _relative_moves(crossing.params, crossing.settings, crossing.n_d)
+    ok_upper = crossing.footholds_ok(crossing.upper_offsets)
+    ok_lower = crossing.footholds_ok(crossing.lower_offsets)
+    start = (0, 0, "upper")
+    parent, queue = {start: None}, deque([start])
+    while queue:
+        i, j, mover = state = queue.popleft()
+        if mover == "upper":
+            nexts = [(i, j1, "lower") for (j0, j1) in moves.upper if j0 == j and ok_upper[i + j1]]
+        else:
+            nexts = [
+                (i + j - j1, j1, "upper")
+                for (j0, j1) in moves.lower
+                if j0 == j and i + j - j1 < crossing.n_x and ok_lower[i + j - j1]
+            ]
+        for nxt in nexts:
+            if nxt in parent:
+                continue
+            parent[nxt] = state
+            if nxt[1] == 0 and nxt[0] >= crossing.n_goal:
+                chain = [nxt]
+                while parent[chain[-1]] is not None:
+                    chain.append(parent[chain[-1]])
+                return chain[::-1]
+            queue.append(nxt)
+    return None
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_level_search_finds_the_plan_a_fifo_search_finds(seed):
+    """The vectorised level-by-level search keeps a FIFO queue's order (first discovery, longest
+    step first), so it returns the same chain of states on random ditches and grids."""
+    from hexapod_envs.robots.upu.gait_plan import _Crossing, _fewest_steps
+
+    rng = np.random.default_rng(seed)
+    params = UpuParams()
+    for _ in range(6):
+        ditch = Ditch(rng.uniform(0.35, 0.9), rng.uniform(0.02, 0.6), rng.uniform(0.01, 0.2))
+        settings = GaitSettings(grid=float(rng.choice([0.005, 0.01])))
+        crossing = _Crossing(params, ditch, 0.0, settings)
+        if not (crossing.can_stand or crossing.can_step_over):
+            continue
+        assert _fewest_steps(crossing) == _fifo_search(crossing), ditch
