@@ -615,6 +615,7 @@ def _fewest_steps(crossing: _Crossing) -> list[tuple[int, int, str]] | None:
     }
     width = n_d + 1
     seen = np.zeros((2, n_x * width), dtype=bool)  # [mover is lower, state]
+    earliest = np.empty(n_x * width, dtype=np.int64)  # per state: its first position in a level
     frontier_i, frontier_j = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
     seen[0, 0] = True
     levels = []  # per level: (i, j, parent position in the previous level)
@@ -638,8 +639,11 @@ def _fewest_steps(crossing: _Crossing) -> list[tuple[int, int, str]] | None:
         next_mover = 1 if mover == "upper" else 0
         fresh = ~seen[next_mover, index]
         source, i_new, j_new, index = source[fresh], i_new[fresh], j_new[fresh], index[fresh]
-        _, first = np.unique(index, return_index=True)
-        first.sort()  # discovery order: a FIFO queue's order of the next level
+        # Each state's first occurrence, in discovery order (a FIFO queue's order of the level).
+        order = np.arange(index.size)
+        earliest[index] = index.size
+        np.minimum.at(earliest, index, order)
+        first = np.flatnonzero(earliest[index] == order)
         source, i_new, j_new, index = source[first], i_new[first], j_new[first], index[first]
         seen[next_mover, index] = True
         levels.append((i_new, j_new, source))
