@@ -5,7 +5,14 @@ import json
 import pytest
 from helpers.paths import REPO
 
-from experiments.reproduction.rows import _isclose, collect, markdown
+from experiments.reproduction.rows import (
+    HEADLINES,
+    _isclose,
+    collect,
+    headline_rows,
+    markdown,
+    summary,
+)
 
 COMMITTED = REPO / "reports" / "reproduction.json"
 
@@ -38,7 +45,31 @@ def test_rows_have_the_required_fields_and_markdown_lists_them():
     keys = {"id", "paper", "quantity", "paper_value", "value", "unit", "tolerance", "holds"}
     assert all(keys <= set(r) for r in rows)
     text = markdown(rows)
-    assert text.count("\n| ") == len(rows) + 1  # header + one line per row
+    table = text.split("## All rows", 1)[1]
+    assert table.count("\n| ") == len(rows) + 1  # header + one line per row
+
+
+def test_summary_lists_every_headline_with_the_verdict_of_its_rows():
+    rows = json.loads(COMMITTED.read_text())
+    lines = summary(rows)[2:]
+    assert len(lines) == len(HEADLINES)
+    for (key, *_), line in zip(HEADLINES, lines, strict=True):
+        picked = headline_rows(rows, key)
+        assert picked, key
+        assert line.startswith(f"| {key.rstrip('.')} |")
+        assert line.endswith("| holds |") == all(r["holds"] for r in picked), line
+    text = markdown(rows)
+    assert text.index("## Summary") < text.index("## All rows")
+
+
+def test_summary_fails_a_per_case_headline_when_one_case_fails():
+    cases = [
+        {"id": f"7b.{case}", "value": 1.0, "unit": "s", "holds": case != "b"} for case in "abc"
+    ]
+    other = {"id": "7b.a@max_tilt_deg=25", "value": 9.0, "unit": "s", "holds": True}
+    assert headline_rows([*cases, other], "7b.") == cases
+    (line,) = summary([*cases, other])[2:]
+    assert line.endswith("| **fails** |") and "2 of 3 cases hold" in line
 
 
 def test_bad_paper_id_is_rejected_with_choices():
