@@ -315,6 +315,22 @@ class IrregularTerrainSettings(EnvSettings):
     """Servo stiffness [N·m/rad] (calibrated to the paper's simple-control ramp sag, 0.068 m)."""
     servo_damping: float = number(0.2, strict=True)
     """Servo viscous damping [N·m·s/rad]."""
+    servo_torque_limit: float | None = number(None, strict=True, optional=True)
+    """Servo torque limit [N·m] (None: the paper's stall torque, 1.89 N·m)."""
+    servo_armature: float | None = number(None, optional=True)
+    """Reflected rotor inertia of each servo [kg·m²] (None: `AthenaParams.servo_armature`)."""
+    servo_delay: float = number(0.0)
+    """Control latency [s]: each servo acts on the target sent this long ago (0: none)."""
+    robot_friction: float | None = number(None, optional=True)
+    """Friction of the robot's feet and links [-] (None: the paper's 0.9). MuJoCo takes the
+    larger of the two geoms' friction, so a contact's friction is max(this, ``friction``)."""
+    contact_solref: tuple[float, float] | None = numbers(None, size=2, optional=True)
+    """MuJoCo solref (time constant [s], damping ratio) of the robot-terrain contacts (None:
+    MuJoCo's (0.02, 1)): the contacts' softness."""
+    contact_solimp: tuple[float, float, float, float, float] | None = numbers(
+        None, size=5, optional=True
+    )
+    """MuJoCo solimp of the robot-terrain contacts (None: MuJoCo's (0.9, 0.95, 0.001, 0.5, 2))."""
     friction: float = number(PAPER_FRICTION)
     ramp_slope_deg: float = number(10.0, high=45.0)
     ramp_start_x: float = number(-0.4, low=None)
@@ -401,7 +417,7 @@ class IrregularTerrainEnv(HexapodEnv):
         self._gains_read_for = -1
         """Phase index of the cycle start at which the gains were last read ("gains" mode)."""
         self.residual_scale = float(s.residual_scale)
-        self.robot = dataclasses.replace(ATHENA, servo_kp=s.servo_kp, servo_damping=s.servo_damping)
+        self.robot = dataclasses.replace(ATHENA, **_servo_and_contact(s))
         self.contact_force = s.contact_threshold * self.robot.total_mass * 9.81
         """Ground reaction above which a foot counts as loaded [N]."""
         self.gait_config = {
@@ -601,6 +617,10 @@ class IrregularTerrainEnv(HexapodEnv):
         low, high = self.action_map.low, self.action_map.high
         self.data.qpos[self._joint_qpos] = np.clip(joints, low, high)
         self.data.ctrl[self._act_ids] = standing
+        if self.robot.servo_delay > 0:  # the delayed servos start from the standing targets too
+            for i, target in zip(self._act_ids, standing, strict=True):
+                n = self.model.actuator_history[i, 0]
+                mujoco.mj_initCtrlHistory(self.model, self.data, i, None, np.full((n, 1), target))
 
     def _start_episode(self) -> None:
         self.controller.reset()
@@ -889,3 +909,19 @@ def _gain_kwargs(gains: tuple[float, ...]) -> dict[str, float]:
     if len(gains) != 3:
         raise ValueError(f"gains must be (k_z, k_alpha, k_beta), got {gains!r}")
     return {"kz": gains[0], "k_alpha": gains[1], "k_beta": gains[2]}
+
+
+def _servo_and_contact(s: IrregularTerrainSettings) -> dict:
+    """The `AthenaParams` fields that `s` sets: the servo stiffness and damping always, the
+    torque limit, armature, latency, friction and contact softness where `s` gives them."""
+    fields = {
+        "servo_kp": s.servo_kp,
+        "servo_damping": s.servo_damping,
+        "stall_torque": s.servo_torque_limit,
+        "servo_armature": s.servo_armature,
+        "servo_delay": s.servo_delay,
+        "friction": s.robot_friction,
+        "contact_solref": s.contact_solref,
+        "contact_solimp": s.contact_solimp,
+    }
+    return {k: v for k, v in fields.items() if v is not None}

@@ -45,6 +45,14 @@ _TORSO_RGBA = [0.2, 0.45, 0.75, 1.0]
 _LINK_RGBA = [0.35, 0.35, 0.4, 1.0]
 _FOOT_RGBA = [0.1, 0.1, 0.1, 1.0]
 
+_SOLMIX_DOMINANT = 1e6
+"""solmix of the robot's geoms when `AthenaParams.contact_solref` / `contact_solimp` are set:
+MuJoCo averages a contact's solref and solimp over its two geoms weighted by solmix, so against
+the terrain's default weight 1 the robot's values count 1e6 : 1 (within 1e-6 of them)."""
+DELAY_MIN_TIMESTEP = 0.0005
+"""Smallest physics step [s] for which a servo's target history covers `AthenaParams.servo_delay`
+(the history keeps delay / this + 2 samples)."""
+
 FOOT_FORCE_SIGN = -1.0
 """Multiply the `L_foot_force` reading (rotated from the site to the world frame) by this to get
 the ground reaction force acting on the foot, up to the foot's own weight and inertia (0.087 N).
@@ -218,6 +226,9 @@ def _add_leg(
         act.forcerange = [-p.stall_torque, p.stall_torque]
         act.ctrllimited = True
         act.ctrlrange = list(p.joint_range(JOINT_NAMES[k]))
+        if p.servo_delay > 0:
+            act.delay = p.servo_delay
+            act.nsample = math.ceil(p.servo_delay / DELAY_MIN_TIMESTEP) + 2
         spec.add_sensor(
             name=f"{name}_pos",
             type=mujoco.mjtSensor.mjSENS_JOINTPOS,
@@ -278,13 +289,20 @@ def _set_inertial(body: mujoco.MjsBody, mass: float, inertia: np.ndarray, ipos: 
 
 
 def _collision_kwargs(p: AthenaParams) -> dict:
-    return {
+    kwargs = {
         "contype": _COLLIDE_GROUND,
         "conaffinity": 0,
         "condim": 3,
         "friction": [p.friction, 0.005, 0.0001],
         "density": 0.0,
     }
+    if p.contact_solref is not None or p.contact_solimp is not None:
+        kwargs["solmix"] = _SOLMIX_DOMINANT
+    if p.contact_solref is not None:
+        kwargs["solref"] = list(p.contact_solref)
+    if p.contact_solimp is not None:
+        kwargs["solimp"] = list(p.contact_solimp)
+    return kwargs
 
 
 def _quat_about(axis: list[float], angle: float) -> list[float]:

@@ -137,6 +137,15 @@ class AthenaParams:
     servo_armature: float = 0.002
     """Reflected rotor inertia of the geared servo, kg·m² (typical for a ~200:1 hobby servo);
     it also keeps the light tibia joint well conditioned at the 2-2.5 ms time steps used."""
+    servo_delay: float = 0.0
+    """Control latency of the servos, s: each servo acts on the target it was sent this long
+    ago (MuJoCo's actuator delay; 0: none)."""
+    contact_solref: tuple[float, float] | None = None
+    """MuJoCo solref (time constant s, damping ratio) of the robot's contacts with the terrain
+    (None: MuJoCo's default, (0.02, 1)): how soft the feet and torso are."""
+    contact_solimp: tuple[float, float, float, float, float] | None = None
+    """MuJoCo solimp of the robot's contacts with the terrain (None: MuJoCo's default,
+    (0.9, 0.95, 0.001, 0.5, 2))."""
 
     # ----- derived quantities --------------------------------------------------------------
     @property
