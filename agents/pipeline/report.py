@@ -569,188 +569,238 @@ img{max-width:100%} code{background:#f4f4f4;padding:0 3px}
 """
 
 
-def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
-    """Write metrics.json, report.md, figures/*.png and report.html into `out_dir`."""
-    out = Path(out_dir)
-    fig_dir = out / "figures"
-    fig_dir.mkdir(parents=True, exist_ok=True)
-    suite = result.suite
-    metrics = build_metrics(result)
-    (out / "metrics.json").write_text(
-        json.dumps(_clean(metrics), indent=1, default=_json_default) + "\n"
-    )
+class _Document:
+    """The report as it is written: every element goes to the Markdown and to the HTML page at
+    once, and figures are saved under ``figures/`` beside them."""
 
-    title = report_title(suite)
-    md: list[str] = [f"# {title}", ""]
-    hx: list[str] = [f"<h1>{html.escape(title)}</h1>"]
+    def __init__(self, out: Path, title: str):
+        self.out, self.fig_dir, self.title = out, out / "figures", title
+        self.fig_dir.mkdir(parents=True, exist_ok=True)
+        self.md: list[str] = [f"# {title}", ""]
+        self.hx: list[str] = [f"<h1>{html.escape(title)}</h1>"]
 
-    def para(text: str) -> None:
-        md.extend([text, ""])
-        hx.append(f"<p>{_inline_html(text)}</p>")
+    def para(self, text: str) -> None:
+        self.md.extend([text, ""])
+        self.hx.append(f"<p>{_inline_html(text)}</p>")
 
-    def bullets(lines: list[str]) -> None:
-        md.extend(lines + [""])
-        hx.append(
+    def bullets(self, lines: list[str]) -> None:
+        self.md.extend(lines + [""])
+        self.hx.append(
             "<ul>" + "".join(f"<li>{_inline_html(x.lstrip('- '))}</li>" for x in lines) + "</ul>"
         )
 
-    def heading(text: str, level: int) -> None:
-        md.extend(["#" * level + " " + text, ""])
-        hx.append(f"<h{level}>{html.escape(text)}</h{level}>")
+    def heading(self, text: str, level: int) -> None:
+        self.md.extend(["#" * level + " " + text, ""])
+        self.hx.append(f"<h{level}>{html.escape(text)}</h{level}>")
 
-    def table(t: Table | None) -> None:
+    def table(self, t: Table | None) -> None:
         if t is not None:
-            md.extend([t.markdown(), ""])
-            hx.append(t.html())
+            self.md.extend([t.markdown(), ""])
+            self.hx.append(t.html())
 
-    def figure(name: str, png: bytes | None, caption: str) -> None:
+    def warnings(self, lines: list[str]) -> None:
+        """The warnings as a highlighted list (a ``warn`` box on the page)."""
+        self.md.extend([f"- **warning:** {w}" for w in lines] + [""])
+        self.hx.append(
+            '<div class="warn"><ul>'
+            + "".join(f"<li><b>warning:</b> {html.escape(w)}</li>" for w in lines)
+            + "</ul></div>"
+        )
+
+    def figure(self, name: str, png: bytes | None, caption: str) -> None:
+        """Save `png` as ``figures/<name>``, linked from the Markdown and embedded in the page
+        (base64); nothing when the figure has no data (None)."""
         if png is None:
             return
-        (fig_dir / name).write_bytes(png)
-        md.extend([f"![{caption}](figures/{name})", ""])
+        (self.fig_dir / name).write_bytes(png)
+        self.md.extend([f"![{caption}](figures/{name})", ""])
         b64 = base64.b64encode(png).decode()
-        hx.append(
+        self.hx.append(
             f'<figure><img alt="{html.escape(caption)}" src="data:image/png;base64,{b64}">'
             f"<figcaption>{html.escape(caption)}</figcaption></figure>"
         )
 
-    def video(path: Path, caption: str) -> None:
-        rel = path.relative_to(out).as_posix()
-        md.extend([f"[{caption}]({rel})", ""])
-        hx.append(
+    def video(self, path: Path, caption: str) -> None:
+        """A video under the report folder, linked (not embedded) by its relative path."""
+        rel = path.relative_to(self.out).as_posix()
+        self.md.extend([f"[{caption}]({rel})", ""])
+        self.hx.append(
             f'<figure><video controls muted loop width="480" src="{html.escape(rel)}"></video>'
             f"<figcaption>{html.escape(caption)}</figcaption></figure>"
         )
 
+    def save(self) -> list[Path]:
+        """Write ``report.md`` and the self-contained ``report.html``; their paths."""
+        (self.out / "report.md").write_text("\n".join(self.md))
+        page = (
+            f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(self.title)}"
+            f"</title><style>{CSS}</style></head><body>{''.join(self.hx)}</body></html>\n"
+        )
+        (self.out / "report.html").write_text(page)
+        return [self.out / "report.md", self.out / "report.html"]
+
+
+def write_report(result: SuiteResult, out_dir: str | Path) -> list[Path]:
+    """Write metrics.json, report.md, figures/*.png and report.html into `out_dir`: the suite's
+    overview, the verdicts and benchmark scores across envs, then one section per env."""
+    out = Path(out_dir)
+    doc = _Document(out, report_title(result.suite))
+    metrics = build_metrics(result)
+    (out / "metrics.json").write_text(
+        json.dumps(_clean(metrics), indent=1, default=_json_default) + "\n"
+    )
+    _write_overview(doc, result)
+    _write_verdicts_and_scores(doc, result)
+    for r in result.envs:
+        _write_env_section(doc, r, result.suite)
+    md_path, html_path = doc.save()
+    return [out / "metrics.json", md_path, html_path]
+
+
+def _write_overview(doc: _Document, result: SuiteResult) -> None:
+    """What ran (policies, envs, seeds, run time), the reading guide, each env's stability
+    criterion and ξ, then the run's warnings and notes."""
+    suite = result.suite
     shown = []
     for p in suite.policies:  # a per-env template is listed expanded for every env
         names = [e.label(p) for e in result.envs] if "{env_id}" in p else [p]
         shown.append(", ".join(f"`{n}`" for n in dict.fromkeys(names)) + f" ({policy_kind(p)})")
-    para(
+    doc.para(
         f"Policies: {'; '.join(shown)}. Envs: "
         f"{', '.join(f'`{e.id}`' for e in suite.envs)}. {suite.episodes} episode(s) per policy "
         f"and env on seeds {suite.seeds} (identical seeds, terrain and start for every policy). "
         f"Cells: mean ± std over episodes; the spread table gives median [min, max]. "
         f"Run time {result.seconds:.1f} s."
     )
-    heading("How to read this report", 2)
-    bullets(HOW_TO_READ)
+    doc.heading("How to read this report", 2)
+    doc.bullets(HOW_TO_READ)
     thresholds = Table(["env", "stability criterion", "ξ [deg]"])
     for r in result.envs:
         xi = "none (FASM for comparison)" if r.xi_deg is None else f"{r.xi_deg:g}"
         thresholds.rows.append([r.env_id, r.criterion, xi])
-    table(thresholds)
+    doc.table(thresholds)
     if result.warnings:
-        heading("Warnings", 2)
-        md.extend([f"- **warning:** {w}" for w in result.warnings] + [""])
-        hx.append(
-            '<div class="warn"><ul>'
-            + "".join(f"<li><b>warning:</b> {html.escape(w)}</li>" for w in result.warnings)
-            + "</ul></div>"
-        )
+        doc.heading("Warnings", 2)
+        doc.warnings(result.warnings)
     if result.notes:  # e.g. a per-env model, an agent trained with other reward scales
-        heading("Notes", 2)
-        bullets([f"- **note:** {n}" for n in result.notes])
+        doc.heading("Notes", 2)
+        doc.bullets([f"- **note:** {n}" for n in result.notes])
 
-    heading("Verdicts", 2)
+
+def _write_verdicts_and_scores(doc: _Document, result: SuiteResult) -> None:
+    """The verdict of every env, the success-rate figure, the benchmark scores and the success
+    against task difficulty: the comparison across envs before the per-env sections."""
+    doc.heading("Verdicts", 2)
     for r in result.envs:
         aggs = {r.label(n): aggregate(run.episodes) for n, run in r.runs.items()}
-        para(f"{r.env_id}: " + verdict_paragraph(r, aggs))
-    figure(
+        doc.para(f"{r.env_id}: " + verdict_paragraph(r, aggs))
+    doc.figure(
         "success_rates.png",
         figures.success_bars(result),
         "Success and tip-over rate per env and policy (share of episodes)",
     )
-    heading("Benchmark scores", 2)
+    doc.heading("Benchmark scores", 2)
     scores, text = benchmark_section(result)
-    para(text)
-    table(scores)
-    figure(
+    doc.para(text)
+    doc.table(scores)
+    doc.figure(
         "success_by_difficulty.png",
         figures.success_by_difficulty(result),
         "Success rate against the task's difficulty (info['task']['difficulty']), per env",
     )
 
-    for r in result.envs:
-        slug = r.env_id.replace("/", "_")
-        heading(r.env_id, 2)
-        aggs = {r.label(n): aggregate(run.episodes) for n, run in r.runs.items()}
-        para(verdict_paragraph(r, aggs))
-        limit = r.max_episode_steps
-        sources = "; ".join(
-            f"`{r.label(n)}`: {run.source}{_action_settings(run.env_kwargs)}"
-            for n, run in r.runs.items()
-        )
-        xi = "no ξ" if r.xi_deg is None else f"ξ = {r.xi_deg:g}°"
-        para(
-            f"Env kwargs: `{r.kwargs or {}}`; time limit {limit} steps"
-            + (f" × {r.dt:g} s" if r.dt else "")
-            + f"; stability criterion: {r.criterion} ({xi})"
-            + (f". Sources: {sources}." if sources else ". No policy ran on this env.")
-        )
-        if not r.runs:
-            continue
-        table(main_table(aggs))
-        unstable = [
-            f"`{name}` {rate(a['sim_unstable'])}"
-            for name, a in aggs.items()
-            if a.get("sim_unstable") and a["sim_unstable"]["mean"] > 0
-        ]
-        if unstable:
-            para(
-                "Episodes that ended in an unstable simulation (`info['sim_unstable']`: the "
-                "episode truncates; it counts as no success, and its last step's repeated "
-                "readings are left out): " + ", ".join(unstable) + "."
-            )
-        heading("Comparisons (like with like)", 3)
-        bullets(verdict_lines(r, aggs, result.suite.reference_names)[0])
-        if all(a["energy_j"] is None for a in aggs.values()):
-            para(f"Energy: n/a, this env reports no `{POWER_KEY}` in info.")
-        heading("Spread (median [min, max])", 3)
-        table(spread_table(aggs))
-        heading("Reward terms (episode sums)", 3)
-        table(reward_table(aggs))
-        breakdown = task_table(r)
-        if breakdown is not None:
-            heading("By sampled task parameter (episodes that succeeded / tipped over)", 3)
-            table(breakdown)
-        spec_table = specifics_table(r, aggs)
-        if spec_table is not None:
-            heading("Env-specific metrics", 3)
-            table(spec_table)
-        figure(
-            f"{slug}_fasm.png",
-            figures.fasm_over_time(r, r.xi_deg, suite.seeds[0]),
-            f"{r.env_id}: FASM over time on seed {suite.seeds[0]}",
-        )
-        figure(f"{slug}_boxes.png", figures.metric_boxes(r), f"{r.env_id}: per-episode metrics")
-        figure(
-            f"{slug}_learning.png",
-            figures.learning_curves(r),
-            f"{r.env_id}: learning curves of the PPO runs (evaluation success rate and return)",
-        )
-        figure(
-            f"{slug}_specific.png", figures.specific_boxes(r), f"{r.env_id}: env-specific metrics"
-        )
-        for name, run in r.runs.items():
-            label = r.label(name)
-            safe = "".join(c if c.isalnum() else "_" for c in name)
-            if run.frames:
-                figure(
-                    f"{slug}_{safe}_frames.png",
-                    figures.frame_strip(run.frames),
-                    f"{r.env_id}, {label}: frames over the episode on seed {suite.seeds[0]}",
-                )
-            if run.video is not None:
-                video(run.video, f"{r.env_id}, {label}: video of seed {suite.seeds[0]}")
 
-    (out / "report.md").write_text("\n".join(md))
-    page = (
-        f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{html.escape(title)}"
-        f"</title><style>{CSS}</style></head><body>{''.join(hx)}</body></html>\n"
+def _write_env_section(doc: _Document, r: EnvResult, suite: Any) -> None:
+    """One env's section: its verdict and setup, then (if any policy ran) its tables and
+    figures."""
+    doc.heading(r.env_id, 2)
+    aggs = {r.label(n): aggregate(run.episodes) for n, run in r.runs.items()}
+    doc.para(verdict_paragraph(r, aggs))
+    doc.para(_env_setup_text(r))
+    if not r.runs:
+        return
+    _write_env_tables(doc, r, aggs, suite)
+    _write_env_figures(doc, r, suite)
+
+
+def _env_setup_text(r: EnvResult) -> str:
+    """The env's kwargs, time limit, stability criterion and each policy's source."""
+    sources = "; ".join(
+        f"`{r.label(n)}`: {run.source}{_action_settings(run.env_kwargs)}"
+        for n, run in r.runs.items()
     )
-    (out / "report.html").write_text(page)
-    return [out / "metrics.json", out / "report.md", out / "report.html"]
+    xi = "no ξ" if r.xi_deg is None else f"ξ = {r.xi_deg:g}°"
+    return (
+        f"Env kwargs: `{r.kwargs or {}}`; time limit {r.max_episode_steps} steps"
+        + (f" × {r.dt:g} s" if r.dt else "")
+        + f"; stability criterion: {r.criterion} ({xi})"
+        + (f". Sources: {sources}." if sources else ". No policy ran on this env.")
+    )
+
+
+def _write_env_tables(doc: _Document, r: EnvResult, aggs: dict[str, dict], suite: Any) -> None:
+    """The env's main table, unstable episodes, like-with-like comparisons, spread, reward
+    terms, the breakdown by sampled task parameter and the env-specific metrics."""
+    doc.table(main_table(aggs))
+    unstable = [
+        f"`{name}` {rate(a['sim_unstable'])}"
+        for name, a in aggs.items()
+        if a.get("sim_unstable") and a["sim_unstable"]["mean"] > 0
+    ]
+    if unstable:
+        doc.para(
+            "Episodes that ended in an unstable simulation (`info['sim_unstable']`: the "
+            "episode truncates; it counts as no success, and its last step's repeated "
+            "readings are left out): " + ", ".join(unstable) + "."
+        )
+    doc.heading("Comparisons (like with like)", 3)
+    doc.bullets(verdict_lines(r, aggs, suite.reference_names)[0])
+    if all(a["energy_j"] is None for a in aggs.values()):
+        doc.para(f"Energy: n/a, this env reports no `{POWER_KEY}` in info.")
+    doc.heading("Spread (median [min, max])", 3)
+    doc.table(spread_table(aggs))
+    doc.heading("Reward terms (episode sums)", 3)
+    doc.table(reward_table(aggs))
+    breakdown = task_table(r)
+    if breakdown is not None:
+        doc.heading("By sampled task parameter (episodes that succeeded / tipped over)", 3)
+        doc.table(breakdown)
+    spec_table = specifics_table(r, aggs)
+    if spec_table is not None:
+        doc.heading("Env-specific metrics", 3)
+        doc.table(spec_table)
+
+
+def _write_env_figures(doc: _Document, r: EnvResult, suite: Any) -> None:
+    """The env's figures (FASM over time on the first seed, per-episode metrics, learning
+    curves, env-specific metrics), then each policy's frame strip and video, if recorded."""
+    slug = r.env_id.replace("/", "_")
+    seed = suite.seeds[0]
+    doc.figure(
+        f"{slug}_fasm.png",
+        figures.fasm_over_time(r, r.xi_deg, seed),
+        f"{r.env_id}: FASM over time on seed {seed}",
+    )
+    doc.figure(f"{slug}_boxes.png", figures.metric_boxes(r), f"{r.env_id}: per-episode metrics")
+    doc.figure(
+        f"{slug}_learning.png",
+        figures.learning_curves(r),
+        f"{r.env_id}: learning curves of the PPO runs (evaluation success rate and return)",
+    )
+    doc.figure(
+        f"{slug}_specific.png", figures.specific_boxes(r), f"{r.env_id}: env-specific metrics"
+    )
+    for name, run in r.runs.items():
+        label = r.label(name)
+        safe = "".join(c if c.isalnum() else "_" for c in name)
+        if run.frames:
+            doc.figure(
+                f"{slug}_{safe}_frames.png",
+                figures.frame_strip(run.frames),
+                f"{r.env_id}, {label}: frames over the episode on seed {seed}",
+            )
+        if run.video is not None:
+            doc.video(run.video, f"{r.env_id}, {label}: video of seed {seed}")
 
 
 def _inline_html(text: str) -> str:
