@@ -1,0 +1,145 @@
+"""The batched vector env (`hexapod_envs.vector`) returns exactly what N single envs return.
+
+The reference is Gymnasium's `SyncVectorEnv` over ``gym.make(id)`` envs with the same seeds:
+observations, rewards, terminations, truncations and the vector info dict are compared bit for
+bit over episodes that end by tipping over and by the time limit, through the autoresets."""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from gymnasium.vector import AutoresetMode
+
+import hexapod_envs  # noqa: F401  (registers the ids)
+from hexapod_envs.vector import BatchedVectorEnv
+
+BATCHED_IDS = [
+    "HexapodCliffWalk-v0",
+    "HexapodCliffWalk-v1",
+    "HexapodStewartTilt-v0",
+    "HexapodStewartTilt-v1",
+    "HexapodIrregularTerrain-v0",
+    "HexapodIrregularTerrain-v1",
+]
+
+
+def _pair(env_id: str, num_envs: int, nthread: int = 2, **kwargs):
+    batched = gym.make_vec(
+        env_id, num_envs, vectorization_mode="vector_entry_point", nthread=nthread, **kwargs
+    )
+    autoreset = kwargs.pop("autoreset_mode", AutoresetMode.NEXT_STEP)
+    sync = gym.make_vec(
+        env_id,
+        num_envs,
+        vectorization_mode="sync",
+        vector_kwargs={"autoreset_mode": autoreset},
+        **kwargs,
+    )
+    return batched, sync
+
+
+def _assert_same(a, b, where: str) -> None:
+    """Bit-identical values: arrays (NaN equal to NaN), dicts, sequences, scalars."""
+    if isinstance(a, dict):
+        assert isinstance(b, dict) and a.keys() == b.keys(), where
+        for key in a:
+            _assert_same(a[key], b[key], f"{where}[{key!r}]")
+    elif isinstance(a, np.ndarray):
+        assert isinstance(b, np.ndarray) and a.dtype == b.dtype and a.shape == b.shape, where
+        if a.dtype == object:
+            for k, (x, y) in enumerate(zip(a, b, strict=True)):
+                _assert_same(x, y, f"{where}[{k}]")
+        else:
+            assert np.array_equal(a, b, equal_nan=a.dtype.kind in "fc"), where
+    elif isinstance(a, list | tuple):
+        assert type(a) is type(b) and len(a) == len(b), where
+        for k, (x, y) in enumerate(zip(a, b, strict=True)):
+            _assert_same(x, y, f"{where}[{k}]")
+    elif isinstance(a, float) and np.isnan(a):
+        assert isinstance(b, float) and np.isnan(b), where
+    else:
+        assert a == b and type(a) is type(b), where
+
+
+def _run_both(batched, sync, steps: int, seed: int) -> tuple[int, int]:
+    """Step both with the same random actions; (terminations, truncations) seen."""
+    _assert_same(batched.reset(seed=seed), sync.reset(seed=seed), "reset")
+    rng = np.random.default_rng(seed)
+    shape = (batched.num_envs, *batched.single_action_space.shape)
+    ended = np.zeros(2, dtype=int)
+    for k in range(steps):
+        actions = rng.uniform(-1.0, 1.0, shape).astype(np.float32)
+        got, expected = batched.step(actions), sync.step(actions)
+        _assert_same(got, expected, f"step {k}")
+        ended += [int(got[2].sum()), int(got[3].sum())]
+    batched.close()
+    sync.close()
+    return tuple(ended)
+
+
+@pytest.mark.parametrize("env_id", BATCHED_IDS)
+def test_batched_equals_single_envs_through_resets(env_id):
+    batched, sync = _pair(env_id, 3, task_distribution="train", max_episode_steps=40)
+    assert isinstance(batched, BatchedVectorEnv)
+    terminated, truncated = _run_both(batched, sync, 130, seed=7)
+    assert truncated > 0  # the time limit's autoresets were exercised
+
+
+def test_batched_equals_single_envs_on_tip_overs():
+    """On a platform that starts tilting at once, the held robot tips over: terminations and
+    their autoresets."""
+    batched, sync = _pair(
+        "HexapodStewartTilt-v1",
+        2,
+        task_distribution="train",
+        tilt_start_time=0.2,
+        max_episode_steps=400,
+    )
+    terminated, _ = _run_both(batched, sync, 300, seed=1)
+    assert terminated > 0
+
+
+@pytest.mark.parametrize("nthread", [0, 1, 3])
+def test_thread_count_does_not_change_results(nthread):
+    batched, sync = _pair("HexapodStewartTilt-v1", 4, nthread=nthread, max_episode_steps=25)
+    _run_both(batched, sync, 60, seed=2)
+
+
+def test_same_step_autoreset():
+    batched, sync = _pair(
+        "HexapodCliffWalk-v0", 2, autoreset_mode=AutoresetMode.SAME_STEP, max_episode_steps=20
+    )
+    assert batched.metadata["autoreset_mode"] == AutoresetMode.SAME_STEP
+    _run_both(batched, sync, 50, seed=4)
+
+
+def test_registered_ids_build_batched_worlds_with_their_settings():
+    for env_id in [*BATCHED_IDS, "HexapodDitchCrossing-v0", "HexapodDitchCrossing-v1"]:
+        spec = gym.spec(env_id)
+        envs = gym.make_vec(env_id, 2, vectorization_mode="vector_entry_point", nthread=1)
+        single = gym.make(env_id)
+        assert envs.metadata["autoreset_mode"] == AutoresetMode.NEXT_STEP
+        assert vars(envs.worlds[0].settings) == vars(single.unwrapped.settings), env_id
+        assert envs.envs[0]._max_episode_steps == spec.max_episode_steps
+        assert envs.single_observation_space == single.observation_space
+        envs.close()
+        single.close()
+
+
+def test_bad_action_leaves_every_world_alone():
+    batched, sync = _pair("HexapodCliffWalk-v1", 2, max_episode_steps=30)
+    batched.reset(seed=0)
+    sync.reset(seed=0)
+    bad = np.zeros((2, 18), dtype=np.float32)
+    bad[1, 3] = np.nan
+    with pytest.raises(ValueError, match="NaN or inf"):
+        batched.step(bad)
+    assert not any("_simulate" in w.__dict__ for w in batched.worlds)
+    good = np.full((2, 18), 0.1, dtype=np.float32)
+    _assert_same(batched.step(good), sync.step(good), "after the refused action")
+
+
+def test_nthread_is_checked():
+    with pytest.raises(ValueError, match="nthread must be an integer >= 0"):
+        gym.make_vec("HexapodCliffWalk-v0", 2, vectorization_mode="vector_entry_point", nthread=-1)
