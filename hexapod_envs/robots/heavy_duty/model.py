@@ -47,11 +47,30 @@ def add_heavy_duty(
     """Add the robot to `spec` with its torso at `pos` (world, m).
 
     `joints` optionally gives the initial [J_x, J_z, J_theta] per leg (default: standing pose).
+    The torso, then per leg its bodies, its three servos and its foot force sensor, then the
+    IMU: the order fixes the compiled model's indices.
     """
     if spec.compiler.degree:
         raise ValueError("set spec.compiler.degree = False: this builder gives angles in radians")
     p = params or HeavyDutyParams()
     gears = (1.0 / p.k_x, 1.0 / p.k_z, 1.0)
+    torso = _add_torso(spec, p, pos)
+    leg_joints: dict[str, tuple[str, ...]] = {}
+    for leg in LEG_NAMES:
+        names = tuple(f"{leg}_{j}" for j in JOINT_NAMES)
+        leg_joints[leg] = names
+        _add_leg(torso, p, leg, names)
+        _add_servos(spec, p, names, gears)
+        add_foot_force_sensor(spec, leg)
+    add_imu_sensors(spec)
+    return HeavyDutyHandles(legs=LEG_NAMES, joints=leg_joints, gears=gears)
+
+
+def _add_torso(
+    spec: mujoco.MjSpec, p: HeavyDutyParams, pos: tuple[float, float, float]
+) -> mujoco.MjsBody:
+    """The free-floating torso box at `pos` [m] with the ``imu`` and ``cog`` sites and the
+    ``track`` camera; returns its body."""
     torso = spec.worldbody.add_body(name="torso", pos=list(pos))
     torso.add_freejoint(name="root")
     torso.add_geom(
@@ -72,106 +91,116 @@ def add_heavy_duty(
         pos=[-9.0, 7.0, 4.5],
         xyaxes=[-0.6, -0.8, 0, 0.33, -0.25, 0.91],
     )
+    return torso
 
-    leg_joints: dict[str, tuple[str, ...]] = {}
-    for leg in LEG_NAMES:
-        l1 = p.signed_l1(leg)
-        names = tuple(f"{leg}_{j}" for j in JOINT_NAMES)
-        leg_joints[leg] = names
-        m = p.leg_mass
-        hip = torso.add_body(name=f"{leg}_hip", pos=p.hip_offsets[leg].tolist())
-        hip.add_joint(
-            name=names[2],
-            type=mujoco.mjtJoint.mjJNT_HINGE,
-            axis=[1, 0, 0],
-            range=list(p.j_theta_range),
-            damping=p.foot_damping[2],
-            armature=p.joint_armature[2],
-        )
-        hip.add_geom(
-            type=mujoco.mjtGeom.mjGEOM_BOX,
-            size=[0.25, abs(l1) / 2, 0.2],
-            pos=[0, l1 / 2, 0],
-            mass=m * _MASS_SPLIT["hip"],
-            contype=0,
-            conaffinity=0,
-            rgba=[0.3, 0.3, 0.35, 1],
-        )
-        carriage = hip.add_body(name=f"{leg}_carriage", pos=[0, l1, 0])
-        carriage.add_joint(
-            name=names[0],
-            type=mujoco.mjtJoint.mjJNT_SLIDE,
-            axis=[1, 0, 0],
-            range=[p.k_x * p.j_x_range[0], p.k_x * p.j_x_range[1]],
-            damping=p.foot_damping[0],
-            armature=p.joint_armature[0],
-        )
-        carriage.add_geom(
-            type=mujoco.mjtGeom.mjGEOM_CAPSULE,
-            fromto=[0, 0, 0.15, 0, 0, -p.l2],
-            size=[0.1, 0, 0],
-            mass=m * _MASS_SPLIT["carriage"],
-            contype=0,
-            conaffinity=0,
-            rgba=[0.3, 0.3, 0.35, 1],
-        )
-        shank = carriage.add_body(name=f"{leg}_shank", pos=[0, 0, -p.l2])
-        shank.add_joint(
-            name=names[1],
-            type=mujoco.mjtJoint.mjJNT_SLIDE,
-            axis=[0, 0, -1],
-            range=[p.k_z * p.j_z_range[0], p.k_z * p.j_z_range[1]],
-            damping=p.foot_damping[1],
-            armature=p.joint_armature[1],
-        )
-        shank.add_geom(
-            type=mujoco.mjtGeom.mjGEOM_CAPSULE,
-            fromto=[0, 0, 0.7, 0, 0, p.foot_radius],
-            size=[0.08, 0, 0],
-            mass=m * _MASS_SPLIT["shank"],
-            contype=0,
-            conaffinity=0,
-            rgba=[0.45, 0.45, 0.5, 1],
-        )
-        foot = shank.add_body(name=f"{leg}_foot", pos=[0, 0, 0])
-        foot.add_geom(
-            name=f"{leg}_foot",
-            type=mujoco.mjtGeom.mjGEOM_SPHERE,
-            size=[p.foot_radius, 0, 0],
-            pos=[0, 0, p.foot_radius],
-            mass=m * _MASS_SPLIT["foot"],
-            contype=_COLLIDE_GROUND,
-            conaffinity=0,
-            friction=[p.friction, 0.005, 0.0001],
-            condim=3,
-            rgba=[0.15, 0.15, 0.15, 1],
-        )
-        # The shank's origin is the sole: the kinematic foot point and the paper's foothold.
-        foot.add_site(name=f"{leg}_foot", pos=[0, 0, 0], size=[0.04, 0, 0])
 
-        for joint, gear, k, f_max in zip(
-            names, gears, p.foot_stiffness, p.force_limit, strict=True
-        ):
-            # A position servo in actuator units: joint-space stiffness = gear^2 * kp.
-            act = spec.add_actuator(
-                name=joint,
-                target=joint,
-                trntype=mujoco.mjtTrn.mjTRN_JOINT,
-                gear=[gear, 0, 0, 0, 0, 0],
-            )
-            kp = k / gear**2
-            act.set_to_position(kp=kp)
-            act.forcelimited = True
-            act.forcerange = [-f_max / gear, f_max / gear]
-            act.ctrlrange = list(p.joint_ranges[JOINT_NAMES.index(joint.split("_")[1])])
-            act.ctrllimited = True
-            spec.add_sensor(
-                name=f"{joint}_pos",
-                type=mujoco.mjtSensor.mjSENS_ACTUATORPOS,
-                objtype=mujoco.mjtObj.mjOBJ_ACTUATOR,
-                objname=joint,
-            )
-        add_foot_force_sensor(spec, leg)
+def _add_joint(
+    body: mujoco.MjsBody,
+    p: HeavyDutyParams,
+    name: str,
+    kind: mujoco.mjtJoint,
+    axis: list[float],
+    limits: list[float],
+    index: int,
+) -> None:
+    """A joint of a leg with the damping and armature of the paper's joint `index` (0: the
+    horizontal, 1: the vertical, 2: the swing joint); `limits` in MuJoCo units (m or rad)."""
+    body.add_joint(
+        name=name,
+        type=kind,
+        axis=axis,
+        range=limits,
+        damping=p.foot_damping[index],
+        armature=p.joint_armature[index],
+    )
 
-    add_imu_sensors(spec)
-    return HeavyDutyHandles(legs=LEG_NAMES, joints=leg_joints, gears=gears)
+
+def _link_geom(
+    body: mujoco.MjsBody, kind: mujoco.mjtGeom, mass: float, rgba: list[float], **shape
+) -> None:
+    """A visual link of a leg: it carries `mass` [kg] and collides with nothing."""
+    body.add_geom(type=kind, **shape, mass=mass, contype=0, conaffinity=0, rgba=rgba)
+
+
+def _add_leg(torso: mujoco.MjsBody, p: HeavyDutyParams, leg: str, names: tuple[str, ...]) -> None:
+    """The leg's chain in foot space: the hip swings about x (J_theta), the carriage slides
+    along x (the horizontal joint), the shank slides down the leg (the vertical joint) and the
+    foot, fixed to the shank, carries the sole's sphere and the ``{leg}_foot`` site.
+    `names`: the joints in `JOINT_NAMES` order."""
+    l1 = p.signed_l1(leg)
+    m = p.leg_mass
+    hip = torso.add_body(name=f"{leg}_hip", pos=p.hip_offsets[leg].tolist())
+    _add_joint(hip, p, names[2], mujoco.mjtJoint.mjJNT_HINGE, [1, 0, 0], list(p.j_theta_range), 2)
+    _link_geom(
+        hip,
+        mujoco.mjtGeom.mjGEOM_BOX,
+        m * _MASS_SPLIT["hip"],
+        [0.3, 0.3, 0.35, 1],
+        size=[0.25, abs(l1) / 2, 0.2],
+        pos=[0, l1 / 2, 0],
+    )
+    carriage = hip.add_body(name=f"{leg}_carriage", pos=[0, l1, 0])
+    x_range = [p.k_x * p.j_x_range[0], p.k_x * p.j_x_range[1]]
+    _add_joint(carriage, p, names[0], mujoco.mjtJoint.mjJNT_SLIDE, [1, 0, 0], x_range, 0)
+    _link_geom(
+        carriage,
+        mujoco.mjtGeom.mjGEOM_CAPSULE,
+        m * _MASS_SPLIT["carriage"],
+        [0.3, 0.3, 0.35, 1],
+        fromto=[0, 0, 0.15, 0, 0, -p.l2],
+        size=[0.1, 0, 0],
+    )
+    shank = carriage.add_body(name=f"{leg}_shank", pos=[0, 0, -p.l2])
+    z_range = [p.k_z * p.j_z_range[0], p.k_z * p.j_z_range[1]]
+    _add_joint(shank, p, names[1], mujoco.mjtJoint.mjJNT_SLIDE, [0, 0, -1], z_range, 1)
+    _link_geom(
+        shank,
+        mujoco.mjtGeom.mjGEOM_CAPSULE,
+        m * _MASS_SPLIT["shank"],
+        [0.45, 0.45, 0.5, 1],
+        fromto=[0, 0, 0.7, 0, 0, p.foot_radius],
+        size=[0.08, 0, 0],
+    )
+    foot = shank.add_body(name=f"{leg}_foot", pos=[0, 0, 0])
+    foot.add_geom(
+        name=f"{leg}_foot",
+        type=mujoco.mjtGeom.mjGEOM_SPHERE,
+        size=[p.foot_radius, 0, 0],
+        pos=[0, 0, p.foot_radius],
+        mass=m * _MASS_SPLIT["foot"],
+        contype=_COLLIDE_GROUND,
+        conaffinity=0,
+        friction=[p.friction, 0.005, 0.0001],
+        condim=3,
+        rgba=[0.15, 0.15, 0.15, 1],
+    )
+    # The shank's origin is the sole: the kinematic foot point and the paper's foothold.
+    foot.add_site(name=f"{leg}_foot", pos=[0, 0, 0], size=[0.04, 0, 0])
+
+
+def _add_servos(
+    spec: mujoco.MjSpec, p: HeavyDutyParams, names: tuple[str, ...], gears: tuple[float, ...]
+) -> None:
+    """A position servo per joint in the paper's joint units (gear 1/K, so ``ctrl`` is J),
+    with its stiffness, force limit and control range, and an ``{joint}_pos`` sensor that
+    reads J."""
+    for joint, gear, k, f_max in zip(names, gears, p.foot_stiffness, p.force_limit, strict=True):
+        # A position servo in actuator units: joint-space stiffness = gear^2 * kp.
+        act = spec.add_actuator(
+            name=joint,
+            target=joint,
+            trntype=mujoco.mjtTrn.mjTRN_JOINT,
+            gear=[gear, 0, 0, 0, 0, 0],
+        )
+        kp = k / gear**2
+        act.set_to_position(kp=kp)
+        act.forcelimited = True
+        act.forcerange = [-f_max / gear, f_max / gear]
+        act.ctrlrange = list(p.joint_ranges[JOINT_NAMES.index(joint.split("_")[1])])
+        act.ctrllimited = True
+        spec.add_sensor(
+            name=f"{joint}_pos",
+            type=mujoco.mjtSensor.mjSENS_ACTUATORPOS,
+            objtype=mujoco.mjtObj.mjOBJ_ACTUATOR,
+            objname=joint,
+        )
