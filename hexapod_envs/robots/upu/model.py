@@ -280,8 +280,27 @@ def add_upu(
             standing with all six nominal-length legs on flat ground at z = 0, 1 mm above it.
         command: "position" (ctrl = target) or "interpolated" (act = target, ctrl = its rate;
             see the module docstring). The interpolated mode needs the PD limb servo.
+
+    The lower platform (the torso), the upper platform on its slides, the three limbs between
+    them, the six legs (upper platform's first), then the IMU: the order fixes the compiled
+    model's indices.
     """
     p = params or UpuParams()
+    interpolated = _is_interpolated(command, p)
+    torso = _add_lower_platform(spec, p, _torso_position(pos, p))
+    upper = _add_upper_platform(torso, p)
+    _add_limbs(spec, p, interpolated)
+    for leg in UPPER_LEGS:
+        _add_leg(spec, upper, leg, p, interpolated)
+    for leg in LOWER_LEGS:
+        _add_leg(spec, torso, leg, p, interpolated)
+    add_imu_sensors(spec)
+    return UpuHandles()
+
+
+def _is_interpolated(command: str, p: UpuParams) -> bool:
+    """Whether `command` is the interpolated mode; ValueError for an unknown mode, or for the
+    interpolated one with an integrating limb servo (both use the actuator activation)."""
     if command not in COMMAND_MODES:
         raise ValueError(f"command must be one of {COMMAND_MODES}, got {command!r}")
     interpolated = command == "interpolated"
@@ -290,18 +309,35 @@ def add_upu(
             'command="interpolated" drives the servo target through the actuator activation, '
             "which MuJoCo's PID actuator uses for its integral: set limb_integral_gain=0"
         )
+    return interpolated
+
+
+def _torso_position(pos: tuple[float, float, float] | None, p: UpuParams) -> list[float]:
+    """`pos` as three finite floats [m] (ValueError otherwise); None: standing on flat ground
+    at z = 0 with nominal-length legs, 1 mm above it."""
     if pos is None:
         pos = (0.0, 0.0, p.lower_leg_length + 0.001)
     pos = [float(v) for v in pos]
     if len(pos) != 3 or not all(math.isfinite(v) for v in pos):
         raise ValueError(f"pos must be three finite coordinates [m], got {pos}")
+    return pos
 
+
+def _set_plate_inertia(body: mujoco.MjsBody, mass: float, radius: float) -> None:
+    """A platform's mass [kg] as a 4 cm disc of `radius` [m] centred half a plate below the
+    body's origin."""
+    body.explicitinertial = True
+    body.mass = mass
+    body.ipos = [0, 0, -_PLATE_THICKNESS / 2]
+    body.inertia = _disc_inertia(mass, radius, 0.04)
+
+
+def _add_lower_platform(spec: mujoco.MjSpec, p: UpuParams, pos: list[float]) -> mujoco.MjsBody:
+    """The torso: the free-floating lower platform at `pos` with its plate, the ``imu`` site,
+    the ``track`` camera and the limbs' lower Hooke-joint sites ``hooke_A<i>``."""
     torso = spec.worldbody.add_body(name="torso", pos=pos)
     torso.add_freejoint(name="root")
-    torso.explicitinertial = True
-    torso.mass = p.lower_platform_mass
-    torso.ipos = [0, 0, -_PLATE_THICKNESS / 2]
-    torso.inertia = _disc_inertia(p.lower_platform_mass, p.lower_radius, 0.04)
+    _set_plate_inertia(torso, p.lower_platform_mass, p.lower_radius)
     lower_arms = [p.foot_offset(leg) for leg in LOWER_LEGS]
     _add_plate(torso, "lower_plate", 0.1, lower_arms, [0.75, 0.55, 0.2, 1])
     torso.add_site(name="imu", pos=[0, 0, 0], size=[0.01, 0, 0])
@@ -313,12 +349,15 @@ def add_upu(
     )
     for i, point in enumerate(p.lower_hooke_points):
         torso.add_site(name=f"hooke_A{i + 1}", pos=point.tolist(), size=[0.012, 0, 0])
+    return torso
 
+
+def _add_upper_platform(torso: mujoco.MjsBody, p: UpuParams) -> mujoco.MjsBody:
+    """The upper platform on three damped slides (x, y, z) relative to the torso, which only
+    translate it (the limbs hold it parallel), with its plate and the upper Hooke-joint sites
+    ``hooke_B<i>``."""
     upper = torso.add_body(name="upper", pos=p.initial_position.tolist())
-    upper.explicitinertial = True
-    upper.mass = p.upper_platform_mass
-    upper.ipos = [0, 0, -_PLATE_THICKNESS / 2]
-    upper.inertia = _disc_inertia(p.upper_platform_mass, p.upper_radius, 0.04)
+    _set_plate_inertia(upper, p.upper_platform_mass, p.upper_radius)
     for name, axis in zip(UPPER_JOINTS, np.eye(3), strict=True):
         lo, hi = (-_SLIDE_RANGE_XY, _SLIDE_RANGE_XY) if name != "upper_z" else _SLIDE_RANGE_Z
         upper.add_joint(
@@ -335,7 +374,13 @@ def add_upu(
     _add_plate(upper, "upper_plate", 0.07, upper_arms, [0.3, 0.5, 0.75, 1])
     for i, point in enumerate(p.upper_hooke_points):
         upper.add_site(name=f"hooke_B{i + 1}", pos=point.tolist(), size=[0.012, 0, 0])
+    return upper
 
+
+def _add_limbs(spec: mujoco.MjSpec, p: UpuParams, interpolated: bool) -> None:
+    """The three UPU limbs: a tendon between ``hooke_A<i>`` and ``hooke_B<i>`` within the limb
+    length range, its servo (limited in stroke and force; `interpolated`: rate-limited
+    commands) and a ``<limb>_length`` sensor."""
     for i, limb in enumerate(LIMB_NAMES):
         tendon = spec.add_tendon(name=limb)
         tendon.wrap_site(f"hooke_A{i + 1}")
@@ -358,14 +403,6 @@ def add_upu(
             objtype=mujoco.mjtObj.mjOBJ_TENDON,
             objname=limb,
         )
-
-    for leg in UPPER_LEGS:
-        _add_leg(spec, upper, leg, p, interpolated)
-    for leg in LOWER_LEGS:
-        _add_leg(spec, torso, leg, p, interpolated)
-
-    add_imu_sensors(spec)
-    return UpuHandles()
 
 
 def upper_slide_offset(position, params: UpuParams) -> np.ndarray:
