@@ -383,12 +383,22 @@ def _unstable(infos: list[dict]) -> bool:
 
 
 def heavy_duty_fidelity(setting: PhysicsSetting, quick: bool) -> list[Fidelity]:
-    from agents.registry import analytical_policy
-    from agents.tripod_gait import TripodGaitPolicy
-    from hexapod_envs.envs.stewart_tilt import CASES
+    """The heavy-duty robot's fidelity rows under `setting`: the flat walk's FASM, the paper
+    cliff's reference gait, the held-out test cliffs and the Stewart platform's controller
+    (`quick`: fewer cycles, tasks and cases)."""
+    return [
+        *_flat_walk_rows(setting, quick),
+        *_paper_cliff_rows(setting),
+        _test_cliffs_row(setting, quick),
+        *_stewart_rows(setting, quick),
+    ]
 
-    rows = []
-    # Flat walk: 150 standing steps, then whole 300-step gait cycles (reproduction rows 1-3).
+
+def _flat_walk_rows(setting: PhysicsSetting, quick: bool) -> list[Fidelity]:
+    """Flat walk with the tripod gait: 150 standing steps, then whole 300-step gait cycles
+    (reproduction rows 1-3); the standing FASM's median and the walking FASM's range [deg]."""
+    from agents.tripod_gait import TripodGaitPolicy
+
     cycles = 2 if quick else 5
     steps = 150 + cycles * 300 + 10
     env = make_env(
@@ -401,7 +411,7 @@ def heavy_duty_fidelity(setting: PhysicsSetting, quick: bool) -> list[Fidelity]:
         failed, note = True, f"episode ended at {infos[-1]['time']:.2f} s"
     fasm = np.array([i["fasm_margin_deg"] for i in infos])
     stand, walk = fasm[10:150], fasm[151:]
-    rows += [
+    return [
         Fidelity(
             "flat: FASM standing, median [deg]",
             float(np.median(stand)) if len(stand) else math.nan,
@@ -419,8 +429,12 @@ def heavy_duty_fidelity(setting: PhysicsSetting, quick: bool) -> list[Fidelity]:
             note,
         ),
     ]
-    # Paper cliff, reference gait (zero residual). The tip-over limit is raised to 60 deg so that
-    # the peak tilt is seen; "tips over" applies the env's 20 deg rule to the same tilt series.
+
+
+def _paper_cliff_rows(setting: PhysicsSetting) -> list[Fidelity]:
+    """Paper cliff, reference gait (zero residual): whether and when the body tilts past
+    20 deg, and the peak tilt. The tip-over limit is raised to 60 deg so that the peak tilt is
+    seen; "tips over" applies the env's 20 deg rule to the same tilt series."""
     env = make_env("HexapodCliffWalk-v0", setting, tip_over_angle_deg=60.0)
     base = env.unwrapped
     obs, info = reset_checked(env, setting, 0)
@@ -437,7 +451,7 @@ def heavy_duty_fidelity(setting: PhysicsSetting, quick: bool) -> list[Fidelity]:
     tilt = np.array(tilt)
     over = np.flatnonzero(tilt > 20.0)
     tip_time = (over[0] + 1) * base.control_dt if len(over) else None
-    rows += [
+    return [
         Fidelity(
             "cliff: reference tips over (body tilt > 20 deg), at [s]",
             (tip_time is not None, tip_time),
@@ -455,9 +469,12 @@ def heavy_duty_fidelity(setting: PhysicsSetting, quick: bool) -> list[Fidelity]:
             f"at {(np.argmax(tilt) + 1) * base.control_dt:.2f} s",
         ),
     ]
-    # Held-out test cliffs (seeds 0-19: the shipped report's tasks), reference gait: how many
-    # tip over. The paper cliff is one task whose tilt peaks just past the 20 deg limit; across
-    # the test distribution a step's numerical damping can change the outcome near the edge.
+
+
+def _test_cliffs_row(setting: PhysicsSetting, quick: bool) -> Fidelity:
+    """Held-out test cliffs (seeds 0-19: the shipped report's tasks), reference gait: how many
+    tip over. The paper cliff is one task whose tilt peaks just past the 20 deg limit; across
+    the test distribution a step's numerical damping can change the outcome near the edge."""
     n_tasks = 5 if quick else 20
     env = make_env("HexapodCliffWalk-v0", setting, task_distribution="test")
     tipped, failed = 0, False
@@ -466,17 +483,23 @@ def heavy_duty_fidelity(setting: PhysicsSetting, quick: bool) -> list[Fidelity]:
         tipped += bool(infos[-1]["is_tipped_over"])
         failed = failed or _unstable(infos)
     env.close()
-    rows.append(
-        Fidelity(
-            f"cliff, {n_tasks} test tasks: the reference gait tips over on",
-            tipped,
-            "within 1 task",
-            within(1.0),
-            failed,
-            "sim unstable" if failed else "",
-        )
+    return Fidelity(
+        f"cliff, {n_tasks} test tasks: the reference gait tips over on",
+        tipped,
+        "within 1 task",
+        within(1.0),
+        failed,
+        "sim unstable" if failed else "",
     )
-    # Stewart platform: the analytical controller (TippingRecoveryPolicy), residual mode.
+
+
+def _stewart_rows(setting: PhysicsSetting, quick: bool) -> list[Fidelity]:
+    """Stewart platform: the analytical controller (TippingRecoveryPolicy, residual mode) on
+    each paper case (`quick`: the LF-LR-RM stance only); whether it tips over or succeeds."""
+    from agents.registry import analytical_policy
+    from hexapod_envs.envs.stewart_tilt import CASES
+
+    rows = []
     cases = [c for c in CASES if c[1] == "LF-LR-RM"] if quick else CASES
     for scenario, stance in cases:
         env = make_env("HexapodStewartTilt-v0", setting, scenario=scenario, stance=stance)
