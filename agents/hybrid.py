@@ -22,13 +22,9 @@ so training and evaluation compute the same env action from the same observation
     The heavy-duty robot's recovery (Zhang et al. 2024) acts once per episode: after judging
     tipping it lands a leg, distributes the foot forces and then holds that stance until the env
     resets; handing control back does not re-arm it. Every later override in the episode applies
-    that recovery's supported or held posture, not a new judgment: on the shipped cliff
-    hybrid's first four test tasks (zero learned action), 414-581 of the 505-657 override steps
-    per episode found the controller in its supported or holding phase, none in monitoring. All
-    four episodes succeeded. Re-arming the controller at every hand-back (its plan cleared, its
-    filters kept; tried outside the package on the 20 test tasks) took over less often (a median
-    of 18 take-overs per episode against 66) and succeeded on 18 of 20 against 20, no tip-over
-    either way.
+    that recovery's supported or held posture, not a new judgment. Re-arming the controller at
+    every hand-back (its plan cleared, its filters kept) is not done because it succeeded less
+    often on the cliff's test tasks (CHANGELOG.md, Findings).
 
 ``safety_filter=True`` adds the same override to the residual mode: the learned residual is
 dropped (the pure analytical action is applied) while the FASM is below ξ, so a residual cannot
