@@ -239,60 +239,20 @@ def fit_actor(
     interpolation is flat there: without it the actor drifts to 0 or 1).
 
     `observations` are what the network sees (normalised). The critic is not touched."""
-    import copy
-
     import torch
 
     torch.manual_seed(seed)
-    device = policy.device
-    obs = torch.as_tensor(observations, dtype=torch.float32, device=device)
-    levels = demos.levels
-    lattice = torch.as_tensor(lattice_costs(demos, cost), device=device)
-    ref = torch.as_tensor(np.asarray(demos.reference, dtype=np.float32), device=device)
     validation = np.asarray(validation, dtype=bool)
     train_rows, held_out = np.flatnonzero(~validation), np.flatnonzero(validation)
     if len(train_rows) == 0 or len(held_out) == 0:
         raise ValueError("fit_actor needs both training and validation rows")
-    val_rows = torch.as_tensor(held_out, device=device)
-
-    lo, hi = float(levels[0]), float(levels[-1])
-
-    def gains(rows) -> torch.Tensor:
-        mean = policy.get_distribution(obs[rows]).distribution.mean
-        return (ref + scale * mean.clamp(-1.0, 1.0)).clamp(0.0, 1.0)
-
-    def loss(rows) -> torch.Tensor:
-        # unclipped, so that the edge term pulls back an action beyond the action space too
-        raw = ref + scale * policy.get_distribution(obs[rows]).distribution.mean
-        outside = torch.relu(lo - raw) + torch.relu(raw - hi)
-        cost = interpolated_cost(lattice[rows], raw, levels)
-        return (cost + edge_weight * (outside**2).sum(dim=-1)).mean()
-
-    def mean_cost(rows) -> float:
-        with torch.no_grad():
-            return float(interpolated_cost(lattice[rows], gains(rows), levels).mean())
-
+    objective = _GainsObjective(policy, observations, demos, cost, scale, edge_weight)
+    history, best_epoch = _train_actor(
+        policy, objective, train_rows, held_out, epochs, learning_rate, batch_size, seed
+    )
     costs = demos.costs(cost)
-    on_lattice = costs[:, : len(levels) ** 3]
+    on_lattice = costs[:, : len(demos.levels) ** 3]
     best_constant = int(on_lattice[train_rows].mean(axis=0).argmin())
-    actor = [*policy.mlp_extractor.policy_net.parameters(), *policy.action_net.parameters()]
-    optimizer = torch.optim.Adam(actor, lr=learning_rate)
-    generator = np.random.default_rng(seed)
-    train_t = torch.as_tensor(train_rows, device=device)
-    history = [(0, mean_cost(train_t), mean_cost(val_rows))]
-    best_state, best_epoch = copy.deepcopy(policy.state_dict()), 0
-    for epoch in range(1, epochs + 1):
-        for batch in np.array_split(
-            generator.permutation(train_rows), max(1, len(train_rows) // batch_size)
-        ):
-            rows = torch.as_tensor(batch, device=device)
-            optimizer.zero_grad()
-            loss(rows).backward()
-            optimizer.step()
-        history.append((epoch, mean_cost(train_t), mean_cost(val_rows)))
-        if history[-1][2] < min(v for e, _, v in history[:-1]):
-            best_state, best_epoch = copy.deepcopy(policy.state_dict()), epoch
-    policy.load_state_dict(best_state)
     return FitResult(
         history,
         best_epoch,
@@ -300,6 +260,92 @@ def fit_actor(
         teacher_cost=float(costs[held_out].min(axis=1).mean()),
         best_constant_cost=float(on_lattice[held_out, best_constant].mean()),
     )
+
+
+class _GainsObjective:
+    """What `fit_actor` minimises and reports, on rows of the demonstrations: the gains the
+    actor's mean action gives (the hybrid residual over `demos.reference`), their cost
+    interpolated over the lattice, and the training loss (that cost plus the penalty for gains
+    outside the lattice)."""
+
+    def __init__(self, policy, observations, demos, cost, scale, edge_weight):
+        import torch
+
+        device = policy.device
+        self.policy, self.scale, self.edge_weight = policy, scale, edge_weight
+        self.device = device
+        self.obs = torch.as_tensor(observations, dtype=torch.float32, device=device)
+        self.levels = demos.levels
+        self.lattice = torch.as_tensor(lattice_costs(demos, cost), device=device)
+        self.ref = torch.as_tensor(np.asarray(demos.reference, dtype=np.float32), device=device)
+        self.lo, self.hi = float(self.levels[0]), float(self.levels[-1])
+
+    def _mean_action(self, rows):
+        return self.policy.get_distribution(self.obs[rows]).distribution.mean
+
+    def gains(self, rows):
+        """The gains (torch (n, 3)) the hybrid applies: the action clipped to [-1, 1], the
+        gains to [0, 1]."""
+        return (self.ref + self.scale * self._mean_action(rows).clamp(-1.0, 1.0)).clamp(0.0, 1.0)
+
+    def loss(self, rows):
+        """The mean interpolated cost plus `edge_weight` x (distance outside the lattice)²."""
+        import torch
+
+        # unclipped, so that the edge term pulls back an action beyond the action space too
+        raw = self.ref + self.scale * self._mean_action(rows)
+        outside = torch.relu(self.lo - raw) + torch.relu(raw - self.hi)
+        cost = interpolated_cost(self.lattice[rows], raw, self.levels)
+        return (cost + self.edge_weight * (outside**2).sum(dim=-1)).mean()
+
+    def mean_cost(self, rows) -> float:
+        """The mean interpolated cost of the applied gains (no gradient)."""
+        import torch
+
+        with torch.no_grad():
+            cost = interpolated_cost(self.lattice[rows], self.gains(rows), self.levels)
+            return float(cost.mean())
+
+
+def _train_actor(
+    policy,
+    objective: _GainsObjective,
+    train_rows: np.ndarray,
+    held_out: np.ndarray,
+    epochs: int,
+    learning_rate: float,
+    batch_size: int,
+    seed: int,
+) -> tuple[list[tuple[int, float, float]], int]:
+    """Adam on the actor's parameters (its MLP and action net), shuffled mini-batches of the
+    training rows each epoch; the policy ends with the weights of the epoch of lowest
+    validation cost (early stopping). Returns the history (epoch, training cost, validation
+    cost), epoch 0 the untrained actor, and that best epoch."""
+    import copy
+
+    import torch
+
+    device = objective.device
+    train_t = torch.as_tensor(train_rows, device=device)
+    val_rows = torch.as_tensor(held_out, device=device)
+    actor = [*policy.mlp_extractor.policy_net.parameters(), *policy.action_net.parameters()]
+    optimizer = torch.optim.Adam(actor, lr=learning_rate)
+    generator = np.random.default_rng(seed)
+    history = [(0, objective.mean_cost(train_t), objective.mean_cost(val_rows))]
+    best_state, best_epoch = copy.deepcopy(policy.state_dict()), 0
+    for epoch in range(1, epochs + 1):
+        for batch in np.array_split(
+            generator.permutation(train_rows), max(1, len(train_rows) // batch_size)
+        ):
+            rows = torch.as_tensor(batch, device=device)
+            optimizer.zero_grad()
+            objective.loss(rows).backward()
+            optimizer.step()
+        history.append((epoch, objective.mean_cost(train_t), objective.mean_cost(val_rows)))
+        if history[-1][2] < min(v for e, _, v in history[:-1]):
+            best_state, best_epoch = copy.deepcopy(policy.state_dict()), epoch
+    policy.load_state_dict(best_state)
+    return history, best_epoch
 
 
 CHOICE_MARGINS = (0.0, 0.002, 0.005, 0.01, 0.02, 0.05, np.inf)

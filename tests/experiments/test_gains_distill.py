@@ -131,43 +131,28 @@ def test_demonstrations_record_every_candidate_and_the_teachers_budget(tmp_path)
         Demonstrations.load(tmp_path / "bad.npz")
 
 
-def test_script_collects_fits_and_the_model_runs_in_the_evaluation(tmp_path, capsys):
+def _script(command: str, demos, *options: str) -> None:
+    """Run the study script's `command` on the blocks config with the demonstrations `demos`
+    (``collect``: written there; the other commands: read from there)."""
+    where = "--out" if command == "collect" else "--demos"
+    distill_gains.main([command, "--config", CONFIG, where, str(demos), *options])
+
+
+@pytest.fixture(scope="module")
+def collected(tmp_path_factory):
+    """Demonstrations of two short episodes on the 2-level lattice, collected by the script."""
+    demos = tmp_path_factory.mktemp("distill") / "demos.npz"
+    options = "--set env.max_episode_steps=70 --episodes 2 --levels 0.2 0.8"
+    _script("collect", demos, *options.split())
+    return demos
+
+
+def test_script_fits_a_model_that_the_evaluation_loads_and_runs(collected, tmp_path):
     from agents.ppo import PPOPolicy
 
-    script = distill_gains
-    demos = tmp_path / "demos.npz"
-    script.main(
-        [
-            "collect",
-            "--config",
-            CONFIG,
-            "--set",
-            "env.max_episode_steps=70",
-            "--episodes",
-            "2",
-            "--levels",
-            "0.2",
-            "0.8",
-            "--out",
-            str(demos),
-        ]
-    )
     model_dir = tmp_path / "model"
-    script.main(
-        [
-            "fit",
-            "--config",
-            CONFIG,
-            "--demos",
-            str(demos),
-            "--epochs",
-            "3",
-            "--validation-fraction",
-            "0.5",
-            "--out",
-            str(model_dir),
-        ]
-    )
+    options = "--epochs 3 --validation-fraction 0.5"
+    _script("fit", collected, *options.split(), "--out", str(model_dir))
     recorded = read_settings(model_dir)  # the evaluation compares it with the env it runs on
     assert recorded["terrain"] == "blocks" and recorded["terrain_scan"] is True
     env = gym.make(
@@ -183,42 +168,32 @@ def test_script_collects_fits_and_the_model_runs_in_the_evaluation(tmp_path, cap
     policy.reset()
     action = policy(obs)
     assert action.shape == (3,) and np.all((action >= 0.0) & (action <= 1.0))
-    script.main(
-        [
-            "curve",
-            "--config",
-            CONFIG,
-            "--demos",
-            str(demos),
-            "--epochs",
-            "2",
-            "--validation-fraction",
-            "0.5",
-            "--fractions",
-            "1",
-            "--seeds",
-            "1",
-        ]
-    )
+
+
+def test_script_draws_the_learning_curve_over_training_beds(collected, capsys):
+    options = "--epochs 2 --validation-fraction 0.5 --fractions 1 --seeds 1"
+    _script("curve", collected, *options.split())
     assert "1 training beds: held-out cost" in capsys.readouterr().out
-    # choose: two more beds (the same rows relabelled) so that test, validation and training
-    # each get one
-    collected = Demonstrations.load(demos)
+
+
+def test_script_chooses_among_the_candidates_and_names_bad_arguments(collected, tmp_path, capsys):
+    # two more beds (the same rows relabelled) so that test, validation and training each get one
+    loaded = Demonstrations.load(collected)
     four = tmp_path / "four.npz"
-    relabelled = dataclasses.replace(collected, beds=collected.beds + 2)
-    Demonstrations.concatenate([collected, relabelled]).save(four)
-    choose = ["choose", "--config", CONFIG, "--demos", str(four), "--test-beds", "1"]
-    script.main([*choose, "--beds", "3", "--seeds", "1", "--epochs", "2", "--drop", "terrain_scan"])
+    relabelled = dataclasses.replace(loaded, beds=loaded.beds + 2)
+    Demonstrations.concatenate([loaded, relabelled]).save(four)
+    options = "--beds 3 --seeds 1 --epochs 2 --drop terrain_scan"
+    _script("choose", four, "--test-beds", "1", *options.split())
     assert "2 beds" not in (out := capsys.readouterr().out)
     assert "3 beds (a fifth for early stopping): test cost" in out and "oracle" in out
     with pytest.raises(ValueError, match="--beds \\[1\\]: each needs at least 2"):
-        script.main([*choose, "--beds", "1"])
+        _script("choose", four, "--test-beds", "1", "--beds", "1")
     with pytest.raises(ValueError, match="not observation pieces; valid: .*terrain_scan"):
-        script.main([*choose, "--drop", "terrain"])
+        _script("choose", four, "--test-beds", "1", "--drop", "terrain")
     with pytest.raises(ValueError, match="--test-beds 3: .* 4 beds, and at least two"):
-        script.main([*choose[:-1], "3"])
+        _script("choose", four, "--test-beds", "3")
     with pytest.raises(ValueError, match="wide observations.*--set"):
-        script.main([*choose, "--set", "env.kwargs.foot_scan=true"])
+        _script("choose", four, "--test-beds", "1", "--set", "env.kwargs.foot_scan=true")
 
 
 def test_fit_choice_predicts_the_state_dependent_choice_and_else_keeps_the_best_fixed_one():
