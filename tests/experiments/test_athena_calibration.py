@@ -83,3 +83,15 @@ def test_a_delayed_servo_starts_from_the_standing_targets():
     after the settle phase as it does without latency."""
     heights = [_model(terrain="flat", servo_delay=d).sensors.cog()[2] for d in (0.0, 0.02)]
     assert heights[1] == pytest.approx(heights[0], abs=1e-4)  # 4 mm lower without it
+
+
+def test_validate_reports_the_ramp_changes_and_the_bed_intervals():
+    v = cal.validate({"contact_solref": [0.01, 1.0]}, ramp_seeds=range(1), beds=range(2), steps=100)
+    assert v["name"] == "contact_solref=(0.01, 1)"
+    assert set(v["ramp_change_pct"]) == set(cal.RAMP_METRICS)
+    for controller in cal.CONTROLLERS:
+        assert v["ramp_medians"][controller]["height"] > 0.02
+    for metric in ("pitch_rate", "roll_rate"):
+        estimate, *interval = v["blocks_change_interval"][metric]
+        assert np.isfinite(estimate) and len(interval) == 2  # 2 beds: the interval may be nan
+    assert 0 <= v["posture_beds_touched"] <= 2
