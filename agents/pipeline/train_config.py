@@ -78,6 +78,14 @@ class EnvConfig:
     """With ``decision: gait_cycle``: "zero_action" makes each cycle's reward the difference to
     the same cycle replayed from the same state with the zero action (a hybrid run's paper
     gains), see `hexapod_envs.wrappers.GainsPerCycle`; every cycle is then simulated twice."""
+    vectorization: Literal["vec_env", "batched"] = "vec_env"
+    """How the ``vec_env.n_envs`` training envs run: "vec_env", the SB3 vec env that
+    ``vec_env.type`` picks (SubprocVecEnv or DummyVecEnv); "batched", one process whose envs'
+    physics runs on ``vec_env.physics_threads`` threads while the process runs the rest of each
+    env's step (`agents.pipeline.batched_vec_env`, on `hexapod_envs.vector.BatchedPhysics`):
+    the same transitions as DummyVecEnv, for hexapod env ids whose learner acts at every step
+    without a hybrid policy (those wrappers change the action between the learner and the
+    env)."""
 
 
 @dataclass
@@ -85,9 +93,15 @@ class VecEnvConfig:
     n_envs: int = 1
     type: Literal["auto", "subprocess", "dummy"] = "auto"  # auto: subprocess when n_envs > 1
     start_method: Literal["forkserver", "spawn", "fork"] | None = None  # None: SB3's default
+    physics_threads: int | None = None
+    """With ``env.vectorization: batched``: the threads that run the envs' physics (None: the
+    CPUs, at most ``n_envs``; 0: none, the physics runs in the main thread)."""
 
     def __post_init__(self):
         _require("vec_env.n_envs", self.n_envs, ">= 1", self.n_envs >= 1)
+        threads = self.physics_threads
+        ok = threads is None or threads >= 0
+        _require("vec_env.physics_threads", threads, ">= 0 or null", ok)
 
     @property
     def use_subprocess(self) -> bool:
@@ -329,6 +343,14 @@ class TrainConfig:
             raise ValueError(
                 f"ppo.batch_size={self.ppo.batch_size} exceeds the rollout size "
                 f"ppo.n_steps x vec_env.n_envs = {rollout}"
+            )
+        if self.env.vectorization == "batched" and (
+            self.hybrid is not None or self.env.decision != "step"
+        ):
+            raise ValueError(
+                "env.vectorization: batched applies the learner's action before each env steps, "
+                "so it needs env.decision: step and no hybrid section (both change the action "
+                "between the learner and the env); use env.vectorization: vec_env"
             )
         if self.hybrid is not None and self.hybrid.mask_overridden and self.env.decision != "step":
             raise ValueError(

@@ -129,13 +129,20 @@ def _vec_envs(config: TrainConfig, seed: int, stats: NormalizationStats | None =
     from .envs import EnvFactory
 
     spec = env_spec(config)
-    venv = make_vec_env(
-        spec,
-        config.vec_env.n_envs,
-        seed,
-        subprocess=config.vec_env.use_subprocess,
-        start_method=config.vec_env.start_method,
-    )
+    if config.env.vectorization == "batched":
+        from .batched_vec_env import make_batched_vec_env
+
+        venv = make_batched_vec_env(
+            spec, config.vec_env.n_envs, seed, config.vec_env.physics_threads
+        )
+    else:
+        venv = make_vec_env(
+            spec,
+            config.vec_env.n_envs,
+            seed,
+            subprocess=config.vec_env.use_subprocess,
+            start_method=config.vec_env.start_method,
+        )
     # Evaluations act at every env step (the same actions as per gait cycle, see GainsPerCycle),
     # so that their episode metrics see every step's info.
     eval_spec = dataclasses.replace(spec, decision="step", cycle_baseline="none")

@@ -20,9 +20,10 @@ from gymnasium.envs.registration import load_env_creator
 from gymnasium.vector import AutoresetMode
 from gymnasium.wrappers import OrderEnforcing, TimeLimit
 
-from .batched import BatchedVectorEnv
+from .batched import BatchedPhysics, BatchedVectorEnv
 
 __all__ = [
+    "BatchedPhysics",
     "BatchedVectorEnv",
     "cliff_walk",
     "ditch_crossing",

@@ -32,8 +32,10 @@ and out of every step, and ATHENA's contact checks within a period would be reim
 from __future__ import annotations
 
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor, wait
+from contextlib import contextmanager
+from functools import partial
 from typing import Any
 
 import gymnasium as gym
@@ -41,7 +43,78 @@ import numpy as np
 from gymnasium.vector import AutoresetMode, SyncVectorEnv
 from gymnasium.vector.utils import iterate
 
-__all__ = ["BatchedVectorEnv"]
+from ..envs.base import HexapodEnv
+
+__all__ = ["BatchedPhysics", "BatchedVectorEnv"]
+
+
+class BatchedPhysics:
+    """The worlds' physics on ``nthread`` threads, between their Python: the engine of
+    `BatchedVectorEnv`, and of any vector env that steps each world through its wrappers in
+    turn (SB3's `DummyVecEnv` loop, `agents.pipeline.batched_vec_env`).
+
+    ``with physics.step(stepping, actions): <step each world in turn>``: on entry the worlds in
+    `stepping` validate and apply their actions and their physics is queued on the threads; in
+    the block, each world's next `_apply_action` is skipped (after a check that the action
+    reaching it is the one applied: the wrappers between the vector env and the world must pass
+    actions through, as `TimeLimit`, `OrderEnforcing` and SB3's `Monitor` do) and its next
+    `_simulate` waits for its physics. A world whose step raises leaves no physics running and
+    no replacement behind."""
+
+    def __init__(self, worlds: Sequence[gym.Env], nthread: int | None = None):
+        self.worlds = list(worlds)
+        """The worlds' env instances (each unwrapped env: its model, data, task, rng)."""
+        for world in self.worlds:
+            if not isinstance(world, HexapodEnv):
+                raise TypeError(
+                    "batched physics steps hexapod_envs worlds (HexapodEnv), got "
+                    f"{type(world).__name__}; use a SyncVectorEnv or an SB3 vec env for others"
+                )
+        if nthread is None:
+            nthread = min(len(self.worlds), os.cpu_count() or 1)
+        if not isinstance(nthread, int | np.integer) or isinstance(nthread, bool) or nthread < 0:
+            raise ValueError(f"nthread must be an integer >= 0, got {nthread!r}")
+        self.nthread = int(nthread)
+        """Threads that run the worlds' physics (0: the calling thread runs it)."""
+        self._pool = ThreadPoolExecutor(self.nthread) if self.nthread else None
+        self._running: list[Future] = []
+
+    @contextmanager
+    def step(self, stepping: Sequence[int], actions: Sequence[np.ndarray]) -> Iterator[None]:
+        """Phases 1 and 2 of the worlds `stepping` (see the class docstring)."""
+        worlds = self.worlds
+        # Validate every action before any world changes: a bad action leaves all worlds alone.
+        applied = {i: worlds[i]._validate_action(actions[i]).copy() for i in stepping}
+        for i in stepping:
+            worlds[i]._apply_action(worlds[i]._action)
+        physics = self._start(stepping)
+        try:
+            for i in stepping:
+                _replace_once(worlds[i], "_apply_action", partial(_check_action, i, applied[i]))
+                _replace_once(worlds[i], "_simulate", physics[i])
+            yield
+        except BaseException:
+            wait(self._running)  # no world's physics may run on after an error
+            raise
+        finally:
+            self._running = []
+            for i in stepping:
+                for name in ("_apply_action", "_simulate"):
+                    worlds[i].__dict__.pop(name, None)
+
+    def _start(self, worlds: Sequence[int]) -> dict[int, Callable[[], bool]]:
+        """Queue one control period of physics of each of `worlds` (its own `_simulate`) on the
+        threads, in world order; world -> a call that waits for it and returns whether it stayed
+        stable. Without threads the call runs the physics itself."""
+        if self._pool is None:
+            return {i: self.worlds[i]._simulate for i in worlds}
+        self._running = [self._pool.submit(self.worlds[i]._simulate) for i in worlds]
+        return {i: future.result for i, future in zip(worlds, self._running, strict=True)}
+
+    def close(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown()
+            self._pool = None
 
 
 class BatchedVectorEnv(SyncVectorEnv):
@@ -60,60 +133,38 @@ class BatchedVectorEnv(SyncVectorEnv):
         autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP,
     ):
         super().__init__(env_fns, copy=copy, autoreset_mode=autoreset_mode)
-        self.worlds = [env.unwrapped for env in self.envs]
-        """The worlds' env instances (each unwrapped env: its model, data, task, rng)."""
-        if nthread is None:
-            nthread = min(self.num_envs, os.cpu_count() or 1)
-        if not isinstance(nthread, int | np.integer) or isinstance(nthread, bool) or nthread < 0:
-            raise ValueError(f"nthread must be an integer >= 0, got {nthread!r}")
-        self.nthread = int(nthread)
-        """Threads that run the worlds' physics (0: the calling thread runs it)."""
-        self._pool = ThreadPoolExecutor(self.nthread) if self.nthread else None
-        self._running: list[Future] = []
+        self.physics = BatchedPhysics([env.unwrapped for env in self.envs], nthread)
+
+    @property
+    def worlds(self) -> list[gym.Env]:
+        """The worlds' env instances (unwrapped)."""
+        return self.physics.worlds
 
     def step(self, actions):
-        """Phase 1 on the calling thread for the worlds that step (not those that autoreset
-        now), their physics started on the threads, then `SyncVectorEnv.step` with each world's
-        action application done and its physics awaited."""
+        """`SyncVectorEnv.step` with the physics of the worlds that step (not those that
+        autoreset now) batched (`BatchedPhysics.step`)."""
         stepping = [
             i
             for i in range(self.num_envs)
             if self.autoreset_mode != AutoresetMode.NEXT_STEP or not self._autoreset_envs[i]
         ]
-        single = list(iterate(self.action_space, actions))
-        # Validate every action before any world changes: a bad action leaves all worlds alone.
-        valid = {i: self.worlds[i]._validate_action(single[i]) for i in stepping}
-        for i in stepping:
-            self.worlds[i]._apply_action(valid[i])
-        physics = self._start_physics(stepping)
-        try:
-            for i in stepping:
-                _replace_once(self.worlds[i], "_apply_action", lambda action: None)
-                _replace_once(self.worlds[i], "_simulate", physics[i])
+        with self.physics.step(stepping, list(iterate(self.action_space, actions))):
             return super().step(actions)
-        except BaseException:
-            wait(self._running)  # no world's physics may run on after an error
-            raise
-        finally:  # and no replacement stays behind
-            self._running = []
-            for i in stepping:
-                for name in ("_apply_action", "_simulate"):
-                    self.worlds[i].__dict__.pop(name, None)
-
-    def _start_physics(self, worlds: list[int]) -> dict[int, Callable[[], bool]]:
-        """Start one control period of physics of each of `worlds` (its own `_simulate`) on
-        the threads, in world order; world -> a call that waits for it and returns whether it
-        stayed stable. Without threads the call runs the physics itself."""
-        if self._pool is None:
-            return {i: self.worlds[i]._simulate for i in worlds}
-        self._running = [self._pool.submit(self.worlds[i]._simulate) for i in worlds]
-        return {i: future.result for i, future in zip(worlds, self._running, strict=True)}
 
     def close_extras(self, **kwargs: Any) -> None:
         super().close_extras(**kwargs)
-        if self._pool is not None:
-            self._pool.shutdown()
-            self._pool = None
+        self.physics.close()
+
+
+def _check_action(world: int, applied: np.ndarray, action: np.ndarray) -> None:
+    """The replacement of a world's `_apply_action` in a batched step: the action reaching the
+    world must be the one applied before its physics ran."""
+    if not np.array_equal(action, applied):
+        raise RuntimeError(
+            f"world {world}: a wrapper changed the action between the vector env and the env; "
+            "batched physics applies the vector env's action before the world steps, so it "
+            "needs wrappers that pass actions through (not a hybrid policy or GainsPerCycle)"
+        )
 
 
 def _replace_once(world: gym.Env, name: str, replacement: Callable) -> None:

@@ -143,3 +143,16 @@ def test_bad_action_leaves_every_world_alone():
 def test_nthread_is_checked():
     with pytest.raises(ValueError, match="nthread must be an integer >= 0"):
         gym.make_vec("HexapodCliffWalk-v0", 2, vectorization_mode="vector_entry_point", nthread=-1)
+
+
+def test_a_wrapper_that_changes_the_action_is_refused():
+    def world():
+        env = gym.make("HexapodCliffWalk-v1")
+        return gym.wrappers.TransformAction(env, lambda a: 0.5 * a, env.action_space)
+
+    envs = BatchedVectorEnv([world, world], nthread=1)
+    envs.reset(seed=0)
+    with pytest.raises(RuntimeError, match="a wrapper changed the action"):
+        envs.step(np.ones((2, 18), dtype=np.float32))
+    assert not any("_apply_action" in w.__dict__ for w in envs.worlds)
+    envs.close()
