@@ -406,29 +406,51 @@ def _script(name: str):
     return module
 
 
-def stewart_rows(seed: int = 0, cases=None, env_kwargs: dict | None = None) -> list[dict]:
-    """Rows 6, 7 and 7b (Zhang et al. 2024 §5.2) for each Stewart case with TippingRecoveryPolicy:
-    adjustment leg, t_s, FASM 0.5 s after landing and its minimum from landing to the end.
+def _paper_case_kwargs(scenario: str, stance: str) -> dict:
+    """Env kwargs of one Stewart case as the paper runs it (`paper_scenario`), less the case."""
+    from hexapod_envs.envs.stewart_tilt import paper_scenario
 
-    Uses `run` / `fasm_at` of scripts/plot_stewart_recovery.py with `env_kwargs` (default:
-    the env's defaults, 2 deg/s without a stop). With `env_kwargs` (a calibration setting, e.g.
-    STEWART_STOP) the row ids get the suffix "@" + the kwargs and row 6 is left out.
+    kwargs = paper_scenario(scenario, stance)
+    del kwargs["scenario"], kwargs["stance"]
+    return kwargs
+
+
+V0_DEFAULT = "@v0 default"
+"""Row-id suffix of the Stewart rows measured with the env's defaults (2 deg/s from 3 s, no stop
+before 38-44 deg) instead of the paper's scenario."""
+
+
+def stewart_rows(
+    seed: int = 0, cases=None, env_kwargs: dict | None = None, tag: str | None = None
+) -> list[dict]:
+    """Rows 6, 7, 7b and 7c (Zhang et al. 2024 §5.2) for each Stewart case with
+    TippingRecoveryPolicy: adjustment leg, t_s, FASM 0.5 s after landing and its minimum from
+    landing to the end, the stability cone's λ.
+
+    Uses `run` / `fasm_at` of scripts/plot_stewart_recovery.py. Each case runs as the paper runs
+    it (`hexapod_envs.envs.stewart_tilt.paper_scenario`: the paper's start time, a tilt rate that
+    exercises eq. 15, the platform stopping once the robot tips) unless `env_kwargs` is given
+    (e.g. {} for the env's defaults); then the row ids get the suffix `tag` (default "@" + the
+    kwargs) and row 6 is left out.
     """
     from agents.tipping.judgment import XI_F_DEG
 
     mod = _script("plot_stewart_recovery")
-    tag = _tag(env_kwargs)
+    paper = env_kwargs is None
+    tag = "" if paper else (_tag(env_kwargs) if tag is None else tag)
     cases = mod.CASES if cases is None else cases
     rows, legs_ok = [], 0
     for scenario, stance in cases:
-        ctrl = mod.run(scenario, stance, controlled=True, seed=seed, env_kwargs=env_kwargs)
+        kwargs = _paper_case_kwargs(scenario, stance) if paper else env_kwargs
+        ctrl = mod.run(scenario, stance, controlled=True, seed=seed, env_kwargs=kwargs)
         d = ctrl["diagnostics"]
         p_leg, p_ts, _, p_after = mod.PAPER[(scenario, stance)]
         legs_ok += d["adjustment_leg"] == p_leg
         case = f"{scenario} {stance}" + tag
         setting = (
-            f"HexapodStewartTilt-v0 scenario={scenario} stance={stance} {env_kwargs or ''}, "
-            f"seed {seed}"
+            f"HexapodStewartTilt-v0 scenario={scenario} stance={stance} {kwargs or ''}"
+            + (" (paper_scenario)" if paper else "")
+            + f", seed {seed}; judged at {d['judgment_time']} s"
         )
         ts = d["t_s"]
         rows.append(
@@ -491,10 +513,16 @@ def stewart_rows(seed: int = 0, cases=None, env_kwargs: dict | None = None) -> l
             "of 6",
             "6/6",
             legs_ok == len(cases),
-            "HexapodStewartTilt-v0, six cases, seed 0",
+            "HexapodStewartTilt-v0, six cases as paper_scenario, seed 0",
         ),
     )
     return rows
+
+
+def stewart_v0_default_rows() -> list[dict]:
+    """Rows 7, 7b and 7c with the env's defaults (suffix V0_DEFAULT): 2 deg/s from 3 s and no
+    stop before 38-44 deg, which the paper's scenario replaces."""
+    return stewart_rows(env_kwargs={}, tag=V0_DEFAULT)
 
 
 def cliff_judgment_rows(seed: int = 0) -> list[dict]:
@@ -526,13 +554,6 @@ def cliff_judgment_rows(seed: int = 0) -> list[dict]:
             f"{ctrl['tipped']} (our walk starts at 3 s, the paper's cliff is reached later)",
         )
     ]
-
-
-STEWART_STOP = {"max_tilt_deg": 25.0}
-"""Calibration setting: the platform stops at 25 deg (2 deg/s). The paper does not give its final
-tilt; without a stop ours keeps tilting to 38-44 deg and the post-landing margin falls back below
-xi_f. Measured 25 deg: margins 0.5 s after landing 36.2 / 36.2 / 26.0 deg and >= 26 deg to the
-end; 30 deg at 10 deg/s: 21.9 deg (climb/descend) and the side case falls to 0."""
 
 
 ATHENA_PREVIOUS_DEFAULT = {"servo_kp": 8.0}
@@ -639,13 +660,16 @@ def _cone_row(id_: str, case: str, ctrl: dict, setting: str) -> dict:
 
 
 def stewart_paper_cone_rows(seed: int = 0) -> list[dict]:
-    """Row 7d per Stewart case: the recovery with the cone at the paper's λ only (no wider λ;
-    a step whose QP is infeasible at λ = 0.5 is solved without the cone and counted), so the
-    infeasibility is reported instead of relaxed."""
+    """Row 7d per Stewart case (the paper's scenario): the recovery with the cone at the paper's
+    λ only (no wider λ; a step whose QP is infeasible at λ = 0.5 is solved without the cone and
+    counted), so the infeasibility is reported instead of relaxed."""
     mod = _script("plot_stewart_recovery")
     rows = []
     for scenario, stance in mod.CASES:
-        ctrl = mod.run(scenario, stance, controlled=True, seed=seed, cone_ratios=())
+        kwargs = _paper_case_kwargs(scenario, stance)
+        ctrl = mod.run(
+            scenario, stance, controlled=True, seed=seed, env_kwargs=kwargs, cone_ratios=()
+        )
         at_paper, _, dropped = _cone_counts(ctrl)
         outcome = "tipped" if ctrl["tipped"] else "recovers"
         rows.append(
@@ -659,9 +683,9 @@ def stewart_paper_cone_rows(seed: int = 0) -> list[dict]:
                 "steps",
                 "recovers, no infeasible step",
                 outcome == "recovers" and dropped == 0,
-                f"HexapodStewartTilt-v0 scenario={scenario} stance={stance}, "
-                f"TippingRecoveryPolicy(cone_ratios=()), seed {seed}; infeasible steps are "
-                "solved without the cone",
+                f"HexapodStewartTilt-v0 scenario={scenario} stance={stance} {kwargs} "
+                f"(paper_scenario), TippingRecoveryPolicy(cone_ratios=()), seed {seed}; "
+                "infeasible steps are solved without the cone",
             )
         )
     return rows
@@ -672,20 +696,23 @@ STEWART_PAPER_REACH = {"hold_depth": 1.79}
 of 1.95 m (env kwarg hold_depth; the paper gives neither the hold posture nor all of the leg
 geometry). The paper's reach model (eqs. 10-12) then picks its foothold at the paper's height,
 (0, +-1837, -1786) mm against (0, +-1894, -1783) mm; at 1.95 m it lies 163 mm lower and 11 mm
-inside the tipping edge, and both side cases tip. Measured for the side case, LF-LR-RM: hold
-depth 1.95 m tips, 1.85 / 1.79 / 1.70 m recover (margin 0.5 s after landing 15.5 / 15.2 / 14.7
-deg, paper 21.5)."""
+inside the tipping edge. Measured for the side case, LF-LR-RM, with the env's default tilt
+(2 deg/s, no stop): hold depth 1.95 m tips, 1.85 / 1.79 / 1.70 m recover (margin 0.5 s after
+landing 15.5 / 15.2 / 14.7 deg, paper 21.5); in the paper's scenario (the platform stops once the
+robot tips) 1.95 m and 1.79 m both recover (19.9 / 19.1 deg)."""
 
 
 def stewart_paper_reach_rows(seed: int = 0, env_kwargs: dict | None = None) -> list[dict]:
-    """Row 6b: the side cases with the paper's reach model (eqs. 10-12) instead of ours; with
-    `env_kwargs` (e.g. STEWART_PAPER_REACH) the row ids get the suffix "@" + the kwargs."""
+    """Row 6b: the side cases (the paper's scenario) with the paper's reach model (eqs. 10-12)
+    instead of ours; with `env_kwargs` (e.g. STEWART_PAPER_REACH, added to the paper's
+    scenario) the row ids get the suffix "@" + the kwargs."""
     mod = _script("plot_stewart_recovery")
     tag = _tag(env_kwargs)
     rows = []
     for stance in ("LF-LR-RM", "LM-RF-RR"):
+        kwargs = {**_paper_case_kwargs("side", stance), **(env_kwargs or {})}
         ctrl = mod.run(
-            "side", stance, controlled=True, seed=seed, env_kwargs=env_kwargs, reach_model="paper"
+            "side", stance, controlled=True, seed=seed, env_kwargs=kwargs, reach_model="paper"
         )
         d = ctrl["diagnostics"]
         foot = d["foothold"]
@@ -705,7 +732,8 @@ def stewart_paper_reach_rows(seed: int = 0, env_kwargs: dict | None = None) -> l
                 "mm",
                 "no tip-over",
                 not ctrl["tipped"],
-                f"HexapodStewartTilt-v0 scenario=side stance={stance} {env_kwargs or ''}, "
+                f"HexapodStewartTilt-v0 scenario=side stance={stance} {kwargs} "
+                f"(paper_scenario{' + ' + str(env_kwargs) if env_kwargs else ''}), "
                 f"reach_model='paper', seed {seed}; FASM 0.5 s after landing {after}",
             )
         )
@@ -715,34 +743,6 @@ def stewart_paper_reach_rows(seed: int = 0, env_kwargs: dict | None = None) -> l
 def stewart_paper_reach_calibrated_rows() -> list[dict]:
     """Row 6b with the calibrated hold posture (STEWART_PAPER_REACH)."""
     return stewart_paper_reach_rows(env_kwargs=STEWART_PAPER_REACH)
-
-
-def stewart_stop_rows() -> list[dict]:
-    """Rows 7 / 7b with the platform stopping at STEWART_STOP (calibration setting)."""
-    return stewart_rows(env_kwargs=STEWART_STOP)
-
-
-STEWART_EQ15 = {
-    "climb": {"tilt_rate_deg": 7.0, "max_tilt_deg": 15.0},
-    "descend": {"tilt_rate_deg": 7.0, "max_tilt_deg": 15.0},
-    "side": {"tilt_rate_deg": 6.0, "max_tilt_deg": 30.0},
-}
-"""Calibration setting per Stewart scenario that exercises eq. 15: tilt rate [deg/s] and the tilt
-at which the platform stops [deg]. The paper gives neither (its judgment times, 4.9-8.8 s after
-the tilt starts, fit a few deg/s). Eq. 15 forecasts the time for the margin to fall from xi_f to
-0 at its current rate, which in our model is 0.85-1.0 times the tilt rate, so the paper's t_s of
-0.74-2.31 s (with kappa 0.7) need 6-20 deg/s. The measurements behind these rates and stops:
-README.md."""
-
-
-def stewart_eq15_rows() -> list[dict]:
-    """Rows 7 / 7b / 7c with STEWART_EQ15 (a tilt rate and stop per scenario)."""
-    cases = _script("plot_stewart_recovery").CASES
-    rows = []
-    for scenario, env_kwargs in STEWART_EQ15.items():
-        mine = [case for case in cases if case[0] == scenario]
-        rows += stewart_rows(cases=mine, env_kwargs=env_kwargs)
-    return rows
 
 
 CHEAP = {"000": (table_ii_rows,), "003": (upu_kinematics_rows,)}
@@ -755,8 +755,7 @@ FULL = {
         stewart_paper_cone_rows,
         stewart_paper_reach_rows,
         stewart_paper_reach_calibrated_rows,
-        stewart_stop_rows,
-        stewart_eq15_rows,
+        stewart_v0_default_rows,
     ),
     "002": (
         athena_rows,
@@ -782,28 +781,37 @@ def collect(only: str | None = None, quick: bool = False) -> list[dict]:
 
 
 NOTES = (
-    "7b (t_s, all cases, default 2 deg/s): t_s is the 3.0 s upper clamp. The margin falls at only"
-    " 1.7-2.0 deg/s, so eq. 15 forecasts 10-12 s. The paper gives neither its tilt rate nor its "
-    "final tilt; with a rate and a stop per scenario that exercise eq. 15 (STEWART_EQ15: climb "
-    "and descend 7 deg/s up to 15 deg, side 6 deg/s up to 30 deg) t_s is 2.41 s (climb, descend) "
-    "and 2.32 s (side), inside the tolerance of 0.5-2.5 s (paper 0.74-2.31 s), and rows 7 hold "
-    "too (37.0 / 37.0 / 21.1 deg after landing, never below xi_f afterwards). The paper's "
-    "shortest times (0.74-1.48 s) are not reached with recovery intact: at 8-10 deg/s the fitted "
-    "margin acceleration turns positive and eq. 15 has no root (3 s clamp); sideways at 7 deg/s "
-    "(t_s 1.98 s) the margin falls to 7 deg after landing; at 20 deg/s t_s is the 0.5 s lower "
-    "clamp.",
-    "7 (post-landing margin, default): 36.0 / 36.0 / 21.9 deg 0.5 s after landing, then the "
-    "platform keeps tilting to 38-44 deg and the margin falls to 13.5 / 13.5 / 3.6 deg. With the "
-    "platform stopping at 25 deg (STEWART_STOP, env kwarg max_tilt_deg=25; the paper does not "
-    "give its final tilt) the rows hold: 36.0 / 36.0 / 26.0 deg and >= 26 deg to the end.",
-    "7c / 7d (stability cone): at the paper's lambda = 0.5 the force-distribution QP is "
-    "infeasible on every supported step of the climb and descend cases (1049-1050 of 1049-1050) "
-    "and on 348-359 of 720 sideways; the controller's default ladder therefore runs at lambda 0.65 "
-    "(climb, descend) or drops the cone (338-356 steps sideways). With the cone at 0.5 only "
-    "(infeasible steps solved without the cone, 7d) every case still recovers: the cone is not "
-    "what holds the robot up in our model. With the platform stopping at 25 deg the side cases "
-    "stay at lambda 0.5 throughout. The cone's base is centred on the support polygon's "
-    "centroid, which lies far from below the CoG once a rear or side leg has landed.",
+    "6, 7, 7b, 7c, 7d, 6b (Stewart platform) run each case as the paper runs it "
+    "(hexapod_envs.envs.stewart_tilt.paper_scenario): the tilt starts after the paper's "
+    "adjustment stage (7 s with legs LF-LR-RM in stance, 5 s with LM-RF-RR), at 7 deg/s "
+    "(climb, descend) or 6 deg/s (side), and the platform stops once the robot tips (FASM < "
+    "xi_f), decelerating over 1 s, as the paper's margins after landing (about 40 / 45 / 21.5 "
+    "deg, holding) require: rows @v0 default keep tilting to 38-44 deg and the margin falls back "
+    "to 13.5 / 3.6 deg. The paper gives no rate; its judgment times (7.48 / 4.85 / 8.83 s after "
+    "the tilt starts) fit 1.2-2.5 deg/s at our judgment tilts (9.1 deg climbing or descending, "
+    "22.3 deg sideways), at which eq. 15 forecasts 10-12 s and t_s is the 3 s clamp (rows @v0 "
+    "default, 2 deg/s). Its t_s of 0.74-2.31 s need the FASM to fall at 6-19 deg/s at the "
+    "judgment, and they differ threefold between mirror-image cases (climbing 0.74 vs 2.31 s) "
+    "that a left-right symmetric robot on a mirrored motion cannot tell apart: they depend on how "
+    "the paper estimated the margin's rate and acceleration, which it does not say. The rates "
+    "chosen reproduce t_s (2.40 s, 2.33 s) and the margin after landing (37.9 / 25.7 deg, held to "
+    "the end); the judgment then comes 1.8 s (climb, descend) and 4.2 s (side) after the tilt "
+    "starts. Faster tilts land the foot with too little load: climbing at 8 deg/s t_s is 2.02 s "
+    "but the margin after landing 21.1 deg, sideways at 7 deg/s 1.98 s and 15.0 deg; at 10 "
+    "deg/s climbing the fitted margin acceleration is positive and t_s is the clamp.",
+    "7c / 7d (stability cone): climbing and descending, the force-distribution QP is infeasible "
+    "at the paper's lambda = 0.5 on every supported step (1039-1139 of 1039-1139), so the "
+    "controller's default ladder runs at lambda 0.65; sideways every step is at 0.5. Measured "
+    "at the landing (climb, LF-LR-RM): the support centroid lies 0.60 m behind the CoG's "
+    "projection, d_min is 1.51 m, and the inscribed pyramid of eq. 24 (its S_M carries the "
+    "1/sqrt(2)) reaches lambda d_min / sqrt(2) = 0.53 m along the body's x axis, which bounds "
+    "the tipping force of the side edges (parallel to x, so the force's x part is projected "
+    "out): infeasible at any tilt. With the paper's foothold coordinates (stance feet at "
+    "|y| = 1.9 m, the rear foot at (-2390, -1908, -1741) mm) the same QP is feasible with the "
+    "CoG above the body origin (0.57 m against 0.56 m) and infeasible with it 0.1 m forward, "
+    'where the paper puts it ("in the front of the body frame"): a knife edge the paper\'s '
+    "geometry does not settle. With the cone at 0.5 only (infeasible steps solved without the "
+    "cone, 7d) every case still recovers: the cone is not what holds the robot up in our model.",
     "9 (ramp roll rate, +5.5 % vs -36 %): with the servo model calibrated to the paper's simple-"
     "control sag (env default servo_kp 6.8 N m/rad; 0.0676 m vs 0.068 m, row 11d) the simple "
     "control drags its torso on the slope, which damps its roll, and posture control's roll-rate "
@@ -828,13 +836,12 @@ NOTES = (
     "previous 0.1 m blocks with kp 8 posture control touched in 4 of 4 episodes (83 steps), "
     "changed the pitch rate by +4 % and lowered the roll rate by 22 %: the simple controller's "
     "torso knocked on the many block edges, which posture control mostly avoids.",
-    "6b (paper's reach model, side cases, default hold posture): the robot tips; the foothold "
-    "(0, +-1889, -1946) mm is the paper's kind but 163 mm lower (our hold posture stands "
-    "taller). With the hold posture calibrated to the paper's foothold height "
-    "(STEWART_PAPER_REACH, hold_depth 1.79 m) it picks (0, +-1837, -1786) mm and both side "
-    "cases recover, with a "
-    "margin of 15.1 deg 0.5 s after landing (paper 21.5). The env default stays 1.95 m with "
-    "the kinematic reach model, on which the shipped agents were trained.",
+    "6b (paper's reach model, side cases): in the paper's scenario both recover with the "
+    "default hold posture (foothold (0, +-1889, -1946) mm, 163 mm lower than the paper's: our "
+    "hold posture stands taller), margin 19.9 deg 0.5 s after landing (paper 21.5); with the "
+    "hold posture calibrated to the paper's foothold height (STEWART_PAPER_REACH, hold_depth "
+    "1.79 m) it picks (0, +-1837, -1786) mm, 19.1 deg. The env default stays 1.95 m with the "
+    "kinematic reach model, on which the shipped agents were trained.",
     "14, 14c @physics_dt=0.0005 (3-UPU, a quarter of the default 2 ms step): the reference gait "
     "tips on the paper's ditch at 97.8 s and on the 450 x 150 mm ditch; it crosses at every "
     "step from 0.8 to 2.5 ms. When the lower platform lifts its legs the robot stands on the "

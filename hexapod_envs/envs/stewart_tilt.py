@@ -20,11 +20,12 @@ The hold posture is a little taller and narrower than the walking stance (feet a
 (the 6-UPS platform tilts at most ~44-46 deg; the walking stance would need 48.5 deg).
 
 The paper gives neither its tilt rate nor its final tilt. At the default 2 deg/s the FASM falls
-too slowly for the recovery's time budget (eq. 15) to come off its 3 s clamp; the calibrated
-profile of the reproduction report exercises it: ``scenario="climb"`` or ``"descend"`` with
-``tilt_rate_deg=7, max_tilt_deg=15``, ``scenario="side"`` with ``tilt_rate_deg=6,
-max_tilt_deg=30`` (t_s 2.24-2.32 s against the paper's 0.74-2.31 s). ``hold_depth=1.79`` lets
-the paper's own reach model (eqs. 10-12) recover the side cases (docs/reproduction.md).
+too slowly for the recovery's time budget (eq. 15) to come off its 3 s clamp, and the platform
+keeps tilting after the robot has tipped. `paper_scenario(scenario, stance)` gives the settings
+of the reproduction report (the paper's start times, 7 / 6 deg/s, and ``stop_on_tipping``: the
+platform comes to rest once the robot's FASM first falls below ξ; t_s 2.3-2.4 s against the
+paper's 0.74-2.31 s). ``hold_depth=1.79`` lets the paper's own reach model (eqs. 10-12)
+recover the side cases (docs/reproduction.md).
 
 ## Action Space
 18 values in [-1, 1]: ``"residual"`` (default) offsets the hold posture by residual_scale x half
@@ -106,6 +107,34 @@ RAMP_TIME = 1.0
 CASES = tuple((scenario, stance) for scenario in ("climb", "descend", "side") for stance in STANCES)
 """The paper's six cases: three tilt directions for each held tripod."""
 
+PAPER_TILT_START = {"LF-LR-RM": 7.0, "LM-RF-RR": 5.0}
+"""Time at which the platform starts tilting in Zhang et al. 2024 §5.2 [s] ("from 0 to 7 s is
+the robot status adjustment stage" with legs 1, 3, 5 in stance; 5 s with legs 2, 4, 6)."""
+PAPER_TILT_RATE_DEG = {"climb": 7.0, "descend": 7.0, "side": 6.0}
+"""Tilt rate per scenario of `paper_scenario` [deg/s]. The paper gives none; these are the
+rates at which the FASM falls fast enough at the judgment for eq. 15's adjustment time to lie in
+the paper's range (t_s 2.4 / 2.3 s against 0.74-2.31 s) while the adjustment foot still lands
+loaded (docs/reproduction.md: at 2 deg/s t_s is the 3 s clamp; climb 8 deg/s or side 7 deg/s
+land the foot with too little load, 21 / 15 deg of margin after landing)."""
+
+
+def paper_scenario(scenario: str, stance: str) -> dict:
+    """Settings of HexapodStewartTilt-v0 for one of the six cases of Zhang et al. 2024 §5.2 as
+    the paper runs it: the platform starts tilting after the paper's adjustment stage
+    (`PAPER_TILT_START`), at `PAPER_TILT_RATE_DEG`, and stops once the robot has tipped
+    (``stop_on_tipping``), so the margin after the adjustment leg lands holds as the paper
+    reports. Use: ``gym.make("HexapodStewartTilt-v0", **paper_scenario("climb", "LF-LR-RM"))``.
+    """
+    if (scenario, stance) not in CASES:
+        raise ValueError(f"(scenario, stance) must be one of {CASES}, got {(scenario, stance)}")
+    return {
+        "scenario": scenario,
+        "stance": stance,
+        "tilt_start_time": PAPER_TILT_START[stance],
+        "tilt_rate_deg": PAPER_TILT_RATE_DEG[scenario],
+        "stop_on_tipping": True,
+    }
+
 
 @dataclasses.dataclass(frozen=True)
 class TiltTaskRanges(HeavyDutyTaskRanges):
@@ -163,6 +192,12 @@ class StewartTiltSettings(HeavyDutySettings):
     """Tilt at which the platform stops [deg] (None: the scenario's default)."""
     tilt_start_time: float = number(3.0)
     """Episode time at which the platform starts tilting [s]."""
+    stop_on_tipping: bool = choice(False, (False, True))
+    """The platform stops once the robot first tips (its FASM below ξ): from then on it
+    decelerates at the ramp's rate (`tilt_rate_deg` per RAMP_TIME) and holds the tilt it comes
+    to rest at. Zhang et al. 2024 §5.2 use the platform to bring the robot to tipping and report
+    the margin after the landing as holding (≈ 40 / 45 / 21.5°); a platform that keeps tilting
+    makes it fall back (docs/reproduction.md). Default False: the tilt runs to `max_tilt_deg`."""
     platform_friction: float = number(1.5)
     hold_depth: float = number(HOLD_DEPTH, strict=True)
     """Feet below the coxa origins in the hold posture [m] (the paper does not give it; 1.79
@@ -200,6 +235,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         self.platform_friction = s.platform_friction
         self.hold_depth = s.hold_depth
         self._max_tilt_arg = s.max_tilt_deg
+        self._first_tipping_time = None  # set per episode at reset; `tilt_at` reads it
         self.platform = DEFAULT_PLATFORM
         self._platform_centre = self.platform.neutral_position  # read-only: never moves
         self._platform_centre.flags.writeable = False
@@ -263,10 +299,29 @@ class StewartTiltEnv(HeavyDutyEnv):
         return np.array([tilt * self.axis[0], tilt * self.axis[1], 0.0])
 
     def tilt_at(self, t: float) -> float:
-        """Platform tilt [rad] at time t: level while settling, then the scenario rate reached
-        and left with a constant (de)celeration over RAMP_TIME so the plate never jerks. A tilt
-        too small to reach the rate (max_tilt < rate x RAMP_TIME) accelerates and decelerates
-        only, with the same (de)celeration, and stops at max_tilt."""
+        """Platform tilt [rad] at time t: the scheduled tilt (`scheduled_tilt_at`), or with
+        ``stop_on_tipping`` once the robot has tipped, the tilt at that moment carried on with
+        the ramp's deceleration until the platform rests (never beyond the scheduled tilt)."""
+        stop = self._first_tipping_time if self.settings.stop_on_tipping else None
+        if stop is None or t <= stop:
+            return self.scheduled_tilt_at(t)
+        decel = self.rate / RAMP_TIME
+        rate = self._scheduled_rate_at(stop)
+        tau = min(t - stop, rate / decel)
+        stopping = self.scheduled_tilt_at(stop) + rate * tau - 0.5 * decel * tau**2
+        return min(stopping, self.scheduled_tilt_at(t))
+
+    def _scheduled_rate_at(self, t: float) -> float:
+        """d/dt of `scheduled_tilt_at` [rad/s] (central difference over 1 ms; the schedule is
+        piecewise quadratic, so this is its exact slope away from the ramps' joints)."""
+        h = 5e-4
+        return (self.scheduled_tilt_at(t + h) - self.scheduled_tilt_at(t - h)) / (2.0 * h)
+
+    def scheduled_tilt_at(self, t: float) -> float:
+        """Platform tilt [rad] at time t as scheduled: level while settling, then the scenario
+        rate reached and left with a constant (de)celeration over RAMP_TIME so the plate never
+        jerks. A tilt too small to reach the rate (max_tilt < rate x RAMP_TIME) accelerates and
+        decelerates only, with the same (de)celeration, and stops at max_tilt."""
         ramp = RAMP_TIME
         tau = t - self.tilt_start_time
         if tau <= 0.0:
