@@ -13,6 +13,7 @@ from gymnasium.vector import AutoresetMode
 
 import hexapod_envs  # noqa: F401  (registers the ids)
 from hexapod_envs.vector import BatchedVectorEnv
+from hexapod_envs.vector.threads import CallThreads
 
 BATCHED_IDS = [
     "HexapodCliffWalk-v0",
@@ -156,3 +157,39 @@ def test_a_wrapper_that_changes_the_action_is_refused():
         envs.step(np.ones((2, 18), dtype=np.float32))
     assert not any("_apply_action" in w.__dict__ for w in envs.worlds)
     envs.close()
+
+
+def test_an_error_in_a_world_s_physics_reaches_the_caller():
+    envs = gym.make_vec(
+        "HexapodCliffWalk-v1", 3, vectorization_mode="vector_entry_point", nthread=2
+    )
+    envs.reset(seed=0)
+
+    def broken():
+        raise FloatingPointError("physics failed")
+
+    envs.worlds[1]._simulate = broken
+    with pytest.raises(FloatingPointError, match="physics failed"):
+        envs.step(np.zeros((3, 18), dtype=np.float32))
+    assert not any("_simulate" in w.__dict__ or "_apply_action" in w.__dict__ for w in envs.worlds)
+    envs.reset(seed=1)  # the threads serve the next steps
+    observations = envs.step(np.zeros((3, 18), dtype=np.float32))[0]
+    assert observations.shape == (3, *envs.single_observation_space.shape)
+    envs.close()
+
+
+def test_call_threads_run_every_call_and_return_results_and_errors_in_order():
+    threads = CallThreads(2)
+    for _ in range(3):  # batches one after another
+        waits = threads.start([lambda k=k: k * k for k in range(7)])
+        assert [wait() for wait in waits] == [k * k for k in range(7)]
+
+    def fail():
+        raise KeyError("seventh")
+
+    waits = threads.start([lambda: 1, fail, lambda: 3])
+    threads.wait_all()
+    assert waits[0]() == 1 and waits[2]() == 3
+    with pytest.raises(KeyError, match="seventh"):
+        waits[1]()
+    threads.close()
