@@ -22,10 +22,10 @@ The hold posture is a little taller and narrower than the walking stance (feet a
 The paper gives neither its tilt rate nor its final tilt. At the default 2 deg/s the FASM falls
 too slowly for the recovery's time budget (eq. 15) to come off its 3 s clamp, and the platform
 keeps tilting after the robot has tipped. `paper_scenario(scenario, stance)` gives the settings
-of the reproduction report (the paper's start times, 7 / 6 deg/s, and ``stop_on_tipping``: the
-platform comes to rest once the robot's FASM first falls below ξ; t_s 2.3-2.4 s against the
-paper's 0.74-2.31 s). ``hold_depth=1.79`` lets the paper's own reach model (eqs. 10-12)
-recover the side cases (docs/reproduction.md).
+of the reproduction report (the paper's start times and stance width, 8 deg/s, and
+``stop_on_tipping``: the platform comes to rest once the robot's FASM first falls below ξ; t_s
+1.7-1.9 s against the paper's 0.74-2.31 s; docs/reproduction.md). ``hold_depth=1.79`` puts the
+foothold of the paper's own reach model (eqs. 10-12) at the paper's height.
 
 ## Action Space
 18 values in [-1, 1]: ``"residual"`` (default) offsets the hold posture by residual_scale x half
@@ -110,17 +110,25 @@ CASES = tuple((scenario, stance) for scenario in ("climb", "descend", "side") fo
 PAPER_TILT_START = {"LF-LR-RM": 7.0, "LM-RF-RR": 5.0}
 """Time at which the platform starts tilting in Zhang et al. 2024 §5.2 [s] ("from 0 to 7 s is
 the robot status adjustment stage" with legs 1, 3, 5 in stance; 5 s with legs 2, 4, 6)."""
-PAPER_TILT_RATE_DEG = {"climb": 7.0, "descend": 7.0, "side": 6.0}
-"""Tilt rate per scenario of `paper_scenario` [deg/s]. The paper gives none; these are the
-rates at which the FASM falls fast enough at the judgment for eq. 15's adjustment time to lie in
-the paper's range (t_s 2.4 / 2.3 s against 0.74-2.31 s) while the adjustment foot still lands
-loaded (docs/reproduction.md: at 2 deg/s t_s is the 3 s clamp; climb 8 deg/s or side 7 deg/s
-land the foot with too little load, 21 / 15 deg of margin after landing)."""
+PAPER_TILT_RATE_DEG = 8.0
+"""Tilt rate of `paper_scenario` [deg/s], in every case. The paper gives none. At 8 deg/s the
+FASM falls at 6.9-8.1 deg/s at the judgment, so eq. 15's adjustment time lies in the paper's
+range (t_s 1.92 s climbing or descending, 1.74 s sideways, against 0.74-2.31 s) and the foot
+lands loaded. Slower tilts leave t_s at its 3 s clamp (2 deg/s) or at the top of the range
+(7 deg/s: 2.26 s); at 9-12 deg/s climbing the judgment comes within 0.6 s of the end of the
+platform's 1 s ramp and the fitted margin acceleration swings (+2.5, -17, +100 deg/s^2): t_s is
+the clamp, or 0.70 s with the foot landing unloaded (docs/reproduction.md)."""
+PAPER_FOOT_Y = 1.9
+"""|y| of the stance feet in Zhang et al. 2024 §5.2 [m]: its footholds lie at |y| = 1.89-1.91 m,
+e.g. (-2390, -1908, -1741) mm. The env's default hold posture is narrower (`HOLD_FOOT_Y`) so that
+the held robot tips sideways within the platform's reach, which a platform that stops once the
+robot tips does not need."""
 
 
 def paper_scenario(scenario: str, stance: str) -> dict:
     """Settings of HexapodStewartTilt-v0 for one of the six cases of Zhang et al. 2024 §5.2 as
-    the paper runs it: the platform starts tilting after the paper's adjustment stage
+    the paper runs it: the robot holds its tripod with the feet as wide as the paper's
+    (`PAPER_FOOT_Y`), the platform starts tilting after the paper's adjustment stage
     (`PAPER_TILT_START`), at `PAPER_TILT_RATE_DEG`, and stops once the robot has tipped
     (``stop_on_tipping``), so the margin after the adjustment leg lands holds as the paper
     reports. Use: ``gym.make("HexapodStewartTilt-v0", **paper_scenario("climb", "LF-LR-RM"))``.
@@ -131,8 +139,9 @@ def paper_scenario(scenario: str, stance: str) -> dict:
         "scenario": scenario,
         "stance": stance,
         "tilt_start_time": PAPER_TILT_START[stance],
-        "tilt_rate_deg": PAPER_TILT_RATE_DEG[scenario],
+        "tilt_rate_deg": PAPER_TILT_RATE_DEG,
         "stop_on_tipping": True,
+        "hold_foot_y": PAPER_FOOT_Y,
     }
 
 
@@ -202,6 +211,8 @@ class StewartTiltSettings(HeavyDutySettings):
     hold_depth: float = number(HOLD_DEPTH, strict=True)
     """Feet below the coxa origins in the hold posture [m] (the paper does not give it; 1.79
     puts the foothold of the paper's reach model at the paper's height, docs/reproduction.md)."""
+    hold_foot_y: float = number(HOLD_FOOT_Y, strict=True)
+    """|y| of the feet in the hold posture [m] (the paper's stance feet lie at about 1.9 m)."""
     residual_scale: float = number(2.0)
     """Residual action 1 = this fraction of each joint's half range (2: any target)."""
     tip_over_angle_deg: float = number(10.0, strict=True, high=90.0)
@@ -234,6 +245,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         self.tilt_start_time = s.tilt_start_time
         self.platform_friction = s.platform_friction
         self.hold_depth = s.hold_depth
+        self.hold_foot_y = s.hold_foot_y
         self._max_tilt_arg = s.max_tilt_deg
         self._first_tipping_time = None  # set per episode at reset; `tilt_at` reads it
         self.platform = DEFAULT_PLATFORM
@@ -281,10 +293,13 @@ class StewartTiltEnv(HeavyDutyEnv):
         for leg in LEG_NAMES:
             side = 1.0 if leg[0] == "L" else -1.0
             foot = self.robot.hip_offsets[leg] + np.array([0.0, 0.0, -self.hold_depth])
-            foot[1] = side * HOLD_FOOT_Y
+            foot[1] = side * self.hold_foot_y
             if leg not in stance:
                 foot[2] += SWING_LIFT
-            unreachable = f"hold_depth={self.hold_depth} m: leg {leg} cannot reach its foothold"
+            unreachable = (
+                f"hold_depth={self.hold_depth} m, hold_foot_y={self.hold_foot_y} m: leg {leg} "
+                "cannot reach its foothold"
+            )
             try:
                 leg_joints = joints_for_foot(leg, foot, self.robot)
             except ValueError as err:
