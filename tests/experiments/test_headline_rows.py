@@ -5,9 +5,9 @@ report.
 Each row comes from the reproduction's own row functions (experiments/reproduction/rows.py, the
 protocol of `python scripts/reproduce_papers.py`); the test asserts its verdict (`holds`). Rows
 that do not hold today are strict xfails with the measured reason, so a fix that makes one hold
-fails here until its mark is removed. About 35 s on one core (measured: cliff walk 2 s, cliff
-judgment 1.3 s, the six Stewart cases in the paper's scenario 12 s, ATHENA's 16 episodes 14 s,
-3-UPU 3.3 s).
+fails here until its mark is removed. About 30 s on an idle core (cliff walk 2 s, cliff
+judgment 1.3 s, the six Stewart cases in the paper's scenario 9.5 s, ATHENA's 16 episodes 14 s,
+3-UPU 3.3 s); 53 s measured with the 2 cores shared at load 6.
 """
 
 import functools
