@@ -1,7 +1,7 @@
 """Build hook (the metadata is in pyproject.toml): the wheel carries the repository's configs/
 and models/ as package data of `agents`, in agents/_shipped/, so that an installed
 ``hexapod-evaluate`` finds the default suite and the shipped models from any folder
-(`agents.pipeline.shipped`). The repository root keeps the one copy; an editable install reads
+(`agents.run_files.shipped`). The repository root keeps the one copy; an editable install reads
 it there and copies nothing."""
 
 import shutil
@@ -11,7 +11,7 @@ from setuptools import setup
 from setuptools.command.build_py import build_py
 
 ROOT = Path(__file__).resolve().parent
-SHIPPED_DIRS = ("configs", "models")  # agents.pipeline.shipped.SHIPPED_DIRS
+SHIPPED_DIRS = ("configs", "models")  # agents.run_files.shipped.SHIPPED_DIRS
 TARGET = Path("agents", "_shipped")
 
 

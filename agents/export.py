@@ -7,7 +7,7 @@
   ``observation (float64, [batch, n_obs]) -> action (float32, [batch, n_act])``. The graph holds,
   in this order: the VecNormalize observation statistics of the model directory,
   ``clip((obs - mean) / sqrt(var + eps), -clip_obs, clip_obs)`` computed in float64 as
-  `agents.pipeline.model_files.NormalizationStats.normalize_obs` does, then the SB3
+  `agents.run_files.model_files.NormalizationStats.normalize_obs` does, then the SB3
   ``MlpPolicy`` actor (features extractor -> ``mlp_extractor.policy_net`` -> ``action_net``:
   the mean of the Gaussian, i.e. the deterministic action) and the clip to the action space that
   SB3's ``predict`` applies. Its output equals `agents.ppo.PPOPolicy`'s action on the same
@@ -38,10 +38,10 @@ from typing import Any
 
 import numpy as np
 
-from .pipeline.artifacts import ModelFiles, find_model, read_meta
 from .pipeline.cli import _add_trust_pickle_option, _run
-from .pipeline.errors import UserError
-from .pipeline.model_files import NormalizationStats, atomic_path, atomic_write_text
+from .run_files.artifacts import ModelFiles, find_model, read_meta
+from .run_files.errors import UserError
+from .run_files.model_files import NormalizationStats, atomic_path, atomic_write_text
 
 OPSET = 17
 INPUT, OUTPUT = "observation", "action"

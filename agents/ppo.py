@@ -1,9 +1,9 @@
 """A trained SB3 PPO model as a `Policy`: loads the model and its VecNormalize statistics.
 
 ``PPOPolicy.load(path, env)`` accepts a model file, a model directory or a run directory (see
-`agents.pipeline.artifacts`). It checks that the model was trained for this env id (from the
+`agents.run_files.artifacts`). It checks that the model was trained for this env id (from the
 resolved ``config.yaml`` saved next to it) and that the observation and action shapes match,
-and raises `agents.pipeline.errors.UserError` (a ValueError) with a clear message otherwise.
+and raises `agents.run_files.errors.UserError` (a ValueError) with a clear message otherwise.
 Observations are normalised with the saved statistics (frozen) before the network sees them.
 Nothing in the model files is unpickled unless the caller passes ``trust_pickle=True``.
 """
@@ -17,11 +17,11 @@ import gymnasium as gym
 import numpy as np
 
 from .hybrid import from_run_config
-from .pipeline.artifacts import ModelFiles, find_model, other_env_error, read_meta
-from .pipeline.errors import UserError
-from .pipeline.model_files import NormalizationStats, load_ppo, load_stats, ppo_custom_objects
-from .pipeline.train_config import load_train_config
 from .policy import Policy
+from .run_files.artifacts import ModelFiles, find_model, other_env_error, read_meta
+from .run_files.errors import UserError
+from .run_files.model_files import NormalizationStats, load_ppo, load_stats, ppo_custom_objects
+from .run_files.train_config import load_train_config
 
 
 class PPOPolicy:
@@ -49,7 +49,7 @@ class PPOPolicy:
         trust_pickle: bool = False,
     ) -> Policy:
         """The model at `path` as a policy for `env`, loaded without unpickling anything (see
-        `agents.pipeline.model_files`; pickled files of older runs only with ``trust_pickle``).
+        `agents.run_files.model_files`; pickled files of older runs only with ``trust_pickle``).
         A hybrid run's model comes back combined with `env`'s analytical controller as in
         training (`agents.hybrid.HybridPolicy`)."""
         files = find_model(path)

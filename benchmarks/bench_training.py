@@ -28,7 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run as a script from anywhere
 
 from agents.pipeline.envs import EnvSpec, make_vec_env  # noqa: E402
-from agents.pipeline.train_config import load_train_config  # noqa: E402
+from agents.run_files.train_config import load_train_config  # noqa: E402
 from benchmarks.common import random_action_rates, verdict  # noqa: E402
 
 ENVS = {

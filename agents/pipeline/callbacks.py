@@ -23,7 +23,7 @@ from typing import Any
 
 from stable_baselines3.common.callbacks import BaseCallback, EvalCallback
 
-from .artifacts import BEST, checkpoint_dir, save_model_dir
+from ..run_files.artifacts import BEST, checkpoint_dir, save_model_dir
 from .episode import EpisodeAccumulator, EpisodeRecord
 
 

@@ -15,11 +15,12 @@ import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from .errors import UserError
-from .shipped import resolve_shipped, shipped_path
+from ..run_files.errors import UserError
+from ..run_files.shipped import resolve_shipped, shipped_path
 
 DEFAULT_SUITE = shipped_path("configs", "evaluate_default.yaml")
-"""The suite of ``hexapod-evaluate`` without --config (the shipped copy, see `shipped`)."""
+"""The suite of ``hexapod-evaluate`` without --config (the shipped copy, see
+`agents.run_files.shipped`)."""
 
 SCRIPTS = {"train.py": "python train.py", "evaluate.py": "python evaluate.py"}
 """How the usage examples call a prog: the root scripts with python, console scripts as is."""
@@ -106,7 +107,7 @@ def train_main(argv: Sequence[str] | None = None, prog: str = "train.py") -> int
     command = _command(prog, argv)
 
     def body() -> int:
-        from .train_config import load_train_config
+        from ..run_files.train_config import load_train_config
         from .training import resume_training, start_training
 
         if args.sweep is not None:
@@ -158,7 +159,7 @@ def _is_sweep_dir(path: Path) -> bool:
 
 
 def _command(script: str, argv: Sequence[str] | None) -> str:
-    from .artifacts import command_line
+    from ..run_files.artifacts import command_line
 
     return command_line(sys.argv if argv is None else [script, *argv])
 
@@ -270,7 +271,7 @@ def hexapod_evaluate() -> int:
 def _suite_envs(config: Path | None, ids: list[str]) -> list[dict]:
     """`--envs` entries with the suite's kwargs and time limit for ids the suite names (so the
     shipped agents are evaluated in the env they were trained in); other ids bare."""
-    from .configtools import load_yaml
+    from ..run_files.configtools import load_yaml
 
     listed = load_yaml(config or DEFAULT_SUITE).get("envs") or []
     known = {}
@@ -284,7 +285,7 @@ def _is_default_report(suite) -> bool:
     """The suite writes to the default suite's report directory (``reports/default``, a scratch
     output that git ignores) and what is there is a previous report (its metrics.json): running
     the default evaluation again replaces it without --force."""
-    from .configtools import load_yaml
+    from ..run_files.configtools import load_yaml
 
     default = load_yaml(DEFAULT_SUITE).get("output_dir")
     out = Path(suite.output_dir)
@@ -292,6 +293,6 @@ def _is_default_report(suite) -> bool:
 
 
 def _prepare_report_dir(path: Path, force: bool) -> Path:
-    from .artifacts import prepare_new_dir
+    from ..run_files.artifacts import prepare_new_dir
 
     return prepare_new_dir(path, force, "report directory")

@@ -18,7 +18,7 @@ import gymnasium as gym
 import numpy as np
 
 from ..hybrid import wrap
-from .errors import UserError
+from ..run_files.errors import UserError
 
 
 def import_gym_packages(packages: Sequence[str]) -> None:

@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
-from .configtools import apply_overrides, from_mapping, load_yaml
-from .errors import ConfigError
-from .train_config import DEFAULT_GYM_PACKAGES
+from ..run_files.configtools import apply_overrides, from_mapping, load_yaml
+from ..run_files.errors import ConfigError
+from ..run_files.train_config import DEFAULT_GYM_PACKAGES
 
 SIMPLE_POLICIES = ("analytical", "zero", "random")
 PPO_PREFIX = "ppo:"

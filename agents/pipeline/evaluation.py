@@ -17,13 +17,19 @@ import numpy as np
 from ..env_kwargs import POLICY_SETTINGS, constructor_defaults, registered_defaults
 from ..policy import Policy, RandomPolicy, ZeroPolicy
 from ..ppo import PPOPolicy
-from .artifacts import checkpoint_note, other_env_error
-from .env_settings import describe, differences, read_settings, resolved_settings, reward_only
+from ..run_files.artifacts import checkpoint_note, other_env_error
+from ..run_files.env_settings import (
+    describe,
+    differences,
+    read_settings,
+    resolved_settings,
+    reward_only,
+)
+from ..run_files.errors import UserError
+from ..run_files.shipped import resolve_shipped
 from .envs import EnvSpec, check_env_id, env_time_step, import_gym_packages
 from .episode import EpisodeAccumulator, EpisodeRecord, MetricSpec, metric_specs
-from .errors import UserError
 from .eval_config import PPO_PREFIX, EvaluationSuite, SuiteEnv
-from .shipped import resolve_shipped
 
 
 class EpisodeSeededRandomPolicy(RandomPolicy):
@@ -154,7 +160,7 @@ def policy_env_kwargs(name: str, env_id: str, suite_kwargs: dict | None = None) 
         return dict(ANALYTICAL_ENV_KWARGS.get(env_id, {}))
     if not name.startswith(PPO_PREFIX):
         return {}
-    from .artifacts import find_model
+    from ..run_files.artifacts import find_model
 
     files = find_model(_ppo_path(name, env_id))
     config = files.training_config() or {}
@@ -172,7 +178,7 @@ def policy_env_kwargs(name: str, env_id: str, suite_kwargs: dict | None = None) 
 
 def _ppo_path(name: str, env_id: str) -> Path:
     """The model path of ``ppo:<path>`` for `env_id` (``models/...``: the shipped model unless
-    the working directory has one, see `shipped`)."""
+    the working directory has one, see `agents.run_files.shipped`)."""
     return resolve_shipped(name[len(PPO_PREFIX) :].replace("{env_id}", env_id))
 
 
@@ -267,9 +273,10 @@ def _settings_note(
     policy_kwargs: dict[str, Any],
 ) -> tuple[str | None, bool]:
     """(note, harmless) when a model was trained on an env set up otherwise than `env`, the
-    one it is evaluated on: every recorded setting of its training env (`env_settings`) against
-    `env`'s, so that a default changed since the training shows; for a model without that
-    record (older runs, envs without typed settings) its config's kwargs against the suite's.
+    one it is evaluated on: every recorded setting of its training env
+    (`agents.run_files.env_settings`) against `env`'s, so that a default changed since the training
+    shows; for a model without that record (older runs, envs without typed settings) its
+    config's kwargs against the suite's.
 
     Harmless: only reward scales differ (told apart for models with the settings record only;
     the kwargs comparison of older models is always a warning). The agent acts the same under

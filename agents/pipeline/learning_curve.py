@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from .errors import UserError
+from ..run_files.errors import UserError
 
 EVALUATIONS_FILE = "evaluations.npz"
 

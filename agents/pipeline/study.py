@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import UserError
+from ..run_files.errors import UserError
 from .eval_config import PPO_PREFIX, EvaluationSuite
 
 CONFIDENCE = 0.95
@@ -59,7 +59,7 @@ def expand_studies(suite: EvaluationSuite) -> tuple[EvaluationSuite, list[Study]
 
     Returns the expanded suite, the studies and warning lines (trials without a saved model).
     """
-    from .artifacts import checkpoint_note, find_model
+    from ..run_files.artifacts import checkpoint_note, find_model
     from .sweep_summary import TRIAL_FILE, trial_dirs
 
     policies: list[str] = []

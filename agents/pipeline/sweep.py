@@ -36,15 +36,15 @@ from typing import Any
 
 import numpy as np
 
-from .artifacts import (
+from ..run_files.artifacts import (
     CONFIG_FILE,
     command_line,
     latest_model_dir,
     prepare_new_dir,
     read_meta,
 )
-from .configtools import dump_yaml, to_mapping
-from .errors import UserError
+from ..run_files.configtools import dump_yaml, to_mapping
+from ..run_files.errors import UserError
 from .sweep_config import SWEEP_FILE, LoadedSweep, load_sweep
 from .sweep_summary import (
     SUMMARY_MD,
@@ -117,7 +117,7 @@ def run_trial(params: dict[str, Any], sweep: LoadedSweep, sweep_dir: str, comman
     import torch
     from ray import tune
 
-    from .train_config import load_train_config
+    from ..run_files.train_config import load_train_config
     from .training import resume_training, start_training
 
     torch.set_num_threads(1)

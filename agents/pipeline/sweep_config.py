@@ -30,9 +30,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
-from .configtools import apply_overrides, from_mapping, load_yaml, unknown_key_message
-from .errors import ConfigError
-from .train_config import TrainConfig, load_train_config
+from ..run_files.configtools import apply_overrides, from_mapping, load_yaml, unknown_key_message
+from ..run_files.errors import ConfigError
+from ..run_files.train_config import TrainConfig, load_train_config
 
 SWEEP_FILE = "sweep.yaml"
 """The resolved sweep file inside a sweep directory (marks the directory as a sweep)."""

@@ -15,8 +15,8 @@ from typing import Any
 
 import numpy as np
 
-from .artifacts import CONFIG_FILE, latest_model_dir, read_meta
-from .configtools import load_yaml
+from ..run_files.artifacts import CONFIG_FILE, latest_model_dir, read_meta
+from ..run_files.configtools import load_yaml
 from .sweep_config import SWEEP_FILE, LoadedSweep
 
 TRIAL_FILE = "trial.json"

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from .artifacts import (
+from ..run_files.artifacts import (
     BEST,
     COMMAND_FILE,
     CONFIG_FILE,
@@ -33,8 +33,8 @@ from .artifacts import (
     run_name,
     saved_model_dirs,
 )
-from .configtools import dump_yaml, load_yaml, parse_override
-from .env_settings import (
+from ..run_files.configtools import dump_yaml, load_yaml, parse_override
+from ..run_files.env_settings import (
     RENDERING,
     describe,
     differences,
@@ -42,17 +42,17 @@ from .env_settings import (
     resolved_settings,
     write_settings,
 )
-from .envs import EnvSpec, env_time_step, make_vec_env
-from .episode import XI_F_DEG, EpisodeAccumulator, metric_specs
-from .errors import UserError
-from .model_files import (
+from ..run_files.errors import UserError
+from ..run_files.model_files import (
     NormalizationStats,
     atomic_write_text,
     load_ppo,
     load_stats,
     ppo_custom_objects,
 )
-from .train_config import TrainConfig, load_train_config
+from ..run_files.train_config import TrainConfig, load_train_config
+from .envs import EnvSpec, env_time_step, make_vec_env
+from .episode import XI_F_DEG, EpisodeAccumulator, metric_specs
 
 EVAL_SEED_OFFSET = 10_000
 """Evaluation envs are seeded apart from the training envs."""

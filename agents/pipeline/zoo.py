@@ -19,8 +19,8 @@ from typing import Any
 
 import yaml
 
-from .schedules import Schedule
-from .train_config import TrainConfig, load_train_config
+from ..run_files.schedules import Schedule
+from ..run_files.train_config import TrainConfig, load_train_config
 
 ACTIVATION_NAMES = {
     "tanh": "nn.Tanh",

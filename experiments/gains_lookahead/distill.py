@@ -486,11 +486,11 @@ def held_out_rows(demos: Demonstrations, fraction: float) -> np.ndarray:
 
 def distill(config, demos: Demonstrations, validation: np.ndarray, **fit_kwargs):
     """(model, its VecNormalize or None, `FitResult`, the env's resolved settings): a new PPO
-    model of the training config `config` (`agents.pipeline.train_config.TrainConfig`, gains
+    model of the training config `config` (`agents.run_files.train_config.TrainConfig`, gains
     mode, plain hybrid residual) whose observation statistics are those of the training rows and
     whose actor is fitted by `fit_actor` (``fit_kwargs``)."""
-    from agents.pipeline.model_files import NormalizationStats
     from agents.pipeline.training import untrained_model
+    from agents.run_files.model_files import NormalizationStats
 
     hybrid = config.hybrid
     if hybrid is None or hybrid.mode != "residual" or hybrid.safety_filter:

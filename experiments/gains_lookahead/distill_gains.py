@@ -36,9 +36,9 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 import numpy as np  # noqa: E402
 
-from agents.pipeline.artifacts import command_line, save_model_dir  # noqa: E402
-from agents.pipeline.train_config import load_train_config  # noqa: E402
 from agents.pipeline.training import env_spec  # noqa: E402
+from agents.run_files.artifacts import command_line, save_model_dir  # noqa: E402
+from agents.run_files.train_config import load_train_config  # noqa: E402
 from experiments.gains_lookahead.distill import (  # noqa: E402
     Demonstrations,
     demonstrate,

@@ -8,8 +8,8 @@ from helpers.paths import REPO
 
 import hexapod_envs  # noqa: F401  (registers the env ids)
 from agents.hybrid import HybridCore, HybridPolicy, HybridSettings, HybridWrapper
-from agents.pipeline.train_config import load_train_config
 from agents.registry import analytical_policy
+from agents.run_files.train_config import load_train_config
 
 CONFIGS = REPO / "configs"
 HYBRID_CONFIGS = [  # residual mode: a zero learned action is the analytical controller
@@ -325,8 +325,8 @@ def test_the_recovery_judges_tipping_at_the_envs_threshold():
 def test_a_hybrid_model_refuses_an_env_that_reads_its_action_otherwise():
     """The shipped cliff hybrid learned its action at residual_scale 2: at the env's default
     0.25 its actions would mean something else, so loading it there names the setting."""
-    from agents.pipeline.errors import UserError
     from agents.ppo import PPOPolicy
+    from agents.run_files.errors import UserError
 
     model = REPO / "models" / "HexapodCliffWalk-v0" / "hybrid"
     with pytest.raises(UserError, match=r"residual_scale=2.0 but the env has residual_scale=0.25"):

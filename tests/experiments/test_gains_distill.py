@@ -10,8 +10,8 @@ import pytest
 import torch
 
 import hexapod_envs  # noqa: F401
-from agents.pipeline.env_settings import read_settings
 from agents.pipeline.envs import EnvSpec
+from agents.run_files.env_settings import read_settings
 from experiments.gains_lookahead import distill_gains
 from experiments.gains_lookahead.distill import (
     Demonstrations,

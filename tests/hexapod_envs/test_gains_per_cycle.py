@@ -64,7 +64,7 @@ def test_other_action_modes_and_envs_are_refused_by_name():
 
 def test_env_spec_decision_builds_the_wrapper_and_names_bad_values():
     from agents.pipeline.envs import EnvSpec
-    from agents.pipeline.errors import UserError
+    from agents.run_files.errors import UserError
 
     spec = EnvSpec(ENV_ID, dict(GAINS), gym_packages=["hexapod_envs"], decision="gait_cycle")
     env = spec.make()
@@ -105,7 +105,7 @@ def test_a_baseline_cycle_is_replayed_from_the_same_state_and_subtracted():
 
 def test_baseline_settings_are_checked_by_name():
     from agents.pipeline.envs import EnvSpec
-    from agents.pipeline.errors import UserError
+    from agents.run_files.errors import UserError
 
     with pytest.raises(ValueError, match="baseline_action .* is not in the action space"):
         GainsPerCycle(gym.make(ENV_ID, **GAINS), baseline_action=[2.0, 0.0, 0.0])

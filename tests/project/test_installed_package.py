@@ -1,6 +1,6 @@
 """The installed package does the main job on its own: a wheel built from this tree, installed
 into a fresh venv, runs ``hexapod-evaluate`` from an empty folder with the shipped configs and
-models it carries (`agents.pipeline.shipped`); plus where relative configs/ and models/ paths
+models it carries (`agents.run_files.shipped`); plus where relative configs/ and models/ paths
 resolve from another folder in this checkout."""
 
 import json
@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 from helpers.paths import REPO
 
-from agents.pipeline.shipped import resolve_shipped, shipped_root
+from agents.run_files.shipped import resolve_shipped, shipped_root
 
 
 def test_shipped_configs_and_models_resolve_from_another_folder(tmp_path, monkeypatch):
@@ -80,7 +80,7 @@ def test_wheel_installed_in_a_fresh_venv_evaluates_from_an_empty_folder(tmp_path
         assert helped.stdout.startswith(f"usage: {script}")
 
     code = (
-        "import json, agents, agents.pipeline.cli as cli, agents.pipeline.shipped as s;"
+        "import json, agents, agents.pipeline.cli as cli, agents.run_files.shipped as s;"
         "print(json.dumps([agents.__file__, str(s.shipped_root()), str(cli.DEFAULT_SUITE),"
         " str(s.resolve_shipped('models/HexapodCliffWalk-v0/ppo'))]))"
     )

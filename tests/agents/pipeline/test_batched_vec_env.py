@@ -16,8 +16,8 @@ from stable_baselines3.common.vec_env import DummyVecEnv
 from agents.pipeline.batched_vec_env import BatchedDummyVecEnv, make_batched_vec_env
 from agents.pipeline.cli import train_main
 from agents.pipeline.envs import EnvFactory, EnvSpec
-from agents.pipeline.errors import ConfigError
-from agents.pipeline.train_config import load_train_config
+from agents.run_files.errors import ConfigError
+from agents.run_files.train_config import load_train_config
 
 TIPPING = EnvSpec(
     "HexapodStewartTilt-v1",

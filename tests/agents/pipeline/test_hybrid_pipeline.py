@@ -31,8 +31,8 @@ def reset_to_untrained(run: Path) -> None:
     """Zero the action net of every saved model of `run` again (an untrained hybrid; the
     learning rate must be > 0, so training cannot be frozen by the config)."""
     from agents.hybrid import zero_init_action_net
-    from agents.pipeline.model_files import load_ppo, ppo_custom_objects
-    from agents.pipeline.train_config import load_train_config
+    from agents.run_files.model_files import load_ppo, ppo_custom_objects
+    from agents.run_files.train_config import load_train_config
 
     config = load_train_config(data=yaml.safe_load((run / "config.yaml").read_text()))
     env = gym.make("HexapodStewartTilt-v0")
@@ -93,8 +93,8 @@ def test_a_new_hybrid_model_starts_at_the_analytical_controller():
     import torch
     from stable_baselines3.common.vec_env import DummyVecEnv
 
-    from agents.pipeline.train_config import load_train_config
     from agents.pipeline.training import new_model
+    from agents.run_files.train_config import load_train_config
 
     venv = DummyVecEnv([lambda: gym.make("HexapodStewartTilt-v0")])
     for zero in (True, False):

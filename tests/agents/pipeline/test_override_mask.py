@@ -10,9 +10,9 @@ import yaml
 from helpers.stewart_hybrid_runs import STEWART, train
 from stable_baselines3.common.buffers import RolloutBuffer
 
-from agents.pipeline.model_files import load_ppo, ppo_custom_objects
 from agents.pipeline.override_mask import OverrideMaskedRolloutBuffer
-from agents.pipeline.train_config import load_train_config
+from agents.run_files.model_files import load_ppo, ppo_custom_objects
+from agents.run_files.train_config import load_train_config
 
 
 def _filled(cls, rng, **kwargs):

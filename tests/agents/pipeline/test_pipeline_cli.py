@@ -16,8 +16,8 @@ from helpers.paths import REPO
 
 from agents.pipeline import callbacks
 from agents.pipeline.cli import evaluate_main, train_main
-from agents.pipeline.env_settings import read_settings, resolved_settings
 from agents.ppo import PPOPolicy
+from agents.run_files.env_settings import read_settings, resolved_settings
 
 
 @pytest.fixture(scope="module")
@@ -492,8 +492,8 @@ def test_each_policy_is_evaluated_in_the_action_mode_it_was_built_for(run):
 
 def test_a_run_is_evaluated_with_the_observation_it_was_trained_on(monkeypatch):
     """terrain_scan shapes the observation: it comes from the run, not from the suite."""
-    from agents.pipeline import artifacts
     from agents.pipeline.evaluation import policy_env_kwargs
+    from agents.run_files import artifacts
 
     class Run:
         def __init__(self, kwargs):
@@ -520,7 +520,7 @@ def test_reward_exclude_takes_the_named_terms_out_of_the_reward():
     """env.reward_exclude: the learner's reward is the env's minus those info terms; a term the
     env does not report is an error at the first step."""
     from agents.pipeline.envs import EnvSpec
-    from agents.pipeline.errors import UserError
+    from agents.run_files.errors import UserError
 
     plain = EnvSpec("HexapodCliffWalk-v0", gym_packages=["hexapod_envs"]).make()
     spec = EnvSpec("HexapodCliffWalk-v0", gym_packages=["hexapod_envs"], reward_exclude=["alive"])

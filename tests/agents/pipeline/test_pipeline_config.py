@@ -8,14 +8,14 @@ import yaml
 from helpers.paths import REPO
 
 import hexapod_envs  # noqa: F401
-from agents.pipeline.configtools import apply_overrides, dump_yaml, from_mapping
 from agents.pipeline.episode import EpisodeAccumulator, MetricSpec, metric_specs
-from agents.pipeline.errors import ConfigError, UserError
 from agents.pipeline.eval_config import PPO_PREFIX, EvaluationSuite, load_suite
-from agents.pipeline.schedules import Schedule, parse_schedule
 from agents.pipeline.summary import aggregate, compare, paired_difference_interval
-from agents.pipeline.train_config import TrainConfig, load_train_config
 from agents.registry import analytical_factory, analytical_policy
+from agents.run_files.configtools import apply_overrides, dump_yaml, from_mapping
+from agents.run_files.errors import ConfigError, UserError
+from agents.run_files.schedules import Schedule, parse_schedule
+from agents.run_files.train_config import TrainConfig, load_train_config
 
 CONFIGS = REPO / "configs"
 TRAIN_CONFIGS = {

@@ -24,9 +24,9 @@ from helpers.paths import REPO
 
 from agents.pipeline import callbacks, training
 from agents.pipeline.cli import train_main
-from agents.pipeline.errors import UserError
-from agents.pipeline.model_files import NormalizationStats
 from agents.ppo import PPOPolicy
+from agents.run_files.errors import UserError
+from agents.run_files.model_files import NormalizationStats
 
 
 class Touch:

@@ -200,7 +200,7 @@ def test_success_and_tip_over_differences_say_when_they_are_not_resolved():
 def test_the_report_says_which_checkpoint_it_evaluated(report):
     """A shipped model's sources name its checkpoint and steps; a best/ kept from step 0 says it
     is the initial policy (models/HexapodIrregularTerrain-v0/hybrid: step 0)."""
-    from agents.pipeline.artifacts import checkpoint_note, read_meta
+    from agents.run_files.artifacts import checkpoint_note, read_meta
 
     md = (report / "report.md").read_text()
     for env_id in ENVS:
@@ -241,10 +241,10 @@ def test_an_unstable_episode_is_flagged_and_its_repeated_readings_count_once():
 def test_a_study_row_names_the_checkpoint_it_evaluates(tmp_path):
     """A trial's row gives the steps of the model evaluated (best/ first), not of its newest
     checkpoint: a best/ kept from step 0 is the initial policy however long the trial ran."""
-    from agents.pipeline.artifacts import checkpoint_note
-    from agents.pipeline.configtools import from_mapping
     from agents.pipeline.eval_config import EvaluationSuite
     from agents.pipeline.study import expand_studies
+    from agents.run_files.artifacts import checkpoint_note
+    from agents.run_files.configtools import from_mapping
 
     sweep = tmp_path / "sweep"
     trial = sweep / "trial_00000"

@@ -21,9 +21,9 @@ import yaml
 from helpers.sweep_helpers import REPO, free_port, is_gone, loopback_cluster, tiny_sweep, wait_until
 
 from agents.pipeline.cli import evaluate_main
-from agents.pipeline.errors import ConfigError
 from agents.pipeline.sweep_config import load_sweep
-from agents.pipeline.train_config import load_train_config
+from agents.run_files.errors import ConfigError
+from agents.run_files.train_config import load_train_config
 
 pytest.importorskip("ray.tune", reason='sweeps need the [sweep] extra: pip install -e ".[sweep]"')
 

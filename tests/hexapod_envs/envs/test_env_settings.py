@@ -206,8 +206,8 @@ def test_a_probability_range_outside_0_1_is_named():
 def test_a_recorded_settings_file_rebuilds_the_same_settings(env_id):
     import yaml
 
-    from agents.pipeline.configtools import dump_yaml
-    from agents.pipeline.env_settings import resolved_settings
+    from agents.run_files.configtools import dump_yaml
+    from agents.run_files.env_settings import resolved_settings
 
     env = gym.make(env_id, task_distribution="train")
     record = yaml.safe_load(dump_yaml(resolved_settings(env)))  # env_settings.yaml's content

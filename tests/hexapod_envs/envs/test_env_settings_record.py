@@ -1,4 +1,4 @@
-"""The record of a training env's settings (agents/pipeline/env_settings.py): what counts as a
+"""The record of a training env's settings (agents/run_files/env_settings.py): what counts as a
 difference, how it is worded, and the warning when a run is resumed on a changed env."""
 
 from pathlib import Path
@@ -6,15 +6,15 @@ from pathlib import Path
 import gymnasium as gym
 from helpers.paths import REPO
 
-from agents.pipeline.env_settings import (
+from agents.pipeline.training import _warn_if_settings_changed, env_spec
+from agents.run_files.env_settings import (
     describe,
     differences,
     read_settings,
     resolved_settings,
     write_settings,
 )
-from agents.pipeline.train_config import load_train_config
-from agents.pipeline.training import _warn_if_settings_changed, env_spec
+from agents.run_files.train_config import load_train_config
 
 TRAINED = {
     "physics_dt": 0.002,
@@ -92,7 +92,7 @@ def test_a_model_saved_without_settings_drops_an_earlier_record(tmp_path):
     previous model's settings behind."""
     from types import SimpleNamespace
 
-    from agents.pipeline.artifacts import save_model_dir
+    from agents.run_files.artifacts import save_model_dir
 
     class FakeModel(SimpleNamespace):
         def save(self, path):

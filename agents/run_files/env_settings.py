@@ -36,7 +36,7 @@ NOT_COMPARED = ("task_distribution", "train_ranges", "test_ranges", *RENDERING)
 """Settings whose differences are no mismatch for an evaluation: the task distribution and its
 ranges are the evaluation's own choice (a held-out distribution is its point)."""
 
-_HEADER = "# The training env's settings, defaults filled in (agents/pipeline/env_settings.py)\n"
+_HEADER = "# The training env's settings, defaults filled in (agents/run_files/env_settings.py)\n"
 
 REWARD = "reward"
 """The nested reward scales: they change returns, not what the agent meets."""
