@@ -1,8 +1,9 @@
 """The observation layout of every registered env, as a Markdown page (``docs/observations.md``).
 
 Generated from each env's ``observation_structure`` (name -> slice of the flat Box), once per
-action mode, so the page cannot drift from the code: ``tests/hexapod_envs/envs/test_observation_docs.py`` compares
-it with a fresh rendering. Regenerate with::
+action mode, so the page cannot drift from the code:
+``tests/hexapod_envs/envs/test_observation_docs.py`` compares it with a fresh rendering.
+Regenerate with::
 
     python -m hexapod_envs.observation_docs > docs/observations.md
 """

@@ -7,10 +7,10 @@ interpreter overhead. These ``numba.njit`` kernels do the same arithmetic in the
 plain-float formulas stay plain floats (numba does not fuse multiply-adds), and the matrix
 products are ``np.dot`` calls, i.e. the BLAS routines numpy's ``@`` calls (numba binds them
 through scipy's BLAS). Where numpy's and scipy's BLAS give the same bits, as they do for these
-small products on the machines this was measured on, U, f, G, h and the controller's actions
-are unchanged to the bit (tests/agents/tipping/test_tipping_force_distribution.py checks it against the
-original assembly). The 6 x 6 solve stays numpy's LAPACK call (scipy's, reached from numba,
-differs in the last bit for about 6 % of systems). Compiled on first use and cached on disk,
+small products on the machines this was measured on, U, f, G, h and the controller's actions are
+unchanged to the bit (tests/agents/tipping/test_tipping_force_distribution.py checks it against the
+original assembly). The 6 x 6 solve stays numpy's LAPACK call (scipy's, reached from numba, differs
+in the last bit for about 6 % of systems). Compiled on first use and cached on disk,
 like :mod:`hexapod_envs.stability._compiled`. Kernels return status codes; the callers raise.
 """
 

@@ -1,9 +1,9 @@
 """The force-distribution QP's assembly as it was before the speed-up of issue 14 (test only).
 
 A verbatim copy of ``stability_cone``, ``tipping_force_matrices`` and ``ForceDistributor.build``
-at commit 911f01b, kept so that tests/agents/tipping/test_tipping_force_distribution.py can check that the
-faster assembly gives bit-identical U, f, G, h (and hence forces) on random cases. Not used by
-the package. ``reference_build(distributor, feet, cog, wrench, normal)`` is the old method.
+at commit 911f01b, kept so that tests/agents/tipping/test_tipping_force_distribution.py can check
+that the faster assembly gives bit-identical U, f, G, h (and hence forces) on random cases. Not
+used by the package. ``reference_build(distributor, feet, cog, wrench, normal)`` is the old method.
 """
 
 from __future__ import annotations
