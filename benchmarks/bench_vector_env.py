@@ -9,10 +9,11 @@ envs (the training pipeline's default with 2 envs); "batched N" ``gym.make_vec(i
 vectorization_mode="vector_entry_point", nthread=2)``; "batched 8, 0 threads" the same code
 with the physics on the calling thread (Gymnasium's SyncVectorEnv loop: what the vector
 machinery costs). Configurations are measured in turn, `--rounds` times, best of the rounds
-(the machine is shared: interference only slows a run down). Each env also gets its step
-profile (`common.step_profile`: physics against the env's Python, µs per step) and the
-ceiling it sets for 2 threads: the calling thread runs every world's Python, the threads the
-physics, so N worlds take at least max(N x python, N x (physics + python) / 2) per step.
+(the machine is shared: interference only slows a run down). Beside the rates, this process's
+CPU per env step (all threads, and the calling thread's: not for subprocess envs) and the rate
+those allow on 2 free cores (1 / CPU for the single env; 1 / max(main, CPU / 2) with the
+physics threads): the figure a loaded machine cannot show. Each env also gets its step profile
+(`common.step_profile`: physics against the env's Python, µs per step).
 
 PPO rows: configs/cliff_walk_ppo.yaml on HexapodCliffWalk-v1 with the same rollout size
 (`--rollout` steps over all envs) and `--ppo-steps` steps: SubprocVecEnv(2), the batched
@@ -31,6 +32,7 @@ import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import NamedTuple
 
 import gymnasium as gym
 import numpy as np
@@ -53,13 +55,26 @@ SUBPROC_TARGET = 1.2
 """Issue 46's targets: batched >= 1.2 x SubprocVecEnv(2), env steps and PPO steps per second."""
 
 
-def _timed(step: Callable[[], int], seconds: float) -> float:
-    """Env steps per second of repeated `step()` calls (each returns the env steps it made)
-    over at least `seconds`."""
+class Rate(NamedTuple):
+    """One measurement: env steps per second, and this process's CPU per env step."""
+
+    rate: float
+    cpu_us: float
+    """CPU time of all this process's threads per env step [µs] (NaN for subprocess envs,
+    whose stepping runs in other processes)."""
+    main_us: float
+    """CPU time of the calling thread per env step [µs]."""
+
+
+def _timed(step: Callable[[], int], seconds: float, local: bool = True) -> Rate:
+    """Repeated `step()` calls (each returns the env steps it made) over at least `seconds`:
+    the rate and the CPU per step (`local`: the stepping runs in this process)."""
     steps, start = 0, time.perf_counter()
+    cpu, main = time.process_time(), time.thread_time()
     while (elapsed := time.perf_counter() - start) < seconds:
         steps += step()
-    return steps / elapsed
+    cpu = (time.process_time() - cpu) / steps * 1e6 if local else float("nan")
+    return Rate(steps / elapsed, cpu, (time.thread_time() - main) / steps * 1e6)
 
 
 ACTION_SCALE = 0.1
@@ -75,7 +90,7 @@ def _actions(space: gym.Space, rows: int, seed: int) -> np.ndarray:
     return rng.uniform(mid - half, mid + half, (rows, *space.shape)).astype(space.dtype)
 
 
-def single_rate(env_id: str, seconds: float) -> float:
+def single_rate(env_id: str, seconds: float) -> Rate:
     env = gym.make(env_id, **KWARGS)
     actions = _actions(env.action_space, 4096, 0)
     env.reset(seed=0)
@@ -94,13 +109,13 @@ def single_rate(env_id: str, seconds: float) -> float:
     return rate
 
 
-def subproc_rate(env_id: str, seconds: float, n_envs: int = 2) -> float:
+def subproc_rate(env_id: str, seconds: float, n_envs: int = 2) -> Rate:
     spec = EnvSpec(env_id, dict(KWARGS), gym_packages=["hexapod_envs"])
     venv = make_vec_env(spec, n_envs, seed=0, subprocess=True)
-    return _vec_rate(venv, n_envs, seconds, venv.action_space)
+    return _vec_rate(venv, n_envs, seconds, venv.action_space, local=False)
 
 
-def batched_rate(env_id: str, seconds: float, n_envs: int, nthread: int = THREADS) -> float:
+def batched_rate(env_id: str, seconds: float, n_envs: int, nthread: int = THREADS) -> Rate:
     envs = gym.make_vec(
         env_id, n_envs, vectorization_mode="vector_entry_point", nthread=nthread, **KWARGS
     )
@@ -108,7 +123,7 @@ def batched_rate(env_id: str, seconds: float, n_envs: int, nthread: int = THREAD
     return _vec_rate(envs, n_envs, seconds, envs.single_action_space)
 
 
-def _vec_rate(envs, n_envs: int, seconds: float, space: gym.Space) -> float:
+def _vec_rate(envs, n_envs: int, seconds: float, space: gym.Space, local: bool = True) -> Rate:
     """Env steps per second of a vec env (SB3's or Gymnasium's) with random actions."""
     actions = _actions(space, 1024 * n_envs, 1).reshape(1024, n_envs, *space.shape)
     envs.reset()
@@ -120,7 +135,7 @@ def _vec_rate(envs, n_envs: int, seconds: float, space: gym.Space) -> float:
         k[0] += 1
         return n_envs
 
-    rate = _timed(step, seconds)
+    rate = _timed(step, seconds, local)
     envs.close()
     return rate
 
@@ -134,14 +149,21 @@ CONFIGS = {
 }
 
 
-def env_rates(seconds: float, rounds: int) -> dict[tuple[str, str], float]:
-    """Best of `rounds` of every (env id, configuration), the configurations taken in turn."""
-    best: dict[tuple[str, str], float] = {}
+def env_rates(seconds: float, rounds: int) -> dict[tuple[str, str], Rate]:
+    """Per (env id, configuration), the configurations taken in turn `rounds` times: the best
+    rate and the lowest CPU figures (the machine is shared: interference slows a run down and
+    inflates its CPU time through the caches)."""
+    best: dict[tuple[str, str], Rate] = {}
     for env_id in ENV_IDS:
         for r in range(rounds):
             for name, measure in CONFIGS.items():
-                rate = measure(env_id, seconds)
-                best[(env_id, name)] = max(best.get((env_id, name), 0.0), rate)
+                got = measure(env_id, seconds)
+                old = best.setdefault((env_id, name), got)
+                best[(env_id, name)] = Rate(
+                    max(old.rate, got.rate),
+                    min(old.cpu_us, got.cpu_us),
+                    min(old.main_us, got.main_us),
+                )
             print(f"measured {env_id}, round {r + 1}", file=sys.stderr)
     return best
 
@@ -150,10 +172,12 @@ def ppo_rate(vectorization: str, n_envs: int, steps: int, rollout: int) -> dict[
     """PPO on configs/cliff_walk_ppo.yaml (HexapodCliffWalk-v1): env steps per second of
     `model.learn`, and its seconds split into env stepping, the rest of the rollouts and the
     updates."""
+    import torch
     from stable_baselines3 import PPO
     from stable_baselines3.common.vec_env import VecNormalize
 
     config = load_train_config(ROOT / "configs" / "cliff_walk_ppo.yaml")
+    torch.set_num_threads(config.train.num_threads)  # as train.py runs it
     spec = EnvSpec("HexapodCliffWalk-v1", dict(config.env.kwargs), gym_packages=["hexapod_envs"])
     if vectorization == "batched":
         venv = make_batched_vec_env(spec, n_envs, seed=0, nthread=THREADS)
@@ -196,31 +220,40 @@ def _time_calls(obj, name: str, seconds: dict[str, float], key: str) -> None:
     setattr(obj, name, timed)
 
 
-def print_env_rows(rates: dict[tuple[str, str], float], profile_steps: int) -> list[float]:
-    """The env table; returns the ratios the targets judge (batched / single, / subproc)."""
+def print_env_rows(rates: dict[tuple[str, str], Rate], profile_steps: int) -> list[tuple]:
+    """The env table; returns the ratios the targets judge (batched / single, / subproc).
+
+    "CPU" is this process's CPU per env step (all threads), "main" the calling thread's; the
+    "2 free cores" bound is what those CPU figures allow when nothing else runs: 1 / CPU for
+    the single env (one core), 1 / max(main, CPU / 2) with the physics threads."""
     print(
-        f"\n{'env (training tasks, random actions)':36s} {'configuration':22s} "
-        f"{'steps/s':>8s} {'/ single':>9s} {'/ subproc':>10s}"
+        f"\n{'env (training tasks)':28s} {'configuration':22s} {'steps/s':>8s} {'/ single':>9s} "
+        f"{'/ subproc':>10s} {'CPU µs':>7s} {'main µs':>8s} {'2 free cores':>13s} {'/ single':>9s}"
     )
     judged = []
     for env_id in ENV_IDS:
         single, subproc = rates[(env_id, "single")], rates[(env_id, f"subproc {THREADS}")]
+        single_bound = 1e6 / single.cpu_us
         for name in CONFIGS:
-            rate = rates[(env_id, name)]
+            r = rates[(env_id, name)]
+            threads = int(name.split(", ")[1].split()[0]) if ", " in name else 0
+            bound = 1e6 / max(r.main_us, r.cpu_us / max(1, min(threads, 2)))
+            if np.isnan(r.cpu_us):  # subprocess envs: their CPU is not this process's
+                bound = float("nan")
             print(
-                f"{env_id:36s} {name:22s} {rate:8.0f} {rate / single:9.2f} {rate / subproc:10.2f}"
+                f"{env_id:28s} {name:22s} {r.rate:8.0f} {r.rate / single.rate:9.2f} "
+                f"{r.rate / subproc.rate:10.2f} {r.cpu_us:7.0f} {r.main_us:8.0f} "
+                f"{bound:13.0f} {bound / single_bound:9.2f}"
             )
             if name.startswith("batched") and not name.endswith("0 threads"):
-                judged.append((rate / single, rate / subproc))
+                judged.append((r.rate / single.rate, r.rate / subproc.rate))
         with gym.make(env_id, **KWARGS) as env:
             profile = step_profile(env, profile_steps)
         physics = profile.pop("simulate")
         python = sum(profile.values())
-        ceiling = 1e6 / max(python, (physics + python) / THREADS)
         print(
-            f"  step profile: physics {physics:.0f} µs, the env's Python {python:.0f} µs per "
-            f"step; ceiling with {THREADS} threads {ceiling:.0f} steps/s "
-            f"({ceiling / single:.2f} x single)"
+            f"  {env_id} step profile (single env): physics {physics:.0f} µs, the env's "
+            f"Python {python:.0f} µs per step"
         )
     return judged
 

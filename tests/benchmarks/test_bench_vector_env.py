@@ -3,9 +3,11 @@
 from benchmarks.bench_vector_env import batched_rate, ppo_rate, single_rate
 
 
-def test_env_rates_count_steps_of_single_and_batched_envs():
-    assert single_rate("HexapodStewartTilt-v1", 0.05) > 0
-    assert batched_rate("HexapodStewartTilt-v1", 0.05, 3, nthread=2) > 0
+def test_env_rates_count_steps_and_the_cpu_they_take():
+    single = single_rate("HexapodStewartTilt-v1", 0.05)
+    batched = batched_rate("HexapodStewartTilt-v1", 0.05, 3, nthread=2)
+    assert single.rate > 0 and single.cpu_us >= single.main_us > 0
+    assert batched.rate > 0 and batched.cpu_us >= batched.main_us > 0
 
 
 def test_ppo_rate_splits_its_time_into_env_policy_and_update():
