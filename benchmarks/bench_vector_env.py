@@ -73,8 +73,9 @@ def _timed(step: Callable[[], int], seconds: float, local: bool = True) -> Rate:
     cpu, main = time.process_time(), time.thread_time()
     while (elapsed := time.perf_counter() - start) < seconds:
         steps += step()
+    main = (time.thread_time() - main) / steps * 1e6  # the process's window holds the thread's
     cpu = (time.process_time() - cpu) / steps * 1e6 if local else float("nan")
-    return Rate(steps / elapsed, cpu, (time.thread_time() - main) / steps * 1e6)
+    return Rate(steps / elapsed, cpu, main)
 
 
 ACTION_SCALE = 0.1
