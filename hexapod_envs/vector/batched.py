@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor, wait
 from contextlib import contextmanager
 from functools import partial
 from typing import Any
@@ -43,7 +44,6 @@ from gymnasium.vector import AutoresetMode, SyncVectorEnv
 from gymnasium.vector.utils import iterate
 
 from ..envs.base import HexapodEnv
-from .threads import CallThreads
 
 __all__ = ["BatchedPhysics", "BatchedVectorEnv"]
 
@@ -76,7 +76,8 @@ class BatchedPhysics:
             raise ValueError(f"nthread must be an integer >= 0, got {nthread!r}")
         self.nthread = int(nthread)
         """Threads that run the worlds' physics (0: the calling thread runs it)."""
-        self._threads = CallThreads(self.nthread) if self.nthread else None
+        self._pool = ThreadPoolExecutor(self.nthread) if self.nthread else None
+        self._running: list[Future] = []
 
     @contextmanager
     def step(self, stepping: Sequence[int], actions: Sequence[np.ndarray]) -> Iterator[None]:
@@ -93,10 +94,10 @@ class BatchedPhysics:
                 _replace_once(worlds[i], "_simulate", physics[i])
             yield
         except BaseException:
-            if self._threads is not None:
-                self._threads.wait_all()  # no world's physics may run on after an error
+            wait(self._running)  # no world's physics may run on after an error
             raise
         finally:
+            self._running = []
             for i in stepping:
                 for name in ("_apply_action", "_simulate"):
                     worlds[i].__dict__.pop(name, None)
@@ -105,14 +106,15 @@ class BatchedPhysics:
         """Queue one control period of physics of each of `worlds` (its own `_simulate`) on the
         threads, in world order; world -> a call that waits for it and returns whether it stayed
         stable. Without threads the call runs the physics itself."""
-        calls = [self.worlds[i]._simulate for i in worlds]
-        waits = calls if self._threads is None else self._threads.start(calls)
-        return dict(zip(worlds, waits, strict=True))
+        if self._pool is None:
+            return {i: self.worlds[i]._simulate for i in worlds}
+        self._running = [self._pool.submit(self.worlds[i]._simulate) for i in worlds]
+        return {i: future.result for i, future in zip(worlds, self._running, strict=True)}
 
     def close(self) -> None:
-        if self._threads is not None:
-            self._threads.close()
-            self._threads = None
+        if self._pool is not None:
+            self._pool.shutdown()
+            self._pool = None
 
 
 class BatchedVectorEnv(SyncVectorEnv):

@@ -13,7 +13,6 @@ from gymnasium.vector import AutoresetMode
 
 import hexapod_envs  # noqa: F401  (registers the ids)
 from hexapod_envs.vector import BatchedVectorEnv
-from hexapod_envs.vector.threads import CallThreads
 
 BATCHED_IDS = [
     "HexapodCliffWalk-v0",
@@ -176,20 +175,3 @@ def test_an_error_in_a_world_s_physics_reaches_the_caller():
     observations = envs.step(np.zeros((3, 18), dtype=np.float32))[0]
     assert observations.shape == (3, *envs.single_observation_space.shape)
     envs.close()
-
-
-def test_call_threads_run_every_call_and_return_results_and_errors_in_order():
-    threads = CallThreads(2)
-    for _ in range(3):  # batches one after another
-        waits = threads.start([lambda k=k: k * k for k in range(7)])
-        assert [wait() for wait in waits] == [k * k for k in range(7)]
-
-    def fail():
-        raise KeyError("seventh")
-
-    waits = threads.start([lambda: 1, fail, lambda: 3])
-    threads.wait_all()
-    assert waits[0]() == 1 and waits[2]() == 3
-    with pytest.raises(KeyError, match="seventh"):
-        waits[1]()
-    threads.close()
