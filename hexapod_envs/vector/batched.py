@@ -23,10 +23,14 @@ Why not `mujoco.rollout` (MuJoCo 4.0): a rollout is stateless by design. It load
 state into a per-thread scratch `MjData`, zeroes ``qacc_warmstart`` unless given and returns
 neither it nor the derived fields (contacts, ``xmat``, the sensors' intermediate values) that
 the envs read after a step, clears the warning counters the envs read as instability and
-stops stepping a world on a warning, where ``mj_step`` goes on. The PGS solver starts from the
-warm start, so a world stepped through a rollout drifts from the single env. `mujoco.batch`
-keeps its own `MjData` per simulation, which would have to be copied into each env's data in
-and out of every step, and ATHENA's contact checks within a period would be reimplemented.
+stops stepping a world on a warning, where ``mj_step`` goes on (MuJoCo's rollout.cc). The PGS
+solver starts from the warm start, so worlds stepped through rollouts would not carry the
+single env's warm start from one control period to the next. `mujoco.batch` keeps its own
+`MjData` per simulation, which would have to be copied into each env's data in and out of
+every step, and ATHENA's contact checks within a period would be reimplemented.
+
+What the threads buy, and what caps it (the calling thread's share of a step, caches that go
+cold between a world's turns): benchmarks/README.md, ``bench_vector_env.py``.
 """
 
 from __future__ import annotations
