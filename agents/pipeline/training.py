@@ -60,6 +60,9 @@ EVAL_SEED_OFFSET = 10_000
 RESUME_FIXED_SECTIONS = ("env", "policy", "normalize", "hybrid")
 """Config sections a resumed run cannot change (the model and its statistics depend on them)."""
 
+RESUME_FREE_KEYS = (("env", "vectorization"),)
+"""Keys of those sections that a resumed run may change: how the envs run, not what they are."""
+
 WORKER_CLOSE_TIMEOUT_S = 10.0
 """How long closing the vec env waits for subprocess workers before terminating them."""
 
@@ -263,8 +266,9 @@ def resume_training(
 ) -> TrainResult:
     """Continue a run from its newest loadable checkpoint (model, statistics, timestep count).
 
-    Overrides may change the budget, PPO hyperparameters, evaluation/checkpoint frequencies and
-    the number of envs, but not the env, the policy network or the normalisation. A damaged
+    Overrides may change the budget, PPO hyperparameters, evaluation/checkpoint frequencies,
+    the number of envs and how they run (``env.vectorization``), but not the env, the policy
+    network or the normalisation. A damaged
     newest checkpoint is reported and the next newest is used; no file of the run is written
     before a checkpoint has loaded.
     """
@@ -272,8 +276,9 @@ def resume_training(
     if not (run_dir / CONFIG_FILE).is_file():
         raise UserError(f"{run_dir} is not a training run directory (no {CONFIG_FILE})")
     for text in overrides:
-        section = parse_override(text)[0][0]
-        if section in RESUME_FIXED_SECTIONS:
+        key = tuple(parse_override(text)[0])
+        section = key[0]
+        if section in RESUME_FIXED_SECTIONS and key[:2] not in RESUME_FREE_KEYS:
             raise UserError(
                 f"cannot change {section!r} when resuming ({text!r}); the sections "
                 f"{list(RESUME_FIXED_SECTIONS)} are fixed by the saved model"

@@ -108,3 +108,8 @@ def test_a_batched_run_trains_the_same_policy_as_dummy_vec_env_and_resumes(tmp_p
     argv = ["--resume", str(run_dir), "--set", "train.total_timesteps=1536"]
     assert train_main(argv) == 0
     assert meta(run_dir / "final")["num_timesteps"] == 1536
+    # how the envs run may change on resuming (what they are may not)
+    argv = ["--resume", str(run_dir), "--set", "train.total_timesteps=2048"]
+    assert train_main([*argv, "--set", "env.vectorization=vec_env"]) == 0
+    assert meta(run_dir / "final")["num_timesteps"] == 2048
+    assert train_main([*argv[:2], "--set", "env.max_episode_steps=50"]) == 2
