@@ -86,6 +86,13 @@ def test_batched_equals_single_envs_through_resets(env_id):
     assert truncated > 0  # the time limit's autoresets were exercised
 
 
+@pytest.mark.parametrize("env_id", ["HexapodDitchCrossing-v0", "HexapodDitchCrossing-v1"])
+def test_the_ditch_crossing_batches_too(env_id):
+    """The UPU robot's env (registered with the same entry point) on its paper task."""
+    batched, sync = _pair(env_id, 2, max_episode_steps=30)
+    assert sum(_run_both(batched, sync, 70, seed=3)) > 0  # episodes ended and reset
+
+
 def test_batched_equals_single_envs_on_tip_overs():
     """On a platform that starts tilting at once, the held robot tips over: terminations and
     their autoresets."""
