@@ -113,7 +113,10 @@ class BatchedPhysics:
         if self._pool is None:
             return {i: self.worlds[i]._simulate for i in worlds}
         self._running = [self._pool.submit(self.worlds[i]._simulate) for i in worlds]
-        return {i: future.result for i, future in zip(worlds, self._running, strict=True)}
+        return {
+            i: partial(_take, future, self.worlds[i]._simulate)
+            for i, future in zip(worlds, self._running, strict=True)
+        }
 
     def close(self) -> None:
         if self._pool is not None:
@@ -158,6 +161,14 @@ class BatchedVectorEnv(SyncVectorEnv):
     def close_extras(self, **kwargs: Any) -> None:
         super().close_extras(**kwargs)
         self.physics.close()
+
+
+def _take(future: Future, simulate: Callable[[], bool]) -> bool:
+    """A world's physics when the calling thread needs it: if no thread has started it yet,
+    the calling thread runs it itself rather than wait idle."""
+    if future.cancel():
+        return simulate()
+    return future.result()
 
 
 def _check_action(world: int, applied: np.ndarray, action: np.ndarray) -> None:
