@@ -8,7 +8,9 @@ Each world is an ordinary env instance (its own `MjModel`, `MjData`, task, contr
    servo commands, residual filters and gait controllers: `HexapodEnv._apply_action`);
 2. the control period's physics of those worlds (each world's own `HexapodEnv._simulate`,
    ATHENA's contact checks included) is queued, in world order, on ``nthread`` threads;
-   MuJoCo releases the GIL inside ``mj_step``, so the worlds' physics runs in parallel;
+   MuJoCo releases the GIL inside ``mj_step``, so the worlds' physics runs in parallel (a
+   world that no thread has started when the calling thread needs it runs on the calling
+   thread);
 3. meanwhile the calling thread runs Gymnasium's `SyncVectorEnv.step`, which steps every world
    as usual with its action application and physics replaced, for this one call, by phase 1
    and by waiting for its physics: world k's measurement, tip-over, success, reward,
