@@ -13,9 +13,12 @@ from __future__ import annotations
 import functools
 import math
 from collections import Counter
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
+
+from hexapod_envs.envs.irregular_terrain import CALIBRATED_MODEL
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -179,13 +182,15 @@ def athena_rows(
     steps: int = 1200,
     env_kwargs: dict | None = None,
     blocks_kwargs: dict | None = None,
+    model: Mapping = CALIBRATED_MODEL,
+    tag: str | None = None,
 ) -> list[dict]:
     """Rows 8-11 (Coelho et al. 2024 §5.2): posture vs simple control on the ramp and the block bed,
-    measured with experiments.athena_posture.study.compare (the posture study's protocol, default
-    env).
+    measured with experiments.athena_posture.study.compare (the posture study's protocol) on the
+    robot `model` (default: the calibrated one, `CALIBRATED_MODEL`; {}: the -v0 env's defaults).
 
     `env_kwargs` apply to both terrains, `blocks_kwargs` to the block bed only; each row's id gets
-    the suffix "@" + the kwargs of its terrain.
+    the suffix `tag`, or "@" + the kwargs of its terrain.
     """
     from experiments.athena_posture.study import compare
 
@@ -195,7 +200,7 @@ def athena_rows(
         "blocks": {**(env_kwargs or {}), **(blocks_kwargs or {})},
     }
     for terrain in ("ramp", "blocks"):
-        result = compare(terrain, d["seeds"], steps=steps, **kwargs[terrain])
+        result = compare(terrain, d["seeds"], steps=steps, **model, **kwargs[terrain])
         d[terrain] = {"summary": result["summary"], "change_pct": result["change_pct"]}
     ramp, blocks = d["ramp"], d["blocks"]
     rc, bc = ramp["change_pct"], blocks["change_pct"]
@@ -208,10 +213,14 @@ def athena_rows(
 
     env_defaults = IrregularTerrainSettings()
     default = (
-        f"default env (servo_kp {env_defaults.servo_kp:g} N m/rad, "
-        f"{env_defaults.block_size[0]:g} m blocks, {env_defaults.physics_dt * 1e3:g} ms step)"
+        f"servo_kp {env_defaults.servo_kp:g} N m/rad, "
+        f"{env_defaults.block_size[0]:g} m blocks, {env_defaults.physics_dt * 1e3:g} ms step"
     )
-    settings = {t: f"HexapodIrregularTerrain-v0 {kwargs[t] or default}, {protocol}" for t in kwargs}
+    robot = f"calibrated model {dict(model)}" if model else "default env"
+    settings = {
+        t: f"HexapodIrregularTerrain-v0 {robot} ({kwargs[t] or default}), {protocol}"
+        for t in kwargs
+    }
     bs, bp = blocks["summary"]["simple"], blocks["summary"]["posture"]
 
     def r(x):
@@ -299,7 +308,8 @@ def athena_rows(
         ),
     ]
     for row in rows:
-        row["id"] += _tag(kwargs["blocks" if row["id"] in ("11", "11b", "11c") else "ramp"])
+        terrain = "blocks" if row["id"] in ("11", "11b", "11c") else "ramp"
+        row["id"] += _tag(kwargs[terrain]) if tag is None else tag
     return rows
 
 
@@ -393,6 +403,12 @@ def athena_finer_step_rows() -> list[dict]:
     return athena_rows(env_kwargs=ATHENA_FINER_STEP)
 
 
+def athena_v0_default_rows() -> list[dict]:
+    """Rows 8-11d with the -v0 env's robot model (suffix V0_DEFAULT) instead of the calibrated
+    one: MuJoCo's default contact softness and 0.002 kg m² of servo rotor inertia."""
+    return athena_rows(model={}, tag=V0_DEFAULT)
+
+
 @functools.cache
 def _script(name: str):
     """Load `scripts/<name>.py` as a module (to reuse its measurement code, not duplicate it),
@@ -416,8 +432,8 @@ def _paper_case_kwargs(scenario: str, stance: str) -> dict:
 
 
 V0_DEFAULT = "@v0 default"
-"""Row-id suffix of the Stewart rows measured with the env's defaults (2 deg/s from 3 s, no stop
-before 38-44 deg) instead of the paper's scenario."""
+"""Row-id suffix of rows measured with the -v0 env's defaults instead of the paper's scenario
+(Stewart: 2 deg/s from 3 s, no stop before 38-44 deg) or the calibrated robot model (ATHENA)."""
 
 
 def stewart_rows(
@@ -573,12 +589,13 @@ def athena_block_beds_rows(seeds=BLOCK_BEDS, steps: int = 1200) -> list[dict]:
     alone moves seeds 0-3's pitch change from +45 % to +39 %, a looser one to -32 %)."""
     from experiments.athena_posture.study import change_interval, compare
 
-    result = compare("blocks", seeds, steps=steps)
+    result = compare("blocks", seeds, steps=steps, **CALIBRATED_MODEL)
     n = len(result["simple"])
     summary = result["summary"]
     touched = summary["posture"]["episodes_with_collision"]
     setting = (
-        f"HexapodIrregularTerrain-v0 default env, blocks, seeds 0-{n - 1} x {steps} steps, "
+        f"HexapodIrregularTerrain-v0 calibrated model {dict(CALIBRATED_MODEL)}, blocks, "
+        f"seeds 0-{n - 1} x {steps} steps, "
         "medians of per-cycle RMS pooled over the beds, posture vs simple (paper gains); "
         "interval: 95 % percentile bootstrap over the beds"
     )
@@ -620,7 +637,9 @@ def athena_block_beds_rows(seeds=BLOCK_BEDS, steps: int = 1200) -> list[dict]:
 
 def athena_previous_default_rows() -> list[dict]:
     """Rows 8-11 with the ATHENA env defaults before the calibration (kp 8, 0.1 m blocks)."""
-    return athena_rows(env_kwargs=ATHENA_PREVIOUS_DEFAULT, blocks_kwargs=ATHENA_PREVIOUS_BLOCKS)
+    return athena_rows(
+        env_kwargs=ATHENA_PREVIOUS_DEFAULT, blocks_kwargs=ATHENA_PREVIOUS_BLOCKS, model={}
+    )
 
 
 PAPER_CONE_RATIO = 0.5
@@ -762,6 +781,7 @@ FULL = {
         athena_block_beds_rows,
         athena_previous_default_rows,
         athena_finer_step_rows,
+        athena_v0_default_rows,
     ),
     "003": (upu_kinematics_rows, ditch_rows, ditch_finer_step_rows),
 }

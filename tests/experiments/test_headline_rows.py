@@ -35,15 +35,9 @@ GROUPS = {
 }
 """Row function of experiments.reproduction.rows -> the ids of its headline rows."""
 
-FAILING = {
-    "9": (
-        "with the servo stiffness calibrated to the simple control's sag (rows 8, 11d) the "
-        "simple control drags its torso on the ramp, which damps its roll: +5.5 % (paper -36 %)"
-    ),
-    "11b": "posture control lowers the blocks' pitch-rate RMS (-36 %; paper +54 %)",
-    "11c": "posture control lowers the blocks' roll-rate RMS (-30 %; paper +82 %)",
-}
-"""Rows that do not hold today, with the measured reason (docs/reproduction.md)."""
+FAILING: dict[str, str] = {}
+"""Rows that do not hold today, with the measured reason (docs/reproduction.md): none since the
+ATHENA rows run on the calibrated robot model (rows 9, 11b and 11c failed on the -v0 defaults)."""
 
 
 @functools.cache
