@@ -1,6 +1,7 @@
 """PPO training runs: start a new run from a config, or resume the latest checkpoint of a run.
 
-See `artifacts` for the run directory layout and `callbacks` for what goes to TensorBoard.
+See `agents.run_files.artifacts` for the run directory layout and `callbacks` for what goes to
+TensorBoard.
 """
 
 from __future__ import annotations
@@ -102,8 +103,8 @@ def _probe(
     learner step is a gait cycle), metric specs and the robot's tipping threshold ξ (the time
     below it is logged). Returns a factory of episode
     accumulators for the training and evaluation callbacks, and the env's resolved settings
-    (recorded with the run, see `env_settings`); with ``reward_exclude``, one step checks
-    that the terms exist."""
+    (recorded with the run, see `agents.run_files.env_settings`); with ``reward_exclude``, one
+    step checks that the terms exist."""
     env = spec.make()
     try:
         if spec.reward_exclude:  # a term missing from the info is named at the first step
@@ -215,7 +216,7 @@ def _ppo_kwargs(config: TrainConfig) -> dict[str, Any]:
 def untrained_model(config: TrainConfig) -> tuple[Any, dict[str, Any] | None]:
     """`new_model` on the config's training vec env (VecNormalize on top when configured), for
     models fitted outside PPO's own loop (e.g. by distillation), and the env's resolved
-    settings (to record with the model, see `env_settings`)."""
+    settings (to record with the model, see `agents.run_files.env_settings`)."""
     _, settings = _probe(env_spec(config))
     venv, eval_env = _vec_envs(config, config.train.seed)
     if eval_env is not None:
