@@ -309,89 +309,30 @@ def select_foothold(
             stance, fewer than 3 stance feet, or bad rho / model.
     """
     params = params or HeavyDutyParams()
-    _check_common(leg, rho, model)
-    if len(stance_feet) < 3:
-        raise ValueError(f"need at least 3 stance feet, got {sorted(stance_feet)}")
-    if leg in stance_feet:
-        raise ValueError(f"adjustment leg {leg} is listed among the stance feet")
+    _check_foothold_inputs(leg, stance_feet, rho, model)
     edge = ccw_edge(*tipping_edge, tuple(stance_feet), stance_feet)
     plane = plane or terrain_plane(stance_feet)
     region = reachable_region(leg, plane, params, rho, model)
-    normal = np.asarray(plane.normal, float)
-    p_i = plane.project(np.asarray(stance_feet[edge[0]], float))
-    p_j = plane.project(np.asarray(stance_feet[edge[1]], float))
-    axis = (p_j - p_i) / np.linalg.norm(p_j - p_i)
-    pts = region.points
-    # Eq. (14): Θ = (P'_i->X × P'_i->P'_j)·z > 0 on the right; measured in the plane (·n).
-    distances = {
-        name: float(np.cross(pts[name] - p_i, axis) @ normal) for name in ("H", *BOUNDARY_POINTS)
-    }
-    edge_name = f"{edge[0]}-{edge[1]}"
-
+    p_i, axis = _tipping_axis(plane, stance_feet, edge)
+    distances = _axis_distances(region.points, plane, p_i, axis)
     if region.status != "ok":
-        return FootholdChoice(
-            status="no_reachable_ground",
-            leg=leg,
-            foothold=None,
-            point=None,
-            reason=(
-                f"no reachable ground: ‖B_iH‖ = {region.hip_height:.3f} m exceeds "
-                f"L_max = {params.max_leg_length:.3f} m or no leg pose reaches the plane"
-            ),
-            tipping_edge=edge,
-            axis_angle_deg=math.nan,
-            distances=distances,
-            joints=None,
-            within_joint_limits=False,
-            region=region,
-            plane=plane,
-        )
-
-    angles = {}
-    for a, b in _SEGMENTS:
-        seg = pts[b] - pts[a]
-        length = np.linalg.norm(seg)
-        if length > 1e-9:
-            cos = min(1.0, abs(float(seg @ axis)) / length)
-            angles[a + b] = math.degrees(math.acos(cos))
+        return _no_ground_choice(leg, edge, distances, region, plane, params)
+    angles = _segment_axis_angles(region.points, axis)
     axis_angle = min(angles.values()) if angles else math.nan
-    near_parallel = bool(angles) and axis_angle < angle_threshold_deg
-    candidates = ("R", "L") if near_parallel else BOUNDARY_POINTS
-    h_point = pts["H"]
-    best = max(
-        candidates,
-        key=lambda n: (round(distances[n], 9), -float(np.linalg.norm(pts[n] - h_point))),
+    best, why = _choose_point(
+        region.points,
+        distances,
+        angles,
+        angle_threshold_deg,
+        edge_name=f"{edge[0]}-{edge[1]}",
+        l_max=params.max_leg_length,
     )
-    collapsed = all(np.linalg.norm(pts[n] - h_point) < 1e-9 for n in BOUNDARY_POINTS)
-    if collapsed:
-        best = "H"
-        why = (
-            f"‖B_iH‖ = L_max = {params.max_leg_length:.3f} m: the reachable region shrinks to H, "
-            f"which is the target ({distances[best]:+.3f} m from the tipping axis {edge_name})"
-        )
-    elif near_parallel:
-        segment = min(angles, key=angles.get)
-        why = (
-            f"segment {segment} makes {axis_angle:.1f}° (< {angle_threshold_deg:g}°) with the "
-            f"tipping axis {edge_name}, so R or L is used; {best} lies "
-            f"{distances[best]:+.3f} m from the axis"
-        )
-    else:
-        why = (
-            f"every boundary segment makes >= {angle_threshold_deg:g}° with the tipping axis "
-            f"{edge_name} ({axis_angle:.1f}° at least), so the boundary point farthest outside "
-            f"the axis is used: {best} at {distances[best]:+.3f} m"
-        )
     status = "ok"
     if distances[best] <= 0.0:
         status = "no_outside_foothold"
         why += "; no reachable point lies outside the axis, so the support polygon cannot grow"
-    foothold = pts[best].copy()
-    try:
-        joints = joints_for_foot(leg, foothold, params)
-        ok = within_limits(joints, params, tol=1e-7)
-    except ValueError:
-        joints, ok = None, False
+    foothold = region.points[best].copy()
+    joints, ok = _foothold_joints(leg, foothold, params)
     return FootholdChoice(
         status=status,
         leg=leg,
@@ -403,6 +344,154 @@ def select_foothold(
         distances=distances,
         joints=joints,
         within_joint_limits=ok,
+        region=region,
+        plane=plane,
+    )
+
+
+def _check_foothold_inputs(
+    leg: str, stance_feet: Mapping[str, np.ndarray], rho: float, model: str
+) -> None:
+    """Raise ValueError for the inputs :func:`select_foothold` cannot use: a bad leg, rho or
+    model, fewer than 3 stance feet (no terrain plane, no support polygon), or the adjustment
+    leg itself among the stance feet (it is the leg being moved)."""
+    _check_common(leg, rho, model)
+    if len(stance_feet) < 3:
+        raise ValueError(f"need at least 3 stance feet, got {sorted(stance_feet)}")
+    if leg in stance_feet:
+        raise ValueError(f"adjustment leg {leg} is listed among the stance feet")
+
+
+def _tipping_axis(
+    plane: Plane, stance_feet: Mapping[str, np.ndarray], edge: tuple[str, str]
+) -> tuple[np.ndarray, np.ndarray]:
+    """P'_i [m] and the unit direction P'_i -> P'_j of the tipping axis, with P'_i, P'_j the
+    edge's feet projected onto ``plane`` (body frame); ``edge`` is counter-clockwise, so the
+    support polygon lies on the axis's left."""
+    p_i = plane.project(np.asarray(stance_feet[edge[0]], float))
+    p_j = plane.project(np.asarray(stance_feet[edge[1]], float))
+    return p_i, (p_j - p_i) / np.linalg.norm(p_j - p_i)
+
+
+def _axis_distances(
+    points: Mapping[str, np.ndarray], plane: Plane, p_i: np.ndarray, axis: np.ndarray
+) -> dict[str, float]:
+    """Signed distance [m] of H and every boundary point to the tipping axis through ``p_i``
+    along the unit ``axis``, > 0 on its right, i.e. outside the support polygon.
+
+    Eq. (14)'s Θ = (P'_i->X × P'_i->P'_j)·z, taken along the plane normal instead of body z so
+    that it is a distance in the plane also on tilted ground.
+    """
+    normal = np.asarray(plane.normal, float)
+    return {
+        name: float(np.cross(points[name] - p_i, axis) @ normal) for name in ("H", *BOUNDARY_POINTS)
+    }
+
+
+def _segment_axis_angles(points: Mapping[str, np.ndarray], axis: np.ndarray) -> dict[str, float]:
+    """Angle [deg, 0-90] between each boundary segment (AB, BC, CD, DA) and the unit tipping
+    ``axis``, keyed "AB".."DA"; segments shorter than 1 nm (a collapsed region has no direction)
+    are left out."""
+    angles = {}
+    for a, b in _SEGMENTS:
+        seg = points[b] - points[a]
+        length = np.linalg.norm(seg)
+        if length > 1e-9:
+            cos = min(1.0, abs(float(seg @ axis)) / length)
+            angles[a + b] = math.degrees(math.acos(cos))
+    return angles
+
+
+def _choose_point(
+    points: Mapping[str, np.ndarray],
+    distances: Mapping[str, float],
+    angles: Mapping[str, float],
+    angle_threshold_deg: float,
+    edge_name: str,
+    l_max: float,
+) -> tuple[str, str]:
+    """§4.2's choice among the region's points, and the sentence that says why.
+
+    A region collapsed to H (‖B_iH‖ = L_max, ``l_max`` [m]) leaves H; a boundary segment within
+    ``angle_threshold_deg`` [deg] of the tipping axis (``angles``, see
+    :func:`_segment_axis_angles`) leaves R or L, level with the hip (a shorter adjustment);
+    otherwise every boundary point competes. Among the candidates the one farthest outside the
+    axis wins (:func:`_farthest_outside`).
+    """
+    h_point = points["H"]
+    if all(np.linalg.norm(points[n] - h_point) < 1e-9 for n in BOUNDARY_POINTS):
+        return "H", (
+            f"‖B_iH‖ = L_max = {l_max:.3f} m: the reachable region shrinks to H, "
+            f"which is the target ({distances['H']:+.3f} m from the tipping axis {edge_name})"
+        )
+    axis_angle = min(angles.values()) if angles else math.nan
+    if angles and axis_angle < angle_threshold_deg:
+        best = _farthest_outside(points, distances, ("R", "L"))
+        segment = min(angles, key=angles.get)
+        return best, (
+            f"segment {segment} makes {axis_angle:.1f}° (< {angle_threshold_deg:g}°) with the "
+            f"tipping axis {edge_name}, so R or L is used; {best} lies "
+            f"{distances[best]:+.3f} m from the axis"
+        )
+    best = _farthest_outside(points, distances, BOUNDARY_POINTS)
+    return best, (
+        f"every boundary segment makes >= {angle_threshold_deg:g}° with the tipping axis "
+        f"{edge_name} ({axis_angle:.1f}° at least), so the boundary point farthest outside "
+        f"the axis is used: {best} at {distances[best]:+.3f} m"
+    )
+
+
+def _farthest_outside(
+    points: Mapping[str, np.ndarray], distances: Mapping[str, float], candidates: tuple[str, ...]
+) -> str:
+    """Name of the candidate point farthest outside the tipping axis: the largest signed
+    distance, rounded to 1 nm so that equal distances tie; ties go to the point nearer to H (the
+    shorter swing)."""
+    h_point = points["H"]
+    return max(
+        candidates,
+        key=lambda n: (round(distances[n], 9), -float(np.linalg.norm(points[n] - h_point))),
+    )
+
+
+def _foothold_joints(
+    leg: str, foothold: np.ndarray, params: HeavyDutyParams
+) -> tuple[np.ndarray | None, bool]:
+    """[J_x, J_z, J_θ] that put ``leg``'s foot on ``foothold`` (body frame, m) and whether they
+    lie within the joint ranges; (None, False) when no pose reaches it. The region is only an
+    approximation of the reach (on tilted ground J_x also changes the leg length), hence the
+    check."""
+    try:
+        joints = joints_for_foot(leg, foothold, params)
+        return joints, within_limits(joints, params, tol=1e-7)
+    except ValueError:
+        return None, False
+
+
+def _no_ground_choice(
+    leg: str,
+    edge: tuple[str, str],
+    distances: dict[str, float],
+    region: ReachableRegion,
+    plane: Plane,
+    params: HeavyDutyParams,
+) -> FootholdChoice:
+    """The :class:`FootholdChoice` without a foothold: the plane lies beyond the leg's reach
+    (‖B_iH‖ > L_max, or no leg pose reaches it)."""
+    return FootholdChoice(
+        status="no_reachable_ground",
+        leg=leg,
+        foothold=None,
+        point=None,
+        reason=(
+            f"no reachable ground: ‖B_iH‖ = {region.hip_height:.3f} m exceeds "
+            f"L_max = {params.max_leg_length:.3f} m or no leg pose reaches the plane"
+        ),
+        tipping_edge=edge,
+        axis_angle_deg=math.nan,
+        distances=distances,
+        joints=None,
+        within_joint_limits=False,
         region=region,
         plane=plane,
     )
