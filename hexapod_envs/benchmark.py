@@ -24,7 +24,7 @@ from types import MappingProxyType
 
 from .envs.cliff_walk import CliffTaskRanges
 from .envs.ditch_crossing import DitchTaskRanges
-from .envs.irregular_terrain import TerrainTaskRanges
+from .envs.irregular_terrain import CALIBRATED_MODEL, TerrainTaskRanges
 
 BENCHMARK_SEEDS = range(50)
 """The benchmark's test tasks: ``env.reset(seed=s)`` on ``task_distribution="test"``."""
@@ -89,6 +89,8 @@ V1_KWARGS = MappingProxyType(
             "success_max_tilt_deg": 2.5,
         },
         "HexapodIrregularTerrain-v1": {
+            **CALIBRATED_MODEL,
+            "robot_friction": 0.0,  # the contact takes the terrain's friction (MuJoCo: the larger)
             "terrain": "blocks",
             "tip_over_angle_deg": 45.0,
             "success_max_tilt_deg": 25.0,

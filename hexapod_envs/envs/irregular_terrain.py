@@ -134,8 +134,11 @@ roll-rate RMS and mean ZMP margin) feed the evaluation pipeline (`evaluation_met
 ## Version History
 - v1: the block bed (``terrain="blocks"``), termination at a 45° tilt, success only with the
   tilt within 25° and at most 30 % of the episode below ξ; beds from easy to hard in training
-  and from the harder half in test (`hexapod_envs.benchmark`, docs/benchmark.md).
-- v0: the papers' reproduction (the 10° ramp by default).
+  and from the harder half in test (`hexapod_envs.benchmark`, docs/benchmark.md); the
+  calibrated robot model (`CALIBRATED_MODEL`), and the terrain's friction as the contact's
+  (``robot_friction=0``).
+- v0: the 10° ramp by default; the robot model before the joint calibration (the papers'
+  reproduction passes `CALIBRATED_MODEL`).
 """
 
 from __future__ import annotations
