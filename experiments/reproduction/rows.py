@@ -177,6 +177,26 @@ def upu_kinematics_rows() -> list[dict]:
     ]
 
 
+ATHENA_ROWS = (
+    # (id, terrain, quantity, paper value, unit, tolerance) of rows 8-11d (Coelho et al. 2024
+    # §5.2); the measured value and whether it holds come from _athena_values.
+    ("8", "ramp", "ramp torso height change", 60.77, "%", ">= +40"),
+    ("9", "ramp", "ramp roll-rate change", -35.98, "%", "< 0"),
+    ("10", "ramp", "ramp pitch-rate change", -11.92, "%", "<= 0"),
+    (
+        "11",
+        "blocks",
+        "blocks torso-contact steps, posture / simple",
+        (0, ">0"),
+        "steps",
+        "posture 0 in >= 3 of 4 seeds, simple > 0 in all",
+    ),
+    ("11b", "blocks", "blocks pitch-rate change", 54.0, "%", "same sign as paper"),
+    ("11c", "blocks", "blocks roll-rate change", 82.0, "%", "same sign as paper"),
+    ("11d", "ramp", "ramp median torso height, simple control", 0.068, "m", "+-0.005"),
+)
+
+
 def athena_rows(
     seeds=range(4),
     steps: int = 1200,
@@ -192,125 +212,94 @@ def athena_rows(
     `env_kwargs` apply to both terrains, `blocks_kwargs` to the block bed only; each row's id gets
     the suffix `tag`, or "@" + the kwargs of its terrain.
     """
-    from experiments.athena_posture.study import compare
-
-    d = {"seeds": list(seeds), "steps": steps}
+    seeds = list(seeds)
     kwargs = {
         "ramp": dict(env_kwargs or {}),
         "blocks": {**(env_kwargs or {}), **(blocks_kwargs or {})},
     }
+    measured = _athena_compare(seeds, steps, model, kwargs)
+    n = len(seeds)
+    values = _athena_values(measured["ramp"], measured["blocks"], n)
+    settings = _athena_settings(kwargs, model, n, steps)
+    touched = measured["blocks"]["summary"]["posture"]["episodes_with_collision"]
+    notes = {"11": f"; posture touched in {touched} of {n} episodes"}
+    rows = []
+    for id_, terrain, quantity, paper_value, unit, tolerance in ATHENA_ROWS:
+        value, holds = values[id_]
+        rows.append(
+            _row(
+                id_ + (_tag(kwargs[terrain]) if tag is None else tag),
+                "002",
+                quantity,
+                list(paper_value) if isinstance(paper_value, tuple) else paper_value,
+                value,
+                unit,
+                tolerance,
+                holds,
+                settings[terrain] + notes.get(id_, ""),
+            )
+        )
+    return rows
+
+
+def _athena_compare(
+    seeds: list[int], steps: int, model: Mapping, kwargs: dict[str, dict]
+) -> dict[str, dict]:
+    """Posture vs simple control on each terrain ("ramp", "blocks": its env kwargs in `kwargs`)
+    with experiments.athena_posture.study.compare, `steps` control steps per seed: the terrain's
+    `summary` (per controller) and `change_pct` (posture vs simple, %)."""
+    from experiments.athena_posture.study import compare
+
+    measured = {}
     for terrain in ("ramp", "blocks"):
-        result = compare(terrain, d["seeds"], steps=steps, **model, **kwargs[terrain])
-        d[terrain] = {"summary": result["summary"], "change_pct": result["change_pct"]}
-    ramp, blocks = d["ramp"], d["blocks"]
+        result = compare(terrain, seeds, steps=steps, **model, **kwargs[terrain])
+        measured[terrain] = {"summary": result["summary"], "change_pct": result["change_pct"]}
+    return measured
+
+
+def _athena_values(ramp: dict, blocks: dict, n: int) -> dict[str, tuple[object, bool]]:
+    """(value, holds) of each row of ATHENA_ROWS from the terrains' comparisons (see
+    _athena_compare) over `n` seeds; each test is the row's tolerance phrase. Rate and height
+    changes in % (2 decimals), torso-contact counts in control steps, the height in m."""
     rc, bc = ramp["change_pct"], blocks["change_pct"]
-    n = len(d["seeds"])
-    protocol = (
-        f"seeds 0-{n - 1} x {d['steps']} steps, medians of per-cycle RMS, posture vs simple "
-        "(paper gains)"
-    )
+    bs, bp = blocks["summary"]["simple"], blocks["summary"]["posture"]
+    simple_height = ramp["summary"]["simple"]["height_median"]
+
+    def r(x):
+        return None if x is None else round(float(x), 2)
+
+    contact_steps = [bp["torso_collision_steps"], bs["torso_collision_steps"]]
+    posture_free = n - bp["episodes_with_collision"]
+    return {
+        "8": (r(rc["height"]), rc["height"] >= 40.0),
+        "9": (r(rc["roll_rate"]), rc["roll_rate"] < 0.0),
+        "10": (r(rc["pitch_rate"]), rc["pitch_rate"] <= 0.0),
+        "11": (contact_steps, posture_free >= 3 and bs["episodes_with_collision"] == n),
+        "11b": (r(bc["pitch_rate"]), bc["pitch_rate"] > 0),
+        "11c": (r(bc["roll_rate"]), bc["roll_rate"] > 0),
+        "11d": (round(simple_height, 4), abs(simple_height - 0.068) <= 0.005),
+    }
+
+
+def _athena_settings(kwargs: dict[str, dict], model: Mapping, n: int, steps: int) -> dict:
+    """The `setting` text of each terrain's rows: env, robot model, the terrain's kwargs (or the
+    env defaults they change: servo gain, block size, physics step) and the protocol."""
     from hexapod_envs.envs.irregular_terrain import IrregularTerrainSettings
 
+    protocol = (
+        f"seeds 0-{n - 1} x {steps} steps, medians of per-cycle RMS, posture vs simple "
+        "(paper gains)"
+    )
     env_defaults = IrregularTerrainSettings()
     default = (
         f"servo_kp {env_defaults.servo_kp:g} N m/rad, "
         f"{env_defaults.block_size[0]:g} m blocks, {env_defaults.physics_dt * 1e3:g} ms step"
     )
     robot = f"calibrated model {dict(model)}" if model else "default env"
-    settings = {
+    return {
         t: f"HexapodIrregularTerrain-v0 {robot} ({kwargs[t] or default}), {protocol}"
         for t in kwargs
     }
-    bs, bp = blocks["summary"]["simple"], blocks["summary"]["posture"]
-
-    def r(x):
-        return None if x is None else round(float(x), 2)
-
-    posture_free = n - bp["episodes_with_collision"]
-    rows = [
-        _row(
-            "8",
-            "002",
-            "ramp torso height change",
-            60.77,
-            r(rc["height"]),
-            "%",
-            ">= +40",
-            rc["height"] >= 40.0,
-            settings["ramp"],
-        ),
-        _row(
-            "9",
-            "002",
-            "ramp roll-rate change",
-            -35.98,
-            r(rc["roll_rate"]),
-            "%",
-            "< 0",
-            rc["roll_rate"] < 0.0,
-            settings["ramp"],
-        ),
-        _row(
-            "10",
-            "002",
-            "ramp pitch-rate change",
-            -11.92,
-            r(rc["pitch_rate"]),
-            "%",
-            "<= 0",
-            rc["pitch_rate"] <= 0.0,
-            settings["ramp"],
-        ),
-        _row(
-            "11",
-            "002",
-            "blocks torso-contact steps, posture / simple",
-            [0, ">0"],
-            [bp["torso_collision_steps"], bs["torso_collision_steps"]],
-            "steps",
-            "posture 0 in >= 3 of 4 seeds, simple > 0 in all",
-            posture_free >= 3 and bs["episodes_with_collision"] == n,
-            settings["blocks"]
-            + f"; posture touched in {bp['episodes_with_collision']} of {n} episodes",
-        ),
-        _row(
-            "11b",
-            "002",
-            "blocks pitch-rate change",
-            54.0,
-            r(bc["pitch_rate"]),
-            "%",
-            "same sign as paper",
-            bc["pitch_rate"] > 0,
-            settings["blocks"],
-        ),
-        _row(
-            "11c",
-            "002",
-            "blocks roll-rate change",
-            82.0,
-            r(bc["roll_rate"]),
-            "%",
-            "same sign as paper",
-            bc["roll_rate"] > 0,
-            settings["blocks"],
-        ),
-        _row(
-            "11d",
-            "002",
-            "ramp median torso height, simple control",
-            0.068,
-            round(ramp["summary"]["simple"]["height_median"], 4),
-            "m",
-            "+-0.005",
-            abs(ramp["summary"]["simple"]["height_median"] - 0.068) <= 0.005,
-            settings["ramp"],
-        ),
-    ]
-    for row in rows:
-        terrain = "blocks" if row["id"] in ("11", "11b", "11c") else "ramp"
-        row["id"] += _tag(kwargs[terrain]) if tag is None else tag
-    return rows
 
 
 def ditch_episode(seed: int = 0, **env_kwargs) -> dict:
