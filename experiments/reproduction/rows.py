@@ -438,8 +438,6 @@ def stewart_rows(
     (e.g. {} for the env's defaults); then the row ids get the suffix `tag` (default "@" + the
     kwargs) and row 6 is left out.
     """
-    from agents.tipping.judgment import XI_F_DEG
-
     mod = _script("plot_stewart_recovery")
     paper = env_kwargs is None
     tag = "" if paper else (_tag(env_kwargs) if tag is None else tag)
@@ -457,71 +455,86 @@ def stewart_rows(
             + (" (paper_scenario)" if paper else "")
             + f", seed {seed}; judged at {d['judgment_time']} s"
         )
-        ts = d["t_s"]
-        rows.append(
-            _row(
-                f"7b.{case}",
-                "000",
-                f"t_s, {case}",
-                p_ts,
-                None if ts is None else round(ts, 3),
-                "s",
-                "inside 0.5-2.5, not at a clamp (0.5 / 3.0)",
-                ts is not None and 0.5 < ts < 2.5,
-                setting,
-            )
-        )
+        rows.append(_time_budget_row(case, d["t_s"], p_ts, setting))
         rows.append(_cone_row(f"7c.{case}", case, ctrl, setting))
-        landed = d["landing_time"]
-        if landed is None:
-            rows.append(
-                _row(
-                    f"7.{case}",
-                    "000",
-                    f"FASM after landing, {case}",
-                    p_after,
-                    None,
-                    "deg",
-                    ">= 35 / 35 / 20",
-                    False,
-                    setting + "; never landed",
-                )
-            )
-            continue
-        after = mod.fasm_at(ctrl, landed + 0.5)
-        later = ctrl["fasm"][ctrl["t"] >= landed + 0.5]
-        low = float(later.min()) if len(later) else float("nan")
-        need = 20.0 if scenario == "side" else 35.0
-        rows.append(
-            _row(
-                f"7.{case}",
-                "000",
-                f"FASM 0.5 s after landing / min to end, {case}",
-                p_after,
-                [round(after, 2), round(low, 2)],
-                "deg",
-                f">= {need:g} after 0.5 s, never below xi_f={XI_F_DEG:g} after",
-                after >= need and low >= XI_F_DEG and not ctrl["tipped"],
-                setting + f"; platform tilt at end {ctrl['tilt'][-1]:.1f} deg",
-            ),
-        )
+        rows.append(_fasm_after_landing_row(mod, case, scenario, ctrl, p_after, setting))
     if tag:
         return rows
-    rows.insert(
-        0,
-        _row(
-            "6",
-            "000",
-            "Stewart adjustment leg as paper",
-            6,
-            legs_ok,
-            "of 6",
-            "6/6",
-            legs_ok == len(cases),
-            "HexapodStewartTilt-v0, six cases as paper_scenario, seed 0",
-        ),
-    )
+    rows.insert(0, _adjustment_leg_row(legs_ok, len(cases)))
     return rows
+
+
+def _time_budget_row(case: str, ts: float | None, paper_ts: float, setting: str) -> dict:
+    """Row 7b of one Stewart case: the adjustment leg's time budget t_s [s] (eq. 15), which holds
+    inside (0.5, 2.5) s, i.e. not at the controller's clamps 0.5 / 3.0 s."""
+    return _row(
+        f"7b.{case}",
+        "000",
+        f"t_s, {case}",
+        paper_ts,
+        None if ts is None else round(ts, 3),
+        "s",
+        "inside 0.5-2.5, not at a clamp (0.5 / 3.0)",
+        ts is not None and 0.5 < ts < 2.5,
+        setting,
+    )
+
+
+def _fasm_after_landing_row(
+    mod, case: str, scenario: str, ctrl: dict, paper_after, setting: str
+) -> dict:
+    """Row 7 of one Stewart case: FASM [deg] 0.5 s after the adjustment leg lands and its minimum
+    from then to the end of run `ctrl` (scripts/plot_stewart_recovery.py's `mod.run`).
+
+    Holds when the first is at least 35 deg (20 deg on the side case) and the second never below
+    the tipping threshold ξ_f, and the robot did not tip; a run whose leg never lands fails.
+    """
+    from agents.tipping.judgment import XI_F_DEG
+
+    landed = ctrl["diagnostics"]["landing_time"]
+    if landed is None:
+        return _row(
+            f"7.{case}",
+            "000",
+            f"FASM after landing, {case}",
+            paper_after,
+            None,
+            "deg",
+            ">= 35 / 35 / 20",
+            False,
+            setting + "; never landed",
+        )
+    after = mod.fasm_at(ctrl, landed + 0.5)
+    later = ctrl["fasm"][ctrl["t"] >= landed + 0.5]
+    low = float(later.min()) if len(later) else float("nan")
+    need = 20.0 if scenario == "side" else 35.0
+    return _row(
+        f"7.{case}",
+        "000",
+        f"FASM 0.5 s after landing / min to end, {case}",
+        paper_after,
+        [round(after, 2), round(low, 2)],
+        "deg",
+        f">= {need:g} after 0.5 s, never below xi_f={XI_F_DEG:g} after",
+        after >= need and low >= XI_F_DEG and not ctrl["tipped"],
+        setting + f"; platform tilt at end {ctrl['tilt'][-1]:.1f} deg",
+    )
+
+
+def _adjustment_leg_row(legs_ok: int, n_cases: int) -> dict:
+    """Row 6: in how many of the Stewart cases the judgment chose the paper's adjustment leg
+    (Zhang et al. 2024 Table II); holds when all of them match."""
+    return _row(
+        "6",
+        "000",
+        "Stewart adjustment leg as paper",
+        6,
+        legs_ok,
+        "of 6",
+        "6/6",
+        legs_ok == n_cases,
+        "HexapodStewartTilt-v0, six cases as paper_scenario, seed 0",
+    )
 
 
 def stewart_v0_default_rows() -> list[dict]:
