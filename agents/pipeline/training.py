@@ -383,21 +383,56 @@ def _learn(
     after_eval: Any = None,
     env_settings: dict[str, Any] | None = None,
 ) -> TrainResult:
+    """Train `model` in `run_dir` up to ``train.total_timesteps`` and save the result.
+
+    Shared by a new run and a resumed one (`resumed`: keep the timestep count and the earlier
+    evaluations). Ctrl-C or SIGTERM saves an ``interrupt`` checkpoint and returns with
+    `interrupted` set; any other error saves a ``crash`` checkpoint and is re-raised; a run that
+    completes saves the final model. The vec envs are closed in every case.
+    """
     import torch
-    from stable_baselines3.common.callbacks import CallbackList
-    from stable_baselines3.common.logger import Logger, make_output_format
 
     torch.set_num_threads(config.train.num_threads)
 
-    from .callbacks import (
-        CheckpointEvery,
-        EpisodeStatsCallback,
-        ModelSaver,
-        SaveBest,
-        StatsEvalCallback,
-    )
+    from .callbacks import ModelSaver
 
     saver = ModelSaver(run_dir, config, command, env_settings)
+    callbacks = _callbacks(config, saver, new_accumulator)
+    if eval_env is not None:
+        eval_cb = _eval_callback(config, run_dir, saver, eval_env, new_accumulator, after_eval)
+        if resumed:
+            _restore_eval_history(eval_cb, run_dir, model.num_timesteps)
+        callbacks.append(eval_cb)
+    _set_logger(model, config, run_dir)
+    start_steps = model.num_timesteps
+    remaining = config.train.total_timesteps - start_steps
+    start = time.perf_counter()
+    interrupted = _run_learn(model, config, remaining, callbacks, resumed, saver, eval_env)
+    seconds = time.perf_counter() - start
+    with _exit_on_second_interrupt():
+        if interrupted:
+            saved = saver.save(model, "interrupt")
+        else:
+            saved = saver.save(model, "final", run_dir / FINAL)
+        _close_envs(model, eval_env)
+    return TrainResult(
+        run_dir=run_dir,
+        num_timesteps=int(model.num_timesteps),
+        steps_this_call=int(model.num_timesteps - start_steps),
+        seconds=seconds,
+        interrupted=interrupted,
+        saved_to=saved,
+    )
+
+
+def _callbacks(
+    config: TrainConfig, saver: Any, new_accumulator: Callable[[], EpisodeAccumulator]
+) -> list[Any]:
+    """The training callbacks other than evaluation: each finished episode's statistics to the
+    log, each step's safety override into the rollout buffer when ``hybrid.mask_overridden``,
+    and a checkpoint every ``checkpoint.freq`` steps (0: none)."""
+    from .callbacks import CheckpointEvery, EpisodeStatsCallback
+
     callbacks = [EpisodeStatsCallback(new_accumulator)]
     if _masks_overridden(config):
         from .override_mask import RecordOverrides
@@ -405,25 +440,46 @@ def _learn(
         callbacks.append(RecordOverrides())
     if config.checkpoint.freq > 0:
         callbacks.append(CheckpointEvery(config.checkpoint.freq, saver))
-    if eval_env is not None:
-        by_success = config.eval.select == "success"
-        eval_cb = StatsEvalCallback(
-            eval_env,
-            n_eval_episodes=config.eval.n_episodes,
-            eval_freq=max(config.eval.freq // config.vec_env.n_envs, 1),
-            log_path=str(run_dir),
-            deterministic=config.eval.deterministic,
-            callback_on_new_best=None if by_success else SaveBest(saver),
-            callback_after_eval=after_eval,
-            warn=False,
-            verbose=config.logging.verbose,
-            new_accumulator=new_accumulator,
-            task_seed=config.train.seed + EVAL_SEED_OFFSET if config.eval.same_tasks else None,
-            select_saver=saver if by_success else None,
-        )
-        if resumed:
-            _restore_eval_history(eval_cb, run_dir, model.num_timesteps)
-        callbacks.append(eval_cb)
+    return callbacks
+
+
+def _eval_callback(
+    config: TrainConfig,
+    run_dir: Path,
+    saver: Any,
+    eval_env: Any,
+    new_accumulator: Callable[[], EpisodeAccumulator],
+    after_eval: Any,
+) -> Any:
+    """The evaluation callback: ``eval.n_episodes`` episodes on `eval_env` every ``eval.freq``
+    steps summed over the envs, logged to ``evaluations.npz`` in `run_dir`; it saves ``best/``
+    by mean return, or by success rate then mean return when ``eval.select`` is "success", and
+    runs `after_eval` after each evaluation. With ``eval.same_tasks`` every evaluation draws the
+    same tasks (seeded apart from training by EVAL_SEED_OFFSET)."""
+    from .callbacks import SaveBest, StatsEvalCallback
+
+    by_success = config.eval.select == "success"
+    return StatsEvalCallback(
+        eval_env,
+        n_eval_episodes=config.eval.n_episodes,
+        eval_freq=max(config.eval.freq // config.vec_env.n_envs, 1),
+        log_path=str(run_dir),
+        deterministic=config.eval.deterministic,
+        callback_on_new_best=None if by_success else SaveBest(saver),
+        callback_after_eval=after_eval,
+        warn=False,
+        verbose=config.logging.verbose,
+        new_accumulator=new_accumulator,
+        task_seed=config.train.seed + EVAL_SEED_OFFSET if config.eval.same_tasks else None,
+        select_saver=saver if by_success else None,
+    )
+
+
+def _set_logger(model: Any, config: TrainConfig, run_dir: Path) -> None:
+    """Send SB3's log to TensorBoard (``run_dir/tb``) when ``logging.tensorboard`` and to
+    stdout when ``logging.verbose`` >= 1."""
+    from stable_baselines3.common.logger import Logger, make_output_format
+
     tb_dir = run_dir / "tb"
     formats = []
     if config.logging.tensorboard:
@@ -434,10 +490,22 @@ def _learn(
         Logger(folder=str(tb_dir) if config.logging.tensorboard else None, output_formats=formats)
     )
 
-    start_steps = model.num_timesteps
-    remaining = config.train.total_timesteps - start_steps
-    start = time.perf_counter()
-    interrupted = False
+
+def _run_learn(
+    model: Any,
+    config: TrainConfig,
+    remaining: int,
+    callbacks: list[Any],
+    resumed: bool,
+    saver: Any,
+    eval_env: Any,
+) -> bool:
+    """Run PPO's learn() for `remaining` steps; True if Ctrl-C or SIGTERM stopped it.
+
+    Any other error saves a crash checkpoint, closes the envs and is re-raised; a second Ctrl-C
+    meanwhile exits at once."""
+    from stable_baselines3.common.callbacks import CallbackList
+
     try:
         with _interruptible():
             model.learn(
@@ -447,29 +515,19 @@ def _learn(
                 progress_bar=config.logging.progress_bar,
             )
     except KeyboardInterrupt:
-        interrupted = True
+        return True
     except BaseException as exc:
         with _exit_on_second_interrupt():
             _save_after_crash(saver, model, exc)
-            for env in (model.get_env(), eval_env):
-                close_vec_env(env)
+            _close_envs(model, eval_env)
         raise
-    seconds = time.perf_counter() - start
-    with _exit_on_second_interrupt():
-        if interrupted:
-            saved = saver.save(model, "interrupt")
-        else:
-            saved = saver.save(model, "final", run_dir / FINAL)
-        for env in (model.get_env(), eval_env):
-            close_vec_env(env)
-    return TrainResult(
-        run_dir=run_dir,
-        num_timesteps=int(model.num_timesteps),
-        steps_this_call=int(model.num_timesteps - start_steps),
-        seconds=seconds,
-        interrupted=interrupted,
-        saved_to=saved,
-    )
+    return False
+
+
+def _close_envs(model: Any, eval_env: Any) -> None:
+    """Close the training vec env and the evaluation one (None: nothing to close)."""
+    for env in (model.get_env(), eval_env):
+        close_vec_env(env)
 
 
 def _save_after_crash(saver: Any, model: Any, exc: BaseException) -> None:
