@@ -100,8 +100,9 @@ class VecEnvConfig:
     def __post_init__(self):
         _require("vec_env.n_envs", self.n_envs, ">= 1", self.n_envs >= 1)
         threads = self.physics_threads
-        ok = threads is None or threads >= 0
-        _require("vec_env.physics_threads", threads, ">= 0 or null", ok)
+        whole = isinstance(threads, int) and not isinstance(threads, bool)
+        ok = threads is None or (whole and threads >= 0)
+        _require("vec_env.physics_threads", threads, "an integer >= 0 or null", ok)
 
     @property
     def use_subprocess(self) -> bool:

@@ -157,7 +157,7 @@ from ..robots.athena.gait import (
     AthenaPostureController,
 )
 from ..robots.athena.kinematics import standing_foot_positions
-from ..robots.athena.model import add_athena
+from ..robots.athena.model import DELAY_MIN_TIMESTEP, add_athena
 from ..robots.athena.params import ATHENA, LEG_NAMES
 from ..terrain.flat import add_flat
 from ..terrain.irregular import PAPER_FRICTION, add_blocks, add_ramp
@@ -207,10 +207,6 @@ class TerrainTaskRanges(TaskRanges):
     in training (extrapolated), lower friction, servo stiffness farther from nominal.
 
     Block sizes lie around the calibrated 0.25 m default (training 0.25-0.35 m, test 0.2-0.25 m).
-    Before the calibration they lay around the old 0.1 m default (training 0.10-0.14 m, test
-    0.08-0.10 m); on those test beds no policy succeeded in any of 20 episodes (the paper's
-    blocks gains: 176 torso-contact steps per episode), which left a comparison of gains little
-    to rank.
     """
 
     slope_deg: tuple[tuple[float, float], ...] = bounded(high=45.0)
@@ -426,6 +422,11 @@ class IrregularTerrainEnv(HexapodEnv):
             raise ValueError(
                 f"control_dt / physics_dt = {self.n_substeps} substeps must be a multiple of "
                 f"{_CONTACT_CHECKS} (torso contact is checked {_CONTACT_CHECKS} times per step)"
+            )
+        if s.servo_delay > 0 and s.physics_dt < DELAY_MIN_TIMESTEP:
+            raise ValueError(
+                f"servo_delay > 0 needs physics_dt >= {DELAY_MIN_TIMESTEP} s (the servos' target "
+                f"history covers the delay at that step or longer), got {s.physics_dt}"
             )
         self.terrain = s.terrain
         self.action_mode = s.action_mode

@@ -111,13 +111,10 @@ PAPER_TILT_START = {"LF-LR-RM": 7.0, "LM-RF-RR": 5.0}
 """Time at which the platform starts tilting in Zhang et al. 2024 §5.2 [s] ("from 0 to 7 s is
 the robot status adjustment stage" with legs 1, 3, 5 in stance; 5 s with legs 2, 4, 6)."""
 PAPER_TILT_RATE_DEG = 8.0
-"""Tilt rate of `paper_scenario` [deg/s], in every case. The paper gives none. At 8 deg/s the
-FASM falls at 6.9-8.1 deg/s at the judgment, so eq. 15's adjustment time lies in the paper's
-range (t_s 1.92 s climbing or descending, 1.74 s sideways, against 0.74-2.31 s) and the foot
-lands loaded. Slower tilts leave t_s at its 3 s clamp (2 deg/s) or at the top of the range
-(7 deg/s: 2.26 s); at 9-12 deg/s climbing the judgment comes within 0.6 s of the end of the
-platform's 1 s ramp and the fitted margin acceleration swings (+2.5, -17, +100 deg/s^2): t_s is
-the clamp, or 0.70 s with the foot landing unloaded (docs/reproduction.md)."""
+"""Tilt rate of `paper_scenario` [deg/s], in every case. The paper gives none; this rate makes
+the FASM fall fast enough that eq. 15's adjustment time comes off its clamp and the adjustment
+foot lands loaded (how other rates behave, and why the paper's judgment times and adjustment
+times cannot both be met: docs/reproduction.md)."""
 PAPER_FOOT_Y = 1.9
 """|y| of the stance feet in Zhang et al. 2024 §5.2 [m]: its footholds lie at |y| = 1.89-1.91 m,
 e.g. (-2390, -1908, -1741) mm. The env's default hold posture is narrower (`HOLD_FOOT_Y`) so that

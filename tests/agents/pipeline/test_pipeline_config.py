@@ -390,3 +390,11 @@ def test_zoo_cannot_express_a_linear_schedule_to_a_nonzero_value():
 def test_an_optional_choice_names_null_among_its_choices():
     with pytest.raises(ConfigError, match=r"'forkserver' \| 'spawn' \| 'fork' \| null"):
         load_train_config(CONFIGS / "cliff_walk_ppo.yaml", ["vec_env.start_method=x"])
+
+
+@pytest.mark.parametrize("threads", [1.5, True, -1, "2"])
+def test_physics_threads_must_be_a_whole_number(threads):
+    from agents.run_files.train_config import VecEnvConfig
+
+    with pytest.raises(ValueError, match="vec_env.physics_threads must be an integer >= 0"):
+        VecEnvConfig(physics_threads=threads)

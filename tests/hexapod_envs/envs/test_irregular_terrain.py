@@ -459,3 +459,8 @@ def test_gymnasium_vector_envs_batch_the_infos_of_cycles_out_of_step():
         finished += int(np.sum(infos.get("_cycle_stats", [False, False])))
     envs.close()
     assert finished >= 2
+
+
+def test_a_servo_delay_needs_a_physics_step_its_history_covers():
+    with pytest.raises(ValueError, match=r"servo_delay > 0 needs physics_dt >= 0\.0005"):
+        gym.make("HexapodIrregularTerrain-v0", servo_delay=0.02, physics_dt=0.0001)
