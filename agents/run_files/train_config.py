@@ -353,6 +353,12 @@ class TrainConfig:
                 "so it needs env.decision: step and no hybrid section (both change the action "
                 "between the learner and the env); use env.vectorization: vec_env"
             )
+        if self.env.vectorization == "batched" and self.vec_env.type == "subprocess":
+            raise ValueError(
+                "env.vectorization: batched runs every env in this process (its physics on "
+                "vec_env.physics_threads threads), so vec_env.type: subprocess does not apply; "
+                "set vec_env.type: auto or dummy, or env.vectorization: vec_env"
+            )
         if self.hybrid is not None and self.hybrid.mask_overridden and self.env.decision != "step":
             raise ValueError(
                 "hybrid.mask_overridden needs env.decision: step (one learner step per gait "

@@ -74,6 +74,7 @@ def test_adapter_refuses_envs_that_are_not_hexapod_worlds():
         (["env.vectorization=threads"], "valid: ['vec_env', 'batched']"),
         (["env.vectorization=batched", "vec_env.physics_threads=-1"], "physics_threads"),
         (["env.vectorization=batched", "env.decision=gait_cycle"], "env.decision: step"),
+        (["env.vectorization=batched", "vec_env.type=subprocess"], "does not apply"),
     ],
 )
 def test_the_vectorization_key_is_checked(overrides, message):
