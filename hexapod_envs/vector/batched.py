@@ -65,7 +65,8 @@ class BatchedPhysics:
     reaching it is the one applied: the wrappers between the vector env and the world must pass
     actions through, as `TimeLimit`, `OrderEnforcing` and SB3's `Monitor` do) and its next
     `_simulate` waits for its physics. A world whose step raises leaves no physics running and
-    no replacement behind."""
+    no replacement behind, and every world of that step must be reset before it steps again
+    (some had their physics run without the rest of their step)."""
 
     def __init__(self, worlds: Sequence[gym.Env], nthread: int | None = None):
         self.worlds = list(worlds)
@@ -101,6 +102,8 @@ class BatchedPhysics:
             yield
         except BaseException:
             wait(self._running)  # no world's physics may run on after an error
+            for i in stepping:  # some worlds ran physics without their step's bookkeeping
+                worlds[i]._needs_reset = True
             raise
         finally:
             self._running = []

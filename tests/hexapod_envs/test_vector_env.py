@@ -178,6 +178,8 @@ def test_an_error_in_a_world_s_physics_reaches_the_caller():
     with pytest.raises(FloatingPointError, match="physics failed"):
         envs.step(np.zeros((3, 18), dtype=np.float32))
     assert not any("_simulate" in w.__dict__ or "_apply_action" in w.__dict__ for w in envs.worlds)
+    with pytest.raises(RuntimeError, match="call reset"):  # worlds 0 and 2 ran physics alone
+        envs.step(np.zeros((3, 18), dtype=np.float32))
     envs.reset(seed=1)  # the threads serve the next steps
     observations = envs.step(np.zeros((3, 18), dtype=np.float32))[0]
     assert observations.shape == (3, *envs.single_observation_space.shape)
