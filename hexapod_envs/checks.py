@@ -14,15 +14,17 @@ import numbers
 from typing import Any
 
 
-def check_number(name: str, value: float, *, low: float = 0.0, strict: bool = False) -> float:
-    """`value` as a float if it is finite and >= `low` (> `low` with `strict`); otherwise a
-    ValueError that names the argument and the valid range."""
+def check_number(
+    name: str, value: float, *, low: float = 0.0, high: float | None = None, strict: bool = False
+) -> float:
+    """`value` as a float if it is finite, >= `low` (> `low` with `strict`) and <= `high` (if
+    given); otherwise a ValueError that names the argument and the valid range."""
     try:
         x = float(value)
     except (TypeError, ValueError):
         x = math.nan
-    if not (math.isfinite(x) and within(x, low, None, strict)):
-        bound = range_text(low, None, strict)
+    if not (math.isfinite(x) and within(x, low, high, strict)):
+        bound = range_text(low, high, strict)
         raise ValueError(f"{name} must be a finite number {bound}, got {value!r}")
     return x
 

@@ -48,9 +48,8 @@ class DifficultyCurriculum(gym.Wrapper):
                 "DifficultyCurriculum draws sampled tasks: make the env with "
                 'task_distribution="train" (or "test"), not "paper"'
             )
-        for name, value in (("level", level), ("step", step)):
-            if not 0.0 <= check_number(name, value) <= 1.0:
-                raise ValueError(f"{name} must be in [0, 1], got {value!r}")
+        check_number("level", level, high=1.0)
+        check_number("step", step, high=1.0)
         if not 0.0 <= check_number("demote_at", demote_at) < promote_at <= 1.0:
             raise ValueError(
                 f"need 0 <= demote_at < promote_at <= 1, got {demote_at!r}, {promote_at!r}"

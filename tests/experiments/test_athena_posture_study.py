@@ -11,6 +11,10 @@ former 2 ms step +45 %, +34 %); the ZMP margin is higher with posture control. T
 are not asserted: on 20 beds they are -8.0 % [-37.1, +51.2] and -21.7 % [-33.6, +19.4] (95 %
 bootstrap intervals over the beds), i.e. their sign is not settled on this bed (reproduction
 rows 11b/11c@seeds 0-19).
+
+These are the -v0 defaults' results. On the calibrated robot model (`CALIBRATED_MODEL`, which the
+reproduction uses) the ramp's roll rate falls by 51 % and the block-bed rates rise on seeds 0-3;
+tests/experiments/test_headline_rows.py asserts those.
 """
 
 import json
