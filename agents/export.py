@@ -74,8 +74,13 @@ def default_output(files: ModelFiles, env_id: str) -> Path:
 # --- the graph -----------------------------------------------------------------------------
 def actor_module(model: Any, stats: NormalizationStats | None) -> Any:
     """A torch module: raw observation (float64) -> the deterministic action of `model`'s actor
-    (float32), with `stats`' normalisation in front and the action-space clip behind."""
+    (float32), with `stats`' normalisation in front and the action-space clip behind. The actor
+    of an asymmetric actor-critic (`agents.privileged_critic`) takes the sensor observation: the
+    privileged values its actor ignores are set to 0 inside the graph."""
     import torch
+
+    from .privileged_critic import PRIVILEGED_DIM
+    from .privileged_critic_policy import SensorOnly
 
     policy = model.policy
     if getattr(policy, "squash_output", False) or not hasattr(policy, "action_net"):
@@ -99,9 +104,13 @@ def actor_module(model: Any, stats: NormalizationStats | None) -> Any:
                 self.clip = float(stats.clip_obs)
             self.register_buffer("low", torch.as_tensor(space.low, dtype=torch.float32))
             self.register_buffer("high", torch.as_tensor(space.high, dtype=torch.float32))
+            self.padding = PRIVILEGED_DIM if isinstance(self.features, SensorOnly) else 0
 
         def forward(self, observation):
             x = observation
+            if self.padding:
+                zeros = torch.zeros_like(x[:, :1]).expand(-1, self.padding)
+                x = torch.cat([x, zeros], dim=1)
             if self.normalize:
                 x = torch.clamp((x - self.mean) / self.std, -self.clip, self.clip)
             x = x.to(torch.float32)

@@ -18,6 +18,7 @@ import numpy as np
 
 from .hybrid import from_run_config
 from .policy import Policy
+from .privileged_critic import PrivilegedObservation, pad_observation
 from .run_files.artifacts import ModelFiles, find_model, other_env_error, read_meta
 from .run_files.errors import UserError
 from .run_files.model_files import NormalizationStats, load_ppo, load_stats, ppo_custom_objects
@@ -34,10 +35,15 @@ class PPOPolicy:
         files: ModelFiles | None = None,
         deterministic: bool = True,
         train_env_kwargs: dict[str, Any] | None = None,
+        privileged_critic: bool = False,
     ):
         self.model, self.stats, self.files = model, stats, files
         self.deterministic = deterministic
         self.train_env_kwargs = dict(train_env_kwargs or {})
+        self.privileged_critic = privileged_critic
+        """The model's observation ends with the critic's privileged values
+        (`agents.privileged_critic`): the sensor observation is padded with zeros, which its
+        actor ignores."""
 
     @classmethod
     def load(
@@ -63,9 +69,14 @@ class PPOPolicy:
         trained_for = (config.get("env") or {}).get("id")
         if trained_for != env_id:
             raise other_env_error(files, trained_for, env_id)
+        train_config = load_train_config(data=config)
+        privileged = train_config.policy.critic_privileged
+        observation_space = env.observation_space
+        if privileged:
+            observation_space = PrivilegedObservation(env, 1).observation_space
         meta = read_meta(files.directory)
         for what, key, env_space in (
-            ("observation", "observation_shape", env.observation_space),
+            ("observation", "observation_shape", observation_space),
             ("action", "action_shape", env.action_space),
         ):
             if key in meta and tuple(meta[key]) != env_space.shape:
@@ -73,17 +84,18 @@ class PPOPolicy:
                     f"the model at {files.model} expects {what} shape {tuple(meta[key])}, "
                     f"but {env_id} (with these kwargs) has {env_space.shape}"
                 )
-        train_config = load_train_config(data=config)
         policy_kwargs = train_config.policy.policy_kwargs()
         action_space = env.action_space
         if config.get("hybrid") is not None:  # the learned action of a hybrid lies in [-1, 1]
             shape, dtype = env.action_space.shape, env.action_space.dtype
             action_space = gym.spaces.Box(-1.0, 1.0, shape=shape, dtype=dtype)
-        objects = ppo_custom_objects(policy_kwargs, env.observation_space, action_space)
+        objects = ppo_custom_objects(
+            policy_kwargs, observation_space, action_space, privileged_critic=privileged
+        )
         model = load_ppo(files.model, objects, trust_pickle, device=device)
         stats = load_stats(files.directory, trust_pickle, train_config.normalize.observation)
         train_kwargs = (config.get("env") or {}).get("kwargs") or {}
-        policy = cls(model, stats, files, deterministic, train_kwargs)
+        policy = cls(model, stats, files, deterministic, train_kwargs, privileged)
         return _as_trained(policy, env, config)
 
     def reset(self) -> None:
@@ -95,6 +107,8 @@ class PPOPolicy:
             raise UserError(
                 f"observation of dtype {obs.dtype} given to a PPO policy; expected real numbers"
             )
+        if self.privileged_critic:
+            obs = pad_observation(obs)
         if self.stats is not None:
             obs = self.stats.normalize_obs(obs)
         action, _ = self.model.predict(obs, deterministic=self.deterministic)

@@ -80,6 +80,9 @@ class EnvSpec:
     cycle_baseline: str = "none"
     """With decision "gait_cycle": "zero_action" rewards each cycle relative to the zero action
     replayed from the same state (`GainsPerCycle`'s ``baseline_action``); "none": plain."""
+    privileged_critic: bool = False
+    """Append the task and the episode's elapsed share to the observation for an asymmetric
+    critic (`agents.privileged_critic.PrivilegedObservation`, the innermost wrapper)."""
 
     def make(self, **extra: Any) -> gym.Env:
         """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
@@ -94,6 +97,10 @@ class EnvSpec:
         except (TypeError, ValueError) as exc:
             message = str(exc).split(" was raised from the environment creator")[0]
             raise UserError(f"cannot create {self.id} with {self.kwargs}: {message}") from None
+        if self.privileged_critic:
+            from ..privileged_critic import PrivilegedObservation
+
+            env = PrivilegedObservation(env, env.spec.max_episode_steps)
         if self.hybrid is not None:
             try:
                 env = wrap(env, self.hybrid)

@@ -49,6 +49,7 @@ from ..run_files.model_files import (
     atomic_write_text,
     load_ppo,
     load_stats,
+    policy_class,
     ppo_custom_objects,
 )
 from ..run_files.train_config import TrainConfig, load_train_config
@@ -93,6 +94,7 @@ def env_spec(config: TrainConfig) -> EnvSpec:
         list(env.reward_exclude),
         env.decision,
         env.cycle_baseline,
+        config.policy.critic_privileged,
     )
 
 
@@ -182,7 +184,7 @@ def new_model(config: TrainConfig, venv: Any) -> Any:
     from stable_baselines3 import PPO
 
     model = PPO(
-        "MlpPolicy",
+        policy_class(config.policy.critic_privileged),
         venv,
         policy_kwargs=config.policy.policy_kwargs(),
         seed=config.train.seed,
@@ -353,6 +355,7 @@ def _load_checkpoint(
         learning_rate=ppo.learning_rate,
         clip_range=ppo.clip_range,
         clip_range_vf=ppo.clip_range_vf,
+        privileged_critic=config.policy.critic_privileged,
     )
     try:
         model = load_ppo(

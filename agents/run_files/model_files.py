@@ -235,6 +235,18 @@ def pickled_entries(model_zip: str | Path) -> list[str]:
     return sorted(k for k, v in data.items() if isinstance(v, dict) and ":serialized:" in v)
 
 
+def policy_class(privileged_critic: bool = False) -> Any:
+    """The SB3 policy class of a run: ``MlpPolicy``, or with ``policy.critic_privileged`` the
+    asymmetric `agents.privileged_critic_policy.PrivilegedCriticPolicy`."""
+    if privileged_critic:
+        from ..privileged_critic_policy import PrivilegedCriticPolicy
+
+        return PrivilegedCriticPolicy
+    from stable_baselines3 import PPO
+
+    return PPO.policy_aliases["MlpPolicy"]
+
+
 def ppo_custom_objects(
     policy_kwargs: dict[str, Any],
     observation_space: Any,
@@ -242,15 +254,14 @@ def ppo_custom_objects(
     learning_rate: Any = 0.0,
     clip_range: Any = 0.0,
     clip_range_vf: Any = None,
+    privileged_critic: bool = False,
 ) -> dict[str, Any]:
     """Objects that replace every pickled entry of a PPO zip (see `_REBUILT_ENTRIES`).
 
     Inference needs no schedules (0.0); resuming passes the config's learning-rate and clip
-    schedules. The policy class is SB3's ``MlpPolicy`` (what `training` trains)."""
-    from stable_baselines3 import PPO
-
+    schedules. The policy class is the one `training` trains (`policy_class`)."""
     return {
-        "policy_class": PPO.policy_aliases["MlpPolicy"],
+        "policy_class": policy_class(privileged_critic),
         "policy_kwargs": dict(policy_kwargs),
         "observation_space": observation_space,
         "action_space": action_space,

@@ -140,6 +140,10 @@ class PolicyConfig:
     """Zero the last layer of the action mean, so that training starts at the zero action (in a
     residual action mode: the reference motion) instead of a random one. A hybrid run's
     ``hybrid.zero_init_action_net`` does the same (default there: true)."""
+    critic_privileged: bool = False
+    """An asymmetric actor-critic: the value function also sees the task's parameters and the
+    elapsed share of the episode (`agents.privileged_critic`); the actor still sees only the
+    sensor observation."""
 
     def __post_init__(self):
         for name in ("pi", "vf"):
@@ -352,6 +356,11 @@ class TrainConfig:
                 "env.vectorization: batched applies the learner's action before each env steps, "
                 "so it needs env.decision: step and no hybrid section (both change the action "
                 "between the learner and the env); use env.vectorization: vec_env"
+            )
+        if self.env.vectorization == "batched" and self.policy.critic_privileged:
+            raise ValueError(
+                "policy.critic_privileged appends the task to each env's observation, which "
+                "env.vectorization: batched does not do; use env.vectorization: vec_env"
             )
         if self.env.vectorization == "batched" and self.vec_env.type == "subprocess":
             raise ValueError(
