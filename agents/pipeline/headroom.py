@@ -7,8 +7,10 @@ controller produced on the next task) and a search over constant actions (fixed 
 every entry at one bound, the mean of the analytical controller's actions, and seeded random
 vectors), and reports
 per policy the success rate, tip-overs, the median of the episodes' largest tilt and of their
-share of time tipping. docs/benchmark.md states the targets: the analytical controller succeeds
-on 40-85 % of the test tasks, the zero action on at most 40 %, random actions on at most 10 %,
+share of time tipping, and the mean return (the env's reward summed over the episode: a reward
+that ranks policies as success does gives the analytical controller the highest).
+docs/benchmark.md states the targets: the analytical controller succeeds on 40-85 % of the
+test tasks, the zero action on at most 40 %, random actions on at most 10 %,
 and neither the open-loop replay nor any constant action reaches the analytical controller.
 
 `scripts/benchmark_headroom.py` prints the table for every ``-v1`` env; the tests run it on a few
@@ -39,6 +41,8 @@ class Episode:
     max_tilt_deg: float
     tipping_share: float
     difficulty: float
+    episode_return: float
+    """The env's reward summed over the episode."""
 
 
 @dataclass
@@ -55,6 +59,10 @@ class Baseline:
     @property
     def tip_over_rate(self) -> float:
         return float(np.mean([e.tipped_over for e in self.episodes]))
+
+    @property
+    def mean_return(self) -> float:
+        return float(np.mean([e.episode_return for e in self.episodes]))
 
     def median(self, figure: str) -> float:
         return float(np.median([getattr(e, figure) for e in self.episodes]))
@@ -117,6 +125,7 @@ def run_baseline(
 ) -> Baseline:
     """Episodes of `make_policy(env)` from ``reset(seed=s)`` for s in `seeds`."""
     env = gym.make(env_id, task_distribution=distribution, **(env_kwargs or {}))
+    env = gym.wrappers.RecordEpisodeStatistics(env)  # the return, in the last info's "episode"
     policy, result = make_policy(env), Baseline(name)
     try:
         for seed in seeds:
@@ -131,6 +140,7 @@ def run_baseline(
                     max_tilt_deg=float(info[keys.MAX_TILT_DEG]),
                     tipping_share=float(info[keys.TIPPING_SHARE]),
                     difficulty=float(info[keys.TASK].get("difficulty", np.nan)),
+                    episode_return=float(info["episode"]["r"]),
                 )
             )
     finally:
@@ -194,16 +204,19 @@ def _constant(action: np.ndarray) -> Callable[[gym.Env], Policy]:
 
 
 def format_table(env_id: str, rows: list[Baseline]) -> str:
-    """A Markdown table: policy, success, tip-overs, median max tilt, median share tipping."""
+    """A Markdown table: policy, success, tip-overs, median max tilt, median share tipping, mean
+    return."""
     lines = [
         f"### {env_id} ({len(rows[0].episodes)} test tasks)",
         "",
-        "| policy | success | tip-over | max tilt, median [deg] | time tipping, median |",
-        "|---|---|---|---|---|",
+        "| policy | success | tip-over | max tilt, median [deg] | time tipping, median "
+        "| return, mean |",
+        "|---|---|---|---|---|---|",
     ]
     for row in rows:
         lines.append(
             f"| {row.name} | {row.success_rate:.0%} | {row.tip_over_rate:.0%} | "
-            f"{row.median('max_tilt_deg'):.1f} | {row.median('tipping_share'):.0%} |"
+            f"{row.median('max_tilt_deg'):.1f} | {row.median('tipping_share'):.0%} | "
+            f"{row.mean_return:.0f} |"
         )
     return "\n".join(lines)
