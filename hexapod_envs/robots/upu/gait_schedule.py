@@ -170,23 +170,15 @@ class GaitSchedule:
         level = {"upper": float(current[3]), "lower": 0.0}
         lo, hi = params.extension_range
         if plan.ok:
+            transfers = _transfer_limbs(plan.steps, params, ticks[PHASES.index("transfer")])
             for k, step in enumerate(plan.steps):
                 legs = PLATFORM_LEGS[step.moving]
                 cols = [_LEG_INDEX[leg] for leg in legs]
                 start_ext = current[cols].copy()
                 swing = np.full(3, step.swing_extension)
                 unloaded = np.maximum(start_ext - self.timing.unload_retract, swing)
-                poses = raise_to_limb_min(
-                    _transfer_poses(step, params, ticks[PHASES.index("transfer")]),
-                    params,
-                    step.moving,
-                )
-                limbs = np.clip(
-                    inverse_kinematics(poses, params, moving=step.moving),
-                    params.limb_min,
-                    params.limb_max,
-                )
-                rise = abs(float(poses[-1, 2])) - params.initial_height
+                limbs, end_z = transfers[k]
+                rise = abs(end_z) - params.initial_height
                 other = "lower" if step.moving == "upper" else "upper"
                 level[step.moving] = level[other] + (rise if step.moving == "upper" else -rise)
                 landing = np.clip(
@@ -256,12 +248,36 @@ class GaitSchedule:
         return self.plan.steps[step].support
 
 
-def _transfer_poses(step, params: UpuParams, n: int) -> np.ndarray:
-    """(n, 3) relative poses of the moving platform along its path (eqs. 19-21), quintic in x,
-    shifted from the paper's height to `walking_height` [m]."""
-    path = step.path(params)
-    a = quintic(np.arange(1, n + 1) / n)
-    x = path.x_start + (path.x_end - path.x_start) * a
+def _transfer_poses(steps, params: UpuParams, n: int) -> np.ndarray:
+    """(len(steps), n, 3) relative poses of the moving platforms along their paths (eqs.
+    19-21), quintic in x, shifted from the paper's height to `walking_height` [m]. The steps
+    must move the same platform."""
+    paths = [step.path(params) for step in steps]
+    column = np.array  # one row per step, broadcast against the n ticks
+    x_start, x_end = column([[p.x_start] for p in paths]), column([[p.x_end] for p in paths])
+    a, b, c = (column([[getattr(p, name)] for p in paths]) for name in ("a", "b", "c"))
+    x = x_start + (x_end - x_start) * quintic(np.arange(1, n + 1) / n)
     shift = walking_height(params) - params.initial_height
-    z = path.z(x) + (shift if step.moving == "upper" else -shift)
-    return np.column_stack([x, np.zeros(n), z])
+    z = a * x**2 + b * x + c + (shift if steps[0].moving == "upper" else -shift)
+    return np.stack([x, np.zeros_like(x), z], axis=-1)
+
+
+def _transfer_limbs(steps, params: UpuParams, n: int) -> list[tuple[np.ndarray, float]]:
+    """Per step, the (n, 3) limb lengths of its transfer phase [m] (poses raised to l_min,
+    lengths clipped to the limbs' range) and the final relative height of the moving platform
+    [m]. Computed for all steps of each moving platform at once: the same numbers as step by
+    step, since every operation is elementwise or over the last axis."""
+    found: list[tuple[np.ndarray, float]] = [None] * len(steps)  # type: ignore[list-item]
+    for moving in ("upper", "lower"):
+        which = [k for k, step in enumerate(steps) if step.moving == moving]
+        if not which:
+            continue
+        poses = raise_to_limb_min(
+            _transfer_poses([steps[k] for k in which], params, n), params, moving
+        )
+        limbs = np.clip(
+            inverse_kinematics(poses, params, moving=moving), params.limb_min, params.limb_max
+        )
+        for j, k in enumerate(which):
+            found[k] = (limbs[j], float(poses[j, -1, 2]))
+    return found
