@@ -1,0 +1,1 @@
+"""Behaviour cloning of the analytical controllers, a candidate warm start for PPO (README.md)."""

@@ -1,0 +1,131 @@
+"""Can an MLP actor copy the analytical controller from the sensor observation? (BC + DAgger)
+
+Kick-starting PPO from the reference (issue "agents that learn", item 2) needs an actor that
+already acts like the analytical controller. This clones the controller of a ``-v1`` env into
+an MLP of the shipped PPO configs' shape (2 x 256 tanh, inputs standardised), in the action mode
+in which the controller runs (`agents.registry.ANALYTICAL_ENV_KWARGS`):
+
+1. round 0: the controller drives `episodes` training tasks; every (observation, action) is kept;
+2. rounds 1..`rounds` (DAgger, Ross et al. 2011): the clone drives, the controller (stepped on
+   every observation, so its gait clock, judgment and plan follow the episode) labels each step;
+3. after each round the MLP is fitted on all pairs (Adam, mean squared error, Gaussian noise of
+   `noise` standard deviations on the standardised inputs against over-fitting to them);
+4. the clone and the controller run the first `tests` benchmark test tasks.
+
+    python experiments/behaviour_cloning/clone.py HexapodCliffWalk-v1
+    python experiments/behaviour_cloning/clone.py HexapodStewartTilt-v1 --episodes 8 --rounds 2
+
+Prints the fit per round and one line per test task (success, distance [m], largest tilt [deg],
+share of time tipping) for the clone and the controller. Findings: README.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+import gymnasium as gym
+import numpy as np
+import torch
+
+import hexapod_envs  # noqa: F401  (registers the ids)
+from agents.registry import ANALYTICAL_ENV_KWARGS, analytical_factory
+from hexapod_envs import info_keys as keys
+
+
+class Clone:
+    """The MLP and the input standardisation of the data it was fitted on."""
+
+    def __init__(self, n_obs: int, n_act: int, seed: int):
+        torch.manual_seed(seed)
+        layers = [torch.nn.Linear(n_obs, 256), torch.nn.Tanh(), torch.nn.Linear(256, 256)]
+        self.net = torch.nn.Sequential(*layers, torch.nn.Tanh(), torch.nn.Linear(256, n_act))
+        self.mean, self.std = np.zeros(n_obs), np.ones(n_obs)
+
+    def fit(self, x: np.ndarray, y: np.ndarray, epochs: int, noise: float) -> float:
+        """Fit on all pairs; the last epoch's mean squared error (in action units²)."""
+        self.mean, self.std = x.mean(axis=0), x.std(axis=0) + 1e-3
+        xt = torch.as_tensor((x - self.mean) / self.std, dtype=torch.float32)
+        yt = torch.as_tensor(y, dtype=torch.float32)
+        optimiser = torch.optim.Adam(self.net.parameters(), lr=1e-3)
+        for _ in range(epochs):
+            losses = []
+            for batch in torch.randperm(len(xt)).split(256):
+                inputs = xt[batch] + noise * torch.randn_like(xt[batch])
+                loss = ((self.net(inputs) - yt[batch]) ** 2).mean()
+                optimiser.zero_grad()
+                loss.backward()
+                optimiser.step()
+                losses.append(loss.item())
+        return float(np.mean(losses))
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        z = torch.as_tensor(((observation - self.mean) / self.std)[None], dtype=torch.float32)
+        with torch.no_grad():
+            return np.clip(self.net(z)[0].numpy(), -1.0, 1.0)
+
+
+def episode(env, expert, seed: int, clone: Clone | None, pairs: list | None) -> dict:
+    """One episode from ``reset(seed)``: the clone acts (the controller if None); the
+    controller labels every step into `pairs` (if given). The last step's info."""
+    obs, info = env.reset(seed=seed)
+    expert.reset()
+    done = False
+    while not done:
+        label = np.asarray(expert(obs))
+        if pairs is not None:
+            pairs.append((obs.copy(), np.clip(label, -1.0, 1.0)))
+        action = label if clone is None else clone(obs)
+        obs, _, terminated, truncated, info = env.step(action)
+        done = terminated or truncated
+    return info
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("env_id")
+    parser.add_argument("--episodes", type=int, default=8, help="training tasks per round")
+    parser.add_argument("--rounds", type=int, default=2, help="DAgger rounds after round 0")
+    parser.add_argument("--epochs", type=int, default=60)
+    parser.add_argument("--noise", type=float, default=0.1)
+    parser.add_argument("--tests", type=int, default=10, help="benchmark test tasks")
+    parser.add_argument("--seed", type=int, default=0)
+    args = parser.parse_args()
+    kwargs = ANALYTICAL_ENV_KWARGS.get(args.env_id, {})
+    make = analytical_factory(args.env_id)
+    train = gym.make(args.env_id, task_distribution="train", **kwargs)
+    expert = make(train)
+    clone = Clone(train.observation_space.shape[0], train.action_space.shape[0], args.seed)
+    pairs: list = []
+    start = time.perf_counter()
+    for round_ in range(args.rounds + 1):
+        for k in range(args.episodes):
+            episode(train, expert, 1000 * round_ + k, clone if round_ else None, pairs)
+        x, y = (np.array(v) for v in zip(*pairs, strict=True))
+        loss = clone.fit(x, y, args.epochs, args.noise)
+        print(
+            f"round {round_}: {len(x)} pairs, fit MSE {loss:.5f}, "
+            f"{time.perf_counter() - start:.0f} s",
+            flush=True,
+        )
+    test = gym.make(args.env_id, task_distribution="test", **kwargs)
+    test_expert = make(test)  # a controller reads its own env's task (the ditch planner)
+    wins = {"clone": 0, "controller": 0}
+    for seed in range(args.tests):
+        line = [f"task {seed}"]
+        for name, actor in (("clone", clone), ("controller", None)):
+            info = episode(test, test_expert, seed, actor, None)
+            wins[name] += bool(info[keys.IS_SUCCESS])
+            line.append(
+                f"{name} {bool(info[keys.IS_SUCCESS])} {info.get('distance', np.nan):.2f} m "
+                f"{info[keys.MAX_TILT_DEG]:.1f} deg {info[keys.TIPPING_SHARE]:.2f}"
+            )
+        print(" | ".join(line), flush=True)
+    print(
+        f"success on {args.tests} test tasks: clone {wins['clone']}, "
+        f"controller {wins['controller']}"
+    )
+
+
+if __name__ == "__main__":
+    main()
