@@ -18,7 +18,7 @@ import numpy as np
 
 from .hybrid import from_run_config
 from .policy import Policy
-from .privileged_critic import PrivilegedObservation, pad_observation
+from .privileged_critic import pad_observation, privileged_space
 from .run_files.artifacts import ModelFiles, find_model, other_env_error, read_meta
 from .run_files.errors import UserError
 from .run_files.model_files import NormalizationStats, load_ppo, load_stats, ppo_custom_objects
@@ -73,7 +73,7 @@ class PPOPolicy:
         privileged = train_config.policy.critic_privileged
         observation_space = env.observation_space
         if privileged:
-            observation_space = PrivilegedObservation(env, 1).observation_space
+            observation_space = privileged_space(observation_space)
         meta = read_meta(files.directory)
         for what, key, env_space in (
             ("observation", "observation_shape", observation_space),

@@ -53,6 +53,16 @@ def task_vector(task: dict[str, Any], keys: list[str]) -> np.ndarray:
     return vector
 
 
+def privileged_space(space: gym.spaces.Space) -> gym.spaces.Box:
+    """The observation space of `PrivilegedObservation` around an env with `space` (a flat
+    Box; ValueError otherwise)."""
+    if not isinstance(space, gym.spaces.Box) or len(space.shape) != 1:
+        raise ValueError(f"the privileged critic needs a flat Box observation, got {space}")
+    low = np.concatenate([space.low, np.full(PRIVILEGED_DIM, -np.inf)])
+    high = np.concatenate([space.high, np.full(PRIVILEGED_DIM, np.inf)])
+    return gym.spaces.Box(low, high, dtype=space.dtype)
+
+
 class PrivilegedObservation(gym.Wrapper):
     """The env's observation with `PRIVILEGED_DIM` values appended for the critic: the task's
     parameters (``info["task"]`` at reset, its keys in the sorted order of the first reset) and
@@ -70,13 +80,8 @@ class PrivilegedObservation(gym.Wrapper):
                 f"the privileged critic needs the episode's time limit in steps, got "
                 f"{max_episode_steps!r}"
             )
-        space = env.observation_space
-        if not isinstance(space, gym.spaces.Box) or len(space.shape) != 1:
-            raise ValueError(f"the privileged critic needs a flat Box observation, got {space}")
+        self.observation_space = privileged_space(env.observation_space)
         self.max_episode_steps = int(max_episode_steps)
-        low = np.concatenate([space.low, np.full(PRIVILEGED_DIM, -np.inf)])
-        high = np.concatenate([space.high, np.full(PRIVILEGED_DIM, np.inf)])
-        self.observation_space = gym.spaces.Box(low, high, dtype=space.dtype)
         self.task_keys: list[str] | None = None
         self._task = np.zeros(TASK_SLOTS)
         self._steps = 0
