@@ -5,13 +5,12 @@ the analytical controller, the zero action (the paper's motion without feedback)
 random actions, an open-loop replay of the controller's actions (each task gets the sequence the
 controller produced on the next task) and a search over constant actions (fixed action vectors:
 every entry at one bound, the mean of the analytical controller's actions, and seeded random
-vectors), and reports
-per policy the success rate, tip-overs, the median of the episodes' largest tilt and of their
-share of time tipping, and the mean return (the env's reward summed over the episode: a reward
-that ranks policies as success does gives the analytical controller the highest).
-docs/benchmark.md states the targets: the analytical controller succeeds on 40-85 % of the
-test tasks, the zero action on at most 40 %, random actions on at most 10 %,
-and neither the open-loop replay nor any constant action reaches the analytical controller.
+vectors), and reports per policy the success rate, tip-overs, the median of the episodes'
+largest tilt and of their share of time tipping, and the mean return (the env's reward summed
+over the episode: a reward that ranks policies as success does gives the analytical controller
+the highest). docs/benchmark.md states the targets: the analytical controller succeeds on
+40-85 % of the test tasks, the zero action on at most 40 %, random actions on at most 10 %, and
+neither the open-loop replay nor any constant action reaches the analytical controller.
 
 `scripts/benchmark_headroom.py` prints the table for every ``-v1`` env; the tests run it on a few
 tasks.

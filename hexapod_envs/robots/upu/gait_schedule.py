@@ -250,12 +250,14 @@ class GaitSchedule:
 
 def _transfer_poses(steps, params: UpuParams, n: int) -> np.ndarray:
     """(len(steps), n, 3) relative poses of the moving platforms along their paths (eqs.
-    19-21), quintic in x, shifted from the paper's height to `walking_height` [m]. The steps
-    must move the same platform."""
+    19-21, `QuadraticPath.z` for all steps at once), quintic in x, shifted from the paper's
+    height to `walking_height` [m]. The steps must move the same platform."""
     paths = [step.path(params) for step in steps]
-    column = np.array  # one row per step, broadcast against the n ticks
-    x_start, x_end = column([[p.x_start] for p in paths]), column([[p.x_end] for p in paths])
-    a, b, c = (column([[getattr(p, name)] for p in paths]) for name in ("a", "b", "c"))
+
+    def per_step(name: str) -> np.ndarray:  # (len(steps), 1): broadcasts against the n ticks
+        return np.array([[getattr(path, name)] for path in paths])
+
+    x_start, x_end, a, b, c = map(per_step, ("x_start", "x_end", "a", "b", "c"))
     x = x_start + (x_end - x_start) * quintic(np.arange(1, n + 1) / n)
     shift = walking_height(params) - params.initial_height
     z = a * x**2 + b * x + c + (shift if steps[0].moving == "upper" else -shift)
