@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from agents.pipeline.learning_curve import load_learning_curve
+from agents.pipeline.learning_curve import LearningCurve, load_learning_curve
 
 
 @dataclass
@@ -57,7 +57,7 @@ def tb_scalars(run_dir: Path, tag: str) -> list[tuple[int, float, float]]:
     return sorted(rows)
 
 
-def _env_steps_per_learner_step(run_dir: Path, step: int, curve) -> float:
+def _env_steps_per_learner_step(run_dir: Path, step: int, curve: LearningCurve) -> float:
     """1, or for a gait-cycle run the env steps per cycle measured near `step` (module doc)."""
     if curve.unit != "gait cycles":
         return 1.0
@@ -81,12 +81,10 @@ def time_to_beat(run_dir: str | Path, reference: float | None = None) -> TimeToB
     if above.size == 0:
         return result
     step = int(curve.timesteps[above[0]])
-    evals = tb_scalars(run_dir, "eval/success_rate")
-    wall = {s: t for s, t, _ in evals}
-    start = wall.get(0, evals[0][1] if evals else None)
+    wall = {s: t for s, t, _ in tb_scalars(run_dir, "eval/success_rate")}
     result.beat_learner_steps = step
     result.beat_env_steps = step * _env_steps_per_learner_step(run_dir, step, curve)
-    result.beat_wall_s = None if step not in wall or start is None else wall[step] - start
+    result.beat_wall_s = wall[step] - wall[0] if {0, step} <= wall.keys() else None
     return result
 
 
