@@ -79,3 +79,70 @@ def _static_margin(soles, loaded, px, py):
             hull = np.array((0, 1, 2)) if area2 > 0 else np.array((0, 2, 1))
             return signed_distance_2d(xs, ys, hull, px, py)
     return hull_distance(xs, ys, px, py)
+
+
+@njit(cache=True)
+def fewest_steps(upper_targets, lower_targets, ok_upper, ok_lower, n_x, n_goal):
+    """Breadth-first search of the ditch planner (`gait_plan._fewest_steps`), one state at a time.
+
+    A state is (mover, i, j): the platform that moves next (0 upper, 1 lower), the lower
+    centre's grid index i < n_x and the upper centre's offset j = x_upper - x_lower in grid
+    cells. From the start (0, 0, 0) it tries each state's moves in the order of the target
+    tables (longest first), marks a state when it is first reached and stops at the first
+    state reached with j = 0 and i >= n_goal.
+
+    Args:
+        upper_targets, lower_targets: (n_d + 1, k) int64, the offsets j1 reachable from each j
+            by a step of that platform, in the search's order, padded with -1.
+        ok_upper, ok_lower: (n_x + n_d + 1,) bool, a platform centred at that grid index has
+            every foot on ground it may land on.
+
+    Returns:
+        (m, 3) int64: the states (i, j, mover) from the start to the goal; (0, 3) if none.
+    """
+    width = upper_targets.shape[0]
+    plane = n_x * width
+    parent = np.full(2 * plane, -1, dtype=np.int64)
+    queue = np.empty(2 * plane, dtype=np.int64)
+    queue[0] = 0
+    parent[0] = 0
+    head, tail = 0, 1
+    while head < tail:
+        state = queue[head]
+        head += 1
+        mover, rest = state // plane, state % plane
+        i, j = rest // width, rest % width
+        targets = upper_targets if mover == 0 else lower_targets
+        for k in range(targets.shape[1]):
+            j1 = targets[j, k]
+            if j1 < 0:
+                continue
+            if mover == 0:
+                i1 = i
+                if not ok_upper[i + j1]:
+                    continue
+            else:
+                i1 = i + j - j1
+                if i1 >= n_x or not ok_lower[i1]:
+                    continue
+            reached = (1 - mover) * plane + i1 * width + j1
+            if parent[reached] >= 0:
+                continue
+            parent[reached] = state
+            queue[tail] = reached
+            tail += 1
+            if j1 == 0 and i1 >= n_goal:
+                count = 1
+                s = reached
+                while s != 0:
+                    s = parent[s]
+                    count += 1
+                chain = np.empty((count, 3), dtype=np.int64)
+                s = reached
+                for c in range(count - 1, -1, -1):
+                    chain[c, 0] = (s % plane) // width
+                    chain[c, 1] = (s % plane) % width
+                    chain[c, 2] = s // plane
+                    s = parent[s]
+                return chain
+    return np.empty((0, 3), dtype=np.int64)

@@ -31,6 +31,7 @@ import numpy as np
 
 from ...checks import check_number
 from ...stability import static_stability_margin
+from ._compiled import fewest_steps
 from .kinematics import inside_limits, inverse_kinematics
 from .params import PLATFORM_LEGS, UpuParams, check_platform
 
@@ -602,69 +603,26 @@ def _fewest_steps(crossing: _Crossing) -> list[tuple[int, int, str]] | None:
     mover), starting standing with the upper platform first: the chain of states from the
     start to the first goal found, or None.
 
-    It runs level by level (a level's states all share the mover, which alternates) with numpy,
-    and keeps a FIFO queue's order exactly: the next level is ordered by first discovery, and a
-    state's parent is the first state of the level (in that order) that reaches it, trying its
-    moves longest first. So the plan equals the one a one-state-at-a-time search finds.
+    A FIFO search that tries each state's moves longest first, so among the plans with the
+    fewest steps it returns the one with the longest early steps. Compiled
+    (`_compiled.fewest_steps`): a sampled ditch needs its own plan at every reset.
     """
-    n_d, n_x = crossing.n_d, crossing.n_x
-    moves = _relative_moves(crossing.params, crossing.settings, n_d)
-    ok = {
-        "upper": crossing.footholds_ok(crossing.upper_offsets),
-        "lower": crossing.footholds_ok(crossing.lower_offsets),
-    }
-    width = n_d + 1
-    seen = np.zeros((2, n_x * width), dtype=bool)  # [mover is lower, state]
-    earliest = np.empty(n_x * width, dtype=np.int64)  # per state: its first position in a level
-    frontier_i, frontier_j = np.zeros(1, dtype=np.int64), np.zeros(1, dtype=np.int64)
-    seen[0, 0] = True
-    levels = []  # per level: (i, j, parent position in the previous level)
-    mover = "upper"
-    while frontier_i.size:
-        if mover == "upper":
-            targets = moves.upper_targets[frontier_j]  # (k, m), -1 padded
-            i_new = np.broadcast_to(frontier_i[:, None], targets.shape)
-            j_new = targets
-            valid = (targets >= 0) & ok["upper"][frontier_i[:, None] + np.maximum(targets, 0)]
-        else:
-            targets = moves.lower_targets[frontier_j]
-            step = frontier_j[:, None] - targets
-            i_new = frontier_i[:, None] + step
-            j_new = targets
-            valid = (targets >= 0) & (i_new < n_x)
-            valid &= ok["lower"][np.where(valid, i_new, 0)]
-        source = np.broadcast_to(np.arange(frontier_i.size)[:, None], targets.shape)[valid]
-        i_new, j_new = i_new[valid], j_new[valid]
-        index = i_new * width + j_new
-        next_mover = 1 if mover == "upper" else 0
-        fresh = ~seen[next_mover, index]
-        source, i_new, j_new, index = source[fresh], i_new[fresh], j_new[fresh], index[fresh]
-        # Each state's first occurrence, in discovery order (a FIFO queue's order of the level).
-        order = np.arange(index.size)
-        earliest[index] = index.size
-        np.minimum.at(earliest, index, order)
-        first = np.flatnonzero(earliest[index] == order)
-        source, i_new, j_new, index = source[first], i_new[first], j_new[first], index[first]
-        seen[next_mover, index] = True
-        levels.append((i_new, j_new, source))
-        at_goal = np.flatnonzero((j_new == 0) & (i_new >= crossing.n_goal))
-        if at_goal.size:
-            return _chain(levels, int(at_goal[0]))
-        frontier_i, frontier_j = i_new, j_new
-        mover = "lower" if mover == "upper" else "upper"
-    return None
+    moves = _relative_moves(crossing.params, crossing.settings, crossing.n_d)
+    chain = fewest_steps(
+        moves.upper_targets,
+        moves.lower_targets,
+        crossing.footholds_ok(crossing.upper_offsets),
+        crossing.footholds_ok(crossing.lower_offsets),
+        crossing.n_x,
+        crossing.n_goal,
+    )
+    if not len(chain):
+        return None
+    return [(int(i), int(j), _MOVERS[mover]) for i, j, mover in chain]
 
 
-def _chain(levels, position: int) -> list[tuple[int, int, str]]:
-    """The states from the start to `position` in the last level, following parents back."""
-    chain = []
-    for depth in range(len(levels) - 1, -1, -1):
-        i, j, source = levels[depth]
-        chain.append((int(i[position]), int(j[position]), "upper" if depth % 2 else "lower"))
-        position = int(source[position])
-    chain.append((0, 0, "upper"))
-    chain.reverse()
-    return chain
+_MOVERS = ("upper", "lower")
+"""The next mover's name by its code in the compiled search."""
 
 
 def _platform_steps(crossing: _Crossing, chain) -> tuple[PlatformStep, ...]:

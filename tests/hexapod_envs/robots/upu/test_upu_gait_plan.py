@@ -313,9 +313,9 @@ def _fifo_search(crossing):
 
 
 @pytest.mark.parametrize("seed", range(4))
-def test_level_search_finds_the_plan_a_fifo_search_finds(seed):
-    """The vectorised level-by-level search keeps a FIFO queue's order (first discovery, longest
-    step first), so it returns the same chain of states on random ditches and grids."""
+def test_compiled_search_finds_the_plan_a_fifo_search_finds(seed):
+    """The compiled search returns the chain of states of the planner's definition (first
+    discovery, longest step first) on random ditches and grids."""
     from hexapod_envs.robots.upu.gait_plan import _Crossing, _fewest_steps
 
     rng = np.random.default_rng(seed)
