@@ -158,6 +158,15 @@ def _learned_part(config: dict[str, Any]) -> str:
             f"{hybrid.get('mode')!r}, scale {hybrid.get('scale')}, safety_filter "
             f"{hybrid.get('safety_filter')}; agents.hybrid), which the robot must run beside it"
         )
+    if config.get("knobs") is not None:
+        names = config["knobs"].get("names")
+        notes.append(
+            f"knobs model: the action is {len(names)} values in [-1, 1] that set the tipping "
+            f"recovery's {', '.join(names)} (0: the controller's own settings, +-1: the ends of "
+            "agents.knobs.KNOB_RANGES), chosen once when the FASM first falls below the "
+            f"threshold + {config['knobs'].get('event_margin_deg')} deg; the recovery "
+            "controller (agents.tipping) runs beside it"
+        )
     if kwargs.get("action_mode") == "gains":
         notes.append(
             "gains model: the action is the posture gains (k_z, k_a, k_b) in [0, 1] of the env's "
@@ -399,6 +408,7 @@ def load_actor(path: str | Path, trust_pickle: bool = False) -> tuple[Any, Any, 
     """(`agents.ppo.PPOPolicy` of the learned actor, the env it was trained on, its files): the
     env is built from the model's config (its id and kwargs, no wrappers)."""
     from .hybrid import HybridPolicy
+    from .knobs import KnobPolicy
     from .pipeline.envs import EnvSpec
     from .ppo import PPOPolicy
 
@@ -421,7 +431,7 @@ def load_actor(path: str | Path, trust_pickle: bool = False) -> tuple[Any, Any, 
     except BaseException:
         env.close()
         raise
-    if isinstance(policy, HybridPolicy):
+    if isinstance(policy, HybridPolicy | KnobPolicy):
         policy = policy.learned
     return policy, env, files
 

@@ -52,7 +52,7 @@ import gymnasium as gym
 import numpy as np
 
 from .env_kwargs import POLICY_SETTINGS, constructor_defaults
-from .policy import Policy
+from .policy import LearnedWithController, Policy
 from .registry import analytical_policy
 
 MODES = ("residual", "safety")
@@ -228,7 +228,7 @@ class HybridWrapper(gym.Wrapper):
         return obs, reward, terminated, truncated, info
 
 
-class HybridPolicy:
+class HybridPolicy(LearnedWithController):
     """A learned `Policy` (actions in [-1, 1]) combined with the env's analytical controller."""
 
     def __init__(self, learned: Policy, env: gym.Env, settings: HybridSettings):
@@ -236,14 +236,8 @@ class HybridPolicy:
         self.core = HybridCore(env, settings)
         self.last_override = False
 
-    def __getattr__(self, name: str) -> Any:  # files, train_env_kwargs... of the learned policy
-        if name in ("learned", "core"):
-            raise AttributeError(name)
-        return getattr(self.learned, name)
-
     def reset(self) -> None:
-        self.learned.reset()
-        self.core.reset()
+        super().reset()
         self.last_override = False
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:

@@ -9,7 +9,7 @@ same way. Analytical policies read the observation by name through the env's
 from __future__ import annotations
 
 import copy
-from typing import Protocol, runtime_checkable
+from typing import Any, Protocol, runtime_checkable
 
 import gymnasium as gym
 import numpy as np
@@ -39,6 +39,24 @@ class EnvBound:
             shared = key == "env"
             new.__dict__[key] = memo.get(id(value), value) if shared else copy.deepcopy(value, memo)
         return new
+
+
+class LearnedWithController:
+    """Base of a learned policy combined with an analytical controller: ``learned`` (a `Policy`)
+    and ``core`` (what owns the controller). Attributes it lacks are the learned policy's (a
+    loaded model's files, train_env_kwargs...); ``reset`` resets both."""
+
+    learned: Policy
+    core: Any
+
+    def __getattr__(self, name: str) -> Any:
+        if name in ("learned", "core"):
+            raise AttributeError(name)
+        return getattr(self.learned, name)
+
+    def reset(self) -> None:
+        self.learned.reset()
+        self.core.reset()
 
 
 class ZeroPolicy:

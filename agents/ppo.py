@@ -17,6 +17,8 @@ import gymnasium as gym
 import numpy as np
 
 from .hybrid import from_run_config
+from .knobs import KnobPolicy
+from .knobs import settings_from_config as knob_settings
 from .policy import Policy
 from .privileged_critic import pad_observation, privileged_space
 from .run_files.artifacts import ModelFiles, find_model, other_env_error, read_meta
@@ -57,7 +59,8 @@ class PPOPolicy:
         """The model at `path` as a policy for `env`, loaded without unpickling anything (see
         `agents.run_files.model_files`; pickled files of older runs only with ``trust_pickle``).
         A hybrid run's model comes back combined with `env`'s analytical controller as in
-        training (`agents.hybrid.HybridPolicy`)."""
+        training (`agents.hybrid.HybridPolicy`), a knobs run's as the controller it tunes
+        (`agents.knobs.KnobPolicy`)."""
         files = find_model(path)
         config = files.training_config()
         env_id = env.spec.id if env.spec is not None else None
@@ -75,9 +78,11 @@ class PPOPolicy:
         if privileged:
             observation_space = privileged_space(observation_space)
         meta = read_meta(files.directory)
+        knobs = knob_settings(config.get("knobs"))
+        action_space = env.action_space if knobs is None else knobs.action_space
         for what, key, env_space in (
             ("observation", "observation_shape", observation_space),
-            ("action", "action_shape", env.action_space),
+            ("action", "action_shape", action_space),
         ):
             if key in meta and tuple(meta[key]) != env_space.shape:
                 raise UserError(
@@ -85,7 +90,6 @@ class PPOPolicy:
                     f"but {env_id} (with these kwargs) has {env_space.shape}"
                 )
         policy_kwargs = train_config.policy.policy_kwargs()
-        action_space = env.action_space
         if config.get("hybrid") is not None:  # the learned action of a hybrid lies in [-1, 1]
             shape, dtype = env.action_space.shape, env.action_space.dtype
             action_space = gym.spaces.Box(-1.0, 1.0, shape=shape, dtype=dtype)
@@ -117,8 +121,12 @@ class PPOPolicy:
 
 def _as_trained(policy: PPOPolicy, env: gym.Env, config: dict[str, Any]) -> Any:
     """The policy as its run used it: a hybrid run's ``hybrid`` config section re-creates the
-    combination with the env's analytical controller (`agents.hybrid.from_run_config`)."""
+    combination with the env's analytical controller (`agents.hybrid.from_run_config`), a knobs
+    run's ``knobs`` section the controller it tunes (`agents.knobs.KnobPolicy`)."""
     try:
+        knobs = knob_settings(config.get("knobs"))
+        if knobs is not None:
+            return KnobPolicy(policy, env, knobs)
         return from_run_config(policy, env, config)
     except ValueError as exc:
         raise UserError(f"cannot use the model at {policy.files.model}: {exc}") from None

@@ -83,6 +83,9 @@ class EnvSpec:
     privileged_critic: bool = False
     """Append the task and the episode's elapsed share to the observation for an asymmetric
     critic (`agents.privileged_critic.PrivilegedObservation`, the innermost wrapper)."""
+    knobs: Any = None
+    """`agents.knobs.KnobSettings` (or the training config's ``knobs`` section): one learner
+    step per tipping event, which sets the recovery's knobs (`agents.knobs.KnobsPerEvent`)."""
 
     def make(self, **extra: Any) -> gym.Env:
         """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
@@ -101,6 +104,14 @@ class EnvSpec:
             from ..privileged_critic import PrivilegedObservation
 
             env = PrivilegedObservation(env, env.spec.max_episode_steps)
+        if self.knobs is not None:
+            from ..knobs import KnobsPerEvent, settings_from_config
+
+            try:
+                env = KnobsPerEvent(env, settings_from_config(self.knobs))
+            except ValueError as exc:
+                env.close()
+                raise UserError(f"cannot build the knobs env on {self.id}: {exc}") from None
         if self.hybrid is not None:
             try:
                 env = wrap(env, self.hybrid)

@@ -59,7 +59,7 @@ from .episode import XI_F_DEG, EpisodeAccumulator, metric_specs
 EVAL_SEED_OFFSET = 10_000
 """Evaluation envs are seeded apart from the training envs."""
 
-RESUME_FIXED_SECTIONS = ("env", "policy", "normalize", "hybrid")
+RESUME_FIXED_SECTIONS = ("env", "policy", "normalize", "hybrid", "knobs")
 """Config sections a resumed run cannot change (the model and its statistics depend on them)."""
 
 RESUME_FREE_KEYS = (("env", "vectorization"),)
@@ -95,6 +95,7 @@ def env_spec(config: TrainConfig) -> EnvSpec:
         env.decision,
         env.cycle_baseline,
         config.policy.critic_privileged,
+        config.knobs,
     )
 
 
@@ -113,8 +114,8 @@ def _probe(
             env.reset(seed=0)
             env.step(np.zeros(env.action_space.shape, env.action_space.dtype))
         dt, specs = env_time_step(env), metric_specs(env)
-        if spec.decision == "gait_cycle":
-            dt = None  # a learner step is a gait cycle, not control_dt: no durations or energy
+        if spec.decision == "gait_cycle" or spec.knobs is not None:
+            dt = None  # a learner step is a gait cycle or an episode: no durations or energy
         xi = getattr(env.unwrapped, "tipping_threshold_deg", XI_F_DEG)
         settings = resolved_settings(env)
     finally:
@@ -193,7 +194,8 @@ def new_model(config: TrainConfig, venv: Any) -> Any:
         **_ppo_kwargs(config),
     )
     hybrid_zero = config.hybrid is not None and config.hybrid.zero_init_action_net
-    if hybrid_zero or config.policy.zero_init_action_net:
+    knobs_zero = config.knobs is not None and config.knobs.zero_init_action_net
+    if hybrid_zero or knobs_zero or config.policy.zero_init_action_net:
         from ..hybrid import zero_init_action_net
 
         zero_init_action_net(model)

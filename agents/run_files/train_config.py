@@ -32,6 +32,7 @@ from pathlib import Path
 from typing import Any, Literal
 
 from ..hybrid import HybridSettings
+from ..knobs import KnobSettings
 from .configtools import apply_overrides, from_mapping, load_yaml
 from .errors import ConfigError
 from .schedules import Schedule, parse_optional_schedule, parse_schedule
@@ -328,6 +329,16 @@ class HybridConfig(HybridSettings):
 
 
 @dataclass
+class KnobConfig(KnobSettings):
+    """``knobs:`` section: train a policy that sets the tipping recovery's knobs once per tipping
+    event (`agents.knobs`: names, event_margin_deg, reward). Absent (null): no knobs."""
+
+    zero_init_action_net: bool = True
+    """Zero the action mean's last layer so that training starts from the controller's own
+    settings."""
+
+
+@dataclass
 class TrainConfig:
     env: EnvConfig
     vec_env: VecEnvConfig = field(default_factory=VecEnvConfig)
@@ -339,6 +350,7 @@ class TrainConfig:
     checkpoint: CheckpointConfig = field(default_factory=CheckpointConfig)
     logging: LoggingConfig = field(default_factory=LoggingConfig)
     hybrid: HybridConfig | None = None  # None: plain PPO; see agents/hybrid.py
+    knobs: KnobConfig | None = None  # None: no controller knobs; see agents/knobs.py
 
     def __post_init__(self):
         rollout = self.ppo.n_steps * self.vec_env.n_envs
@@ -367,6 +379,17 @@ class TrainConfig:
                 "env.vectorization: batched runs every env in this process (its physics on "
                 "vec_env.physics_threads threads), so vec_env.type: subprocess does not apply; "
                 "set vec_env.type: auto or dummy, or env.vectorization: vec_env"
+            )
+        if self.knobs is not None and (
+            self.hybrid is not None
+            or self.env.decision != "step"
+            or self.env.vectorization == "batched"
+            or self.env.reward_exclude
+        ):
+            raise ValueError(
+                "knobs: one learner step per tipping event, rewarded by the episode's outcome; "
+                "it needs no hybrid section, env.decision: step, env.vectorization: vec_env and "
+                "no env.reward_exclude"
             )
         if self.hybrid is not None and self.hybrid.mask_overridden and self.env.decision != "step":
             raise ValueError(

@@ -1,0 +1,260 @@
+"""Learned controller knobs: a policy that tunes the tipping recovery once per tipping event.
+
+The heavy-duty robot's recovery (Zhang et al. 2024, `agents.tipping`) plans its rescue step when
+it judges tipping: the foothold's safety factor ρ, the swing time's share ϰ of the forecast
+time to tip and its clamp, the swing's clearance. The paper fixes them for every situation. Here
+a learned policy sets them for each event, from what the robot senses as the event begins: when
+the measured FASM (observation ``fasm_margin_deg``) first falls below ξ + `event_margin_deg`,
+the policy is asked once, and the controller then judges and recovers with those settings.
+
+A knob's learned action ``a`` lies in [-1, 1]. ``a = 0`` is the controller's own setting, and
+``a = ±1`` the ends of the knob's range (`KNOB_RANGES`; linear on each side of the default), so
+an untrained policy that outputs 0 is the analytical controller exactly.
+
+Two ways to run it, sharing `KnobCore`:
+
+- `KnobsPerEvent`: the env a learner trains on. One learner step per episode: reset runs the
+  controller to the event and returns that observation; step applies the knobs and runs the
+  controller to the episode's end. The reward is the episode's ``info["is_success"]`` (the
+  benchmark's rule) or the env's return from the event on.
+- `KnobPolicy`: a trained policy as a per-step `Policy` on the plain env (`evaluate.py`), asked
+  at the same event.
+
+The config section ``knobs:`` of a training run (docs/training.md) builds both.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields, replace
+from typing import Any, Literal
+
+import gymnasium as gym
+import numpy as np
+
+from .policy import LearnedWithController, Policy
+from .registry import analytical_policy
+from .tipping.controller import RecoveryConfig, TippingRecoveryPolicy
+
+KNOB_RANGES: dict[str, tuple[float, float]] = {
+    "rho": (0.4, 1.0),
+    "angle_threshold_deg": (20.0, 60.0),
+    "kappa": (0.3, 0.95),
+    "t_min": (0.2, 1.5),
+    "t_max": (1.5, 4.0),
+    "swing_clearance": (0.03, 0.3),
+    "touchdown_speed": (0.05, 0.4),
+    "force_gain": (0.1, 1.0),
+}
+"""`RecoveryConfig` fields a policy may set per event, with the range a learned knob spans (units
+of the field: ρ, ϰ and the force gain dimensionless, angles in deg, times in s, the clearance in
+m, the touchdown speed in m/s). Only fields the controller reads when it uses them (at judgment,
+in the swing, at touchdown, in support) are here, so a setting made at the event takes effect."""
+
+REWARDS = ("success", "return")
+
+
+@dataclass
+class KnobSettings:
+    """What the learned policy tunes and when (see the module docstring).
+
+    Attributes:
+        names: the knobs, keys of `KNOB_RANGES`; the learned action has one value per name.
+        event_margin_deg: the policy is asked when the FASM first falls below ξ + this [deg]
+            (ξ: the controller's threshold), before the controller judges at ξ.
+        reward: training only: "success" (1 when the episode meets the env's success rule, else
+            0) or "return" (the env's reward summed from the event to the episode's end).
+    """
+
+    names: tuple[str, ...] = ("rho", "kappa", "t_min")
+    event_margin_deg: float = 5.0
+    reward: Literal["success", "return"] = "success"
+
+    def __post_init__(self):
+        self.names = names = tuple(self.names)
+        unknown = [n for n in names if n not in KNOB_RANGES]
+        if not names or unknown or len(set(names)) != len(names):
+            raise ValueError(
+                f"knobs.names must be distinct names from {sorted(KNOB_RANGES)}, got {list(names)}"
+            )
+        if not np.isfinite(self.event_margin_deg) or self.event_margin_deg < 0:
+            raise ValueError(
+                f"knobs.event_margin_deg must be a finite number >= 0, got {self.event_margin_deg}"
+            )
+        if self.reward not in REWARDS:
+            raise ValueError(f"knobs.reward must be one of {REWARDS}, got {self.reward!r}")
+
+    @property
+    def action_space(self) -> gym.spaces.Box:
+        """The learned action: one value in [-1, 1] per knob."""
+        return gym.spaces.Box(-1.0, 1.0, shape=(len(self.names),), dtype=np.float32)
+
+
+def knob_values(default: RecoveryConfig, names: tuple[str, ...], action) -> dict[str, float]:
+    """The settings a learned action means: ``a = 0`` the default, ``±1`` the range's ends.
+
+    Values of ``a`` outside [-1, 1] are clipped; a default outside a knob's range is kept at
+    ``a = 0`` and the side toward it has no span.
+    """
+    action = np.clip(np.asarray(action, dtype=float).reshape(-1), -1.0, 1.0)
+    if action.shape != (len(names),) or not np.all(np.isfinite(action)):
+        raise ValueError(
+            f"the knob action must be {len(names)} finite values (one per knob {list(names)}), "
+            f"got {np.asarray(action).tolist()}"
+        )
+    values = {}
+    for name, a in zip(names, action, strict=True):
+        low, high = KNOB_RANGES[name]
+        base = float(getattr(default, name))
+        end = high if a >= 0 else low
+        values[name] = base + abs(float(a)) * (end - base)
+    return values
+
+
+class KnobCore:
+    """The env's recovery controller and when, and how, its knobs are set.
+
+    Args:
+        env: a heavy-duty hexapod env (any wrapper of it) whose analytical controller
+            (`agents.registry`) is a `TippingRecoveryPolicy`.
+        settings: `KnobSettings`.
+        base: the controller to tune instead of the registry's (tests, variants).
+    """
+
+    def __init__(self, env: gym.Env, settings: KnobSettings, base: Policy | None = None):
+        base = base if base is not None else analytical_policy(env)
+        if not isinstance(base, TippingRecoveryPolicy):
+            raise ValueError(
+                f"knobs tune the tipping recovery's settings; the analytical controller of "
+                f"{env.spec.id if env.spec else type(env.unwrapped).__name__} is "
+                f"{type(base).__name__}, which has none (envs with the recovery: the cliff walk "
+                "and the Stewart tilt)"
+            )
+        structure = env.unwrapped.observation_structure
+        self._fasm = structure["fasm_margin_deg"]
+        self.settings = settings
+        self.base = base
+        self.default = base.controller.config
+        self.event_below_deg = self.default.threshold_deg + settings.event_margin_deg
+        self.decided = False
+        self.values: dict[str, float] = {}
+
+    def reset(self) -> None:
+        self.base.reset()
+        self.base.controller.config = self.default
+        self.decided = False
+        self.values = {}
+
+    def at_event(self, observation: np.ndarray) -> bool:
+        """Whether the policy is to be asked now: no knobs set yet this episode and the FASM
+        below ξ + event_margin_deg."""
+        if self.decided:
+            return False
+        return float(np.asarray(observation)[self._fasm][0]) < self.event_below_deg
+
+    def set_knobs(self, action) -> dict[str, float]:
+        """Apply a learned action for the rest of the episode; returns the settings."""
+        self.values = knob_values(self.default, self.settings.names, action)
+        self.base.controller.config = replace(self.default, **self.values)
+        self.decided = True
+        return self.values
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        """The controller's env action (with the knobs set so far)."""
+        return self.base(observation)
+
+
+class KnobsPerEvent(gym.Wrapper):
+    """The env seen by a learner of knobs: one step per episode, at the tipping event.
+
+    ``reset`` resets the env and runs the controller until the event; an episode that ends first
+    (the robot never came near tipping) has nothing to decide, and the env is reset again, up to
+    `max_skipped` times. ``step(a)`` sets the knobs and runs the controller to the episode's end;
+    the step ends the episode (terminated or truncated as the env's last step was). Its reward
+    is `KnobSettings.reward`; ``info`` is the env's last, plus ``knobs`` (the settings),
+    ``env_steps`` (control steps the learner step spanned) and ``episode_return`` (the env's).
+    """
+
+    def __init__(
+        self,
+        env: gym.Env,
+        settings: KnobSettings,
+        base: Policy | None = None,
+        max_skipped: int = 100,
+    ):
+        super().__init__(env)
+        self.core = KnobCore(env, settings, base)
+        self.action_space = settings.action_space
+        self.max_skipped = int(max_skipped)
+        self._obs: np.ndarray | None = None
+        self._steps = 0
+        self._return = 0.0
+
+    def reset(self, **kwargs: Any):
+        for _ in range(self.max_skipped + 1):
+            obs, info = self.env.reset(**kwargs)
+            kwargs.pop("seed", None)  # a skipped task: the next one from the env's generator
+            self.core.reset()
+            self._steps, self._return = 0, 0.0
+            ended = False
+            while not self.core.at_event(obs):
+                obs, reward, terminated, truncated, info = self.env.step(self.core(obs))
+                self._steps += 1
+                self._return += float(reward)
+                if terminated or truncated:
+                    ended = True
+                    break
+            if not ended:
+                self._obs = obs
+                return obs, info
+        raise RuntimeError(
+            f"{self.max_skipped + 1} episodes in a row ended before the FASM fell below "
+            f"{self.core.event_below_deg} deg: no tipping event to tune the recovery for"
+        )
+
+    def step(self, action: np.ndarray):
+        if self._obs is None:
+            raise RuntimeError("call reset() before step()")
+        values = self.core.set_knobs(action)
+        obs, steps, after_event = self._obs, 0, 0.0
+        while True:
+            obs, reward, terminated, truncated, info = self.env.step(self.core(obs))
+            steps += 1
+            after_event += float(reward)
+            if terminated or truncated:
+                break
+        self._obs = None
+        if self.core.settings.reward == "success":
+            learner_reward = float(bool(info.get("is_success", False)))
+        else:
+            learner_reward = after_event
+        info = {
+            **info,
+            "knobs": values,
+            "env_steps": self._steps + steps,
+            "episode_return": self._return + after_event,
+        }
+        return obs, learner_reward, terminated, truncated, info
+
+
+class KnobPolicy(LearnedWithController):
+    """A trained knob policy (actions in [-1, 1]) with the env's recovery controller, as a
+    per-step `Policy`: asked once per episode at the event, the controller acts every step."""
+
+    def __init__(self, learned: Policy, env: gym.Env, settings: KnobSettings):
+        self.learned = learned
+        self.core = KnobCore(env, settings)
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        if self.core.at_event(observation):
+            self.core.set_knobs(self.learned(observation))
+        return self.core(observation)
+
+
+def settings_from_config(section: Any) -> KnobSettings | None:
+    """`KnobSettings` from a config's ``knobs`` section (a dataclass or a mapping), or None."""
+    if section is None:
+        return None
+    names = [f.name for f in fields(KnobSettings)]
+    if not isinstance(section, dict):
+        section = {k: getattr(section, k) for k in names}
+    return KnobSettings(**{k: v for k, v in section.items() if k in names})
