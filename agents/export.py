@@ -19,10 +19,11 @@
   model in a ``hexapod-evaluate`` report).
 
 A hybrid model (its config has a ``hybrid`` section: the learned action combined with the env's
-analytical controller) and the irregular terrain's gains models (the learned action is the
-posture gains, applied once per gait cycle) are exported as their learned actor only; the card
-says what the robot must add around it. The export needs the ``[export]`` extra (``onnx``;
-``onnxruntime`` to check the file).
+analytical controller), a knobs model (a ``knobs`` section: the learned action sets the tipping
+recovery's settings at its judgment) and the irregular terrain's gains models (the learned
+action is the posture gains, applied once per gait cycle) are exported as their learned actor
+only; the card says what the robot must add around it. The export needs the ``[export]`` extra
+(``onnx``; ``onnxruntime`` to check the file).
 """
 
 from __future__ import annotations
@@ -38,6 +39,7 @@ from typing import Any
 
 import numpy as np
 
+from .knobs import KNOB_RANGES, KnobPolicy
 from .pipeline.cli import _add_trust_pickle_option, _run
 from .run_files.artifacts import ModelFiles, find_model, read_meta
 from .run_files.errors import UserError
@@ -160,12 +162,12 @@ def _learned_part(config: dict[str, Any]) -> str:
         )
     if config.get("knobs") is not None:
         names = config["knobs"].get("names")
+        spans = ", ".join(f"{n} {KNOB_RANGES[n][0]}..{KNOB_RANGES[n][1]}" for n in names)
         notes.append(
             f"knobs model: the action is {len(names)} values in [-1, 1] that set the tipping "
-            f"recovery's {', '.join(names)} (0: the controller's own settings, +-1: the ends of "
-            "agents.knobs.KNOB_RANGES), chosen once when the FASM first falls below the "
-            f"threshold + {config['knobs'].get('event_margin_deg')} deg; the recovery "
-            "controller (agents.tipping) runs beside it"
+            f"recovery's knobs (0: the controller's own settings, +-1: the ends of the ranges "
+            f"{spans}; agents.knobs), chosen once per episode at the controller's tipping "
+            "judgment; the recovery controller (agents.tipping) runs beside it"
         )
     if kwargs.get("action_mode") == "gains":
         notes.append(
@@ -408,7 +410,6 @@ def load_actor(path: str | Path, trust_pickle: bool = False) -> tuple[Any, Any, 
     """(`agents.ppo.PPOPolicy` of the learned actor, the env it was trained on, its files): the
     env is built from the model's config (its id and kwargs, no wrappers)."""
     from .hybrid import HybridPolicy
-    from .knobs import KnobPolicy
     from .pipeline.envs import EnvSpec
     from .ppo import PPOPolicy
 

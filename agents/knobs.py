@@ -1,11 +1,13 @@
-"""Learned controller knobs: a policy that tunes the tipping recovery once per tipping event.
+"""Learned controller knobs: a policy that tunes the tipping recovery at its tipping judgment.
 
 The heavy-duty robot's recovery (Zhang et al. 2024, `agents.tipping`) plans its rescue step when
 it judges tipping: the foothold's safety factor ρ, the swing time's share ϰ of the forecast
 time to tip and its clamp, the swing's clearance. The paper fixes them for every situation. Here
-a learned policy sets them for each event, from what the robot senses as the event begins: when
-the measured FASM (observation ``fasm_margin_deg``) first falls below ξ + `event_margin_deg`,
-the policy is asked once, and the controller then judges and recovers with those settings.
+a learned policy sets them from what the robot senses at that moment: at the control step on
+which the controller judges tipping (found by running a copy of the controller on the step's
+observation, while the measured FASM is below ξ + `event_margin_deg`), the policy is asked,
+and the controller then plans and recovers with those settings. It is asked once per episode:
+a controller that resumes walking and judges again keeps the first event's settings.
 
 A knob's learned action ``a`` lies in [-1, 1]. ``a = 0`` is the controller's own setting, and
 ``a = ±1`` the ends of the knob's range (`KNOB_RANGES`; linear on each side of the default), so
@@ -25,6 +27,7 @@ The config section ``knobs:`` of a training run (docs/training.md) builds both.
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass, fields, replace
 from typing import Any, Literal
 
@@ -59,8 +62,9 @@ class KnobSettings:
 
     Attributes:
         names: the knobs, keys of `KNOB_RANGES`; the learned action has one value per name.
-        event_margin_deg: the policy is asked when the FASM first falls below ξ + this [deg]
-            (ξ: the controller's threshold), before the controller judges at ξ.
+        event_margin_deg: while the measured FASM (observation ``fasm_margin_deg``) is below
+            ξ + this [deg] (ξ: the controller's threshold), every step is checked for the
+            controller's judgment (its own FASM, from its body model, may differ a little).
         reward: training only: "success" (1 when the episode meets the env's success rule, else
             0) or "return" (the env's reward summed from the event to the episode's end).
     """
@@ -92,8 +96,8 @@ class KnobSettings:
 def knob_values(default: RecoveryConfig, names: tuple[str, ...], action) -> dict[str, float]:
     """The settings a learned action means: ``a = 0`` the default, ``±1`` the range's ends.
 
-    Values of ``a`` outside [-1, 1] are clipped; a default outside a knob's range is kept at
-    ``a = 0`` and the side toward it has no span.
+    Values of ``a`` outside [-1, 1] are clipped. A default outside a knob's range widens the
+    range to it, so the mapping stays monotone.
     """
     action = np.clip(np.asarray(action, dtype=float).reshape(-1), -1.0, 1.0)
     if action.shape != (len(names),) or not np.all(np.isfinite(action)):
@@ -105,7 +109,7 @@ def knob_values(default: RecoveryConfig, names: tuple[str, ...], action) -> dict
     for name, a in zip(names, action, strict=True):
         low, high = KNOB_RANGES[name]
         base = float(getattr(default, name))
-        end = high if a >= 0 else low
+        end = max(high, base) if a >= 0 else min(low, base)
         values[name] = base + abs(float(a)) * (end - base)
     return values
 
@@ -134,7 +138,7 @@ class KnobCore:
         self.settings = settings
         self.base = base
         self.default = base.controller.config
-        self.event_below_deg = self.default.threshold_deg + settings.event_margin_deg
+        self.probe_below_deg = self.default.threshold_deg + settings.event_margin_deg
         self.decided = False
         self.values: dict[str, float] = {}
 
@@ -145,11 +149,16 @@ class KnobCore:
         self.values = {}
 
     def at_event(self, observation: np.ndarray) -> bool:
-        """Whether the policy is to be asked now: no knobs set yet this episode and the FASM
-        below ξ + event_margin_deg."""
-        if self.decided:
+        """Whether the policy is to be asked now: no knobs set yet this episode, and the
+        controller judges tipping on this observation (a copy of it is run on the observation
+        while the measured FASM is below ξ + event_margin_deg; 0.3 ms a copy)."""
+        if self.decided or self.base.controller.phase != "monitor":
             return False
-        return float(np.asarray(observation)[self._fasm][0]) < self.event_below_deg
+        if float(np.asarray(observation)[self._fasm][0]) >= self.probe_below_deg:
+            return False
+        probe = copy.deepcopy(self.base)  # shares the env (`agents.policy.EnvBound`)
+        probe(observation)
+        return probe.controller.active
 
     def set_knobs(self, action) -> dict[str, float]:
         """Apply a learned action for the rest of the episode; returns the settings."""
@@ -167,11 +176,14 @@ class KnobsPerEvent(gym.Wrapper):
     """The env seen by a learner of knobs: one step per episode, at the tipping event.
 
     ``reset`` resets the env and runs the controller until the event; an episode that ends first
-    (the robot never came near tipping) has nothing to decide, and the env is reset again, up to
-    `max_skipped` times. ``step(a)`` sets the knobs and runs the controller to the episode's end;
-    the step ends the episode (terminated or truncated as the env's last step was). Its reward
-    is `KnobSettings.reward`; ``info`` is the env's last, plus ``knobs`` (the settings),
-    ``env_steps`` (control steps the learner step spanned) and ``episode_return`` (the env's).
+    (the controller never judged tipping) has nothing to decide, and the env is reset again, up
+    to `max_skipped` times. ``step(a)`` sets the knobs and runs the controller to the episode's
+    end. Its reward is `KnobSettings.reward`, and it ends the learner's episode as terminated:
+    nothing follows the outcome, so a learner must not bootstrap a value after it (the env's own
+    flags are ``info["env_terminated"]`` and ``info["env_truncated"]``). ``info`` is the env's
+    last step's, plus ``knobs`` (the settings), ``env_steps`` (control steps the episode took),
+    ``episode_return`` (the env's) and ``skipped_episodes`` (episodes without an event before
+    this one). The training logs' per-episode metrics see only that last step's ``info``.
     """
 
     def __init__(
@@ -186,11 +198,12 @@ class KnobsPerEvent(gym.Wrapper):
         self.action_space = settings.action_space
         self.max_skipped = int(max_skipped)
         self._obs: np.ndarray | None = None
+        self._skipped = 0
         self._steps = 0
         self._return = 0.0
 
     def reset(self, **kwargs: Any):
-        for _ in range(self.max_skipped + 1):
+        for skipped in range(self.max_skipped + 1):
             obs, info = self.env.reset(**kwargs)
             kwargs.pop("seed", None)  # a skipped task: the next one from the env's generator
             self.core.reset()
@@ -204,11 +217,11 @@ class KnobsPerEvent(gym.Wrapper):
                     ended = True
                     break
             if not ended:
-                self._obs = obs
+                self._obs, self._skipped = obs, skipped
                 return obs, info
         raise RuntimeError(
-            f"{self.max_skipped + 1} episodes in a row ended before the FASM fell below "
-            f"{self.core.event_below_deg} deg: no tipping event to tune the recovery for"
+            f"{self.max_skipped + 1} episodes in a row ended without a tipping judgment: no "
+            "event to tune the recovery for"
         )
 
     def step(self, action: np.ndarray):
@@ -232,8 +245,11 @@ class KnobsPerEvent(gym.Wrapper):
             "knobs": values,
             "env_steps": self._steps + steps,
             "episode_return": self._return + after_event,
+            "skipped_episodes": self._skipped,
+            "env_terminated": terminated,
+            "env_truncated": truncated,
         }
-        return obs, learner_reward, terminated, truncated, info
+        return obs, learner_reward, True, False, info
 
 
 class KnobPolicy(LearnedWithController):

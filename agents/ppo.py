@@ -78,7 +78,10 @@ class PPOPolicy:
         if privileged:
             observation_space = privileged_space(observation_space)
         meta = read_meta(files.directory)
-        knobs = knob_settings(config.get("knobs"))
+        try:
+            knobs = knob_settings(config.get("knobs"))
+        except ValueError as exc:
+            raise UserError(f"cannot use the model at {files.model}: {exc}") from None
         action_space = env.action_space if knobs is None else knobs.action_space
         for what, key, env_space in (
             ("observation", "observation_shape", observation_space),
@@ -124,7 +127,7 @@ def _as_trained(policy: PPOPolicy, env: gym.Env, config: dict[str, Any]) -> Any:
     combination with the env's analytical controller (`agents.hybrid.from_run_config`), a knobs
     run's ``knobs`` section the controller it tunes (`agents.knobs.KnobPolicy`)."""
     try:
-        knobs = knob_settings(config.get("knobs"))
+        knobs = knob_settings(config.get("knobs"))  # checked in PPOPolicy.load
         if knobs is not None:
             return KnobPolicy(policy, env, knobs)
         return from_run_config(policy, env, config)

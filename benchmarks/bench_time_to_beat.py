@@ -13,7 +13,9 @@ counted, not averaged.
 - **Env steps** are the learner's steps, except for ``env.decision: gait_cycle`` runs (one
   learner step per gait cycle). There they are learner steps times the env steps per cycle,
   measured in the run as the mean evaluation episode length [env steps] over the mean training
-  episode length [cycles] (``rollout/ep_len_mean``) logged nearest to that evaluation.
+  episode length [cycles] (``rollout/ep_len_mean``) logged nearest to that evaluation. A knobs
+  run's learner step is a whole episode (`agents.knobs`); its env steps are not logged and are
+  shown as "-".
 
     python benchmarks/bench_time_to_beat.py runs/<sweep dir>            # every trial_* in it
     python benchmarks/bench_time_to_beat.py runs/a runs/b --reference-success 0.6
@@ -57,8 +59,11 @@ def tb_scalars(run_dir: Path, tag: str) -> list[tuple[int, float, float]]:
     return sorted(rows)
 
 
-def _env_steps_per_learner_step(run_dir: Path, step: int, curve: LearningCurve) -> float:
-    """1, or for a gait-cycle run the env steps per cycle measured near `step` (module doc)."""
+def _env_steps_per_learner_step(run_dir: Path, step: int, curve: LearningCurve) -> float | None:
+    """1, for a gait-cycle run the env steps per cycle measured near `step`, for a knobs run
+    None (module doc)."""
+    if curve.unit == "tipping events":
+        return None
     if curve.unit != "gait cycles":
         return 1.0
     lengths = tb_scalars(run_dir, "rollout/ep_len_mean")
@@ -83,7 +88,8 @@ def time_to_beat(run_dir: str | Path, reference: float | None = None) -> TimeToB
     step = int(curve.timesteps[above[0]])
     wall = {s: t for s, t, _ in tb_scalars(run_dir, "eval/success_rate")}
     result.beat_learner_steps = step
-    result.beat_env_steps = step * _env_steps_per_learner_step(run_dir, step, curve)
+    per_step = _env_steps_per_learner_step(run_dir, step, curve)
+    result.beat_env_steps = None if per_step is None else step * per_step
     result.beat_wall_s = wall[step] - wall[0] if {0, step} <= wall.keys() else None
     return result
 
@@ -108,16 +114,18 @@ def table(results: list[TimeToBeat]) -> str:
             passed = f"not within {r.evaluations} evaluations | - | -"
         else:
             wall = "-" if r.beat_wall_s is None else f"{r.beat_wall_s:.0f}"
-            passed = f"{r.beat_learner_steps} | {r.beat_env_steps:.0f} | {wall}"
+            env_steps = "-" if r.beat_env_steps is None else f"{r.beat_env_steps:.0f}"
+            passed = f"{r.beat_learner_steps} | {env_steps} | {wall}"
         lines.append(f"| {r.run} | {r.reference:.0%} | {r.best:.0%} | {passed} |")
     passed = [r for r in results if r.beat_learner_steps is not None]
     lines.append("")
     lines.append(f"{len(passed)} of {len(results)} runs passed the reference.")
     if passed:
-        env_steps = np.mean([r.beat_env_steps for r in passed])
+        counted = [r.beat_env_steps for r in passed if r.beat_env_steps is not None]
+        env_steps = f"{np.mean(counted):.0f} env steps" if counted else "no env-step counts"
         walls = [r.beat_wall_s for r in passed if r.beat_wall_s is not None]
         wall = f"{np.mean(walls):.0f} s" if walls else "no wall times"
-        lines.append(f"Mean over them: {env_steps:.0f} env steps, {wall}.")
+        lines.append(f"Mean over them: {env_steps}, {wall}.")
     return "\n".join(lines)
 
 

@@ -28,8 +28,9 @@ class LearningCurve:
     lengths: np.ndarray  # (n, episodes) episode lengths [steps]
     successes: np.ndarray | None  # (n, episodes) 0/1; None if the env reports no is_success
     unit: str = "env steps"
-    """What ``timesteps`` counts: the learner's steps, "env steps", or "gait cycles" for a run
-    whose learner acts once per gait cycle (``env.decision: gait_cycle`` in its config)."""
+    """What ``timesteps`` counts: the learner's steps, "env steps", "gait cycles" for a run
+    whose learner acts once per gait cycle (``env.decision: gait_cycle`` in its config) or
+    "tipping events" for a knobs run (one learner step per episode, `agents.knobs`)."""
 
     @property
     def mean_return(self) -> np.ndarray:
@@ -63,8 +64,10 @@ def load_learning_curve(run_dir: str | Path) -> LearningCurve:
     unit = "env steps"
     config = Path(run_dir) / "config.yaml"
     if config.is_file():
-        env = (yaml.safe_load(config.read_text()) or {}).get("env") or {}
+        data = yaml.safe_load(config.read_text()) or {}
+        env = data.get("env") or {}
         unit = "gait cycles" if env.get("decision") == "gait_cycle" else unit
+        unit = "tipping events" if data.get("knobs") is not None else unit
     with np.load(path) as data:
         successes = data["successes"] if "successes" in data and data["successes"].size else None
         return LearningCurve(

@@ -15,7 +15,7 @@ from agents.ppo import PPOPolicy
 from agents.registry import analytical_policy
 from agents.run_files.errors import UserError
 from agents.run_files.train_config import load_train_config
-from agents.tipping.controller import RecoveryConfig
+from agents.tipping.controller import RecoveryConfig, TippingRecoveryPolicy
 
 STEWART = "HexapodStewartTilt-v1"
 LIMIT = 500  # control steps: every test task's event comes before (about steps 150-400)
@@ -23,6 +23,17 @@ LIMIT = 500  # control steps: every test task's event comes before (about steps 
 
 def _stewart():
     return gym.make(STEWART, task_distribution="test", max_episode_steps=LIMIT)
+
+
+def _episode(env, policy, seed):
+    """(return, last info) of one episode of `policy` on `env`."""
+    obs, _ = env.reset(seed=seed)
+    policy.reset()
+    total, done = 0.0, False
+    while not done:
+        obs, reward, terminated, truncated, info = env.step(policy(obs))
+        total, done = total + reward, terminated or truncated
+    return total, info
 
 
 class _Constant:
@@ -74,28 +85,38 @@ def test_bad_settings_name_the_valid_choices():
 
 
 def test_the_zero_action_replays_the_analytical_controller():
-    """One learner step spans the episode from the event on; with a = 0 the env's episode is
-    the analytical controller's, step for step."""
+    """The learner is asked on the step the controller judges tipping; its one step spans the
+    rest of the episode and ends it as terminated (no value to bootstrap after the outcome);
+    with a = 0 the env's episode is the analytical controller's, step for step."""
     env = KnobsPerEvent(_stewart(), KnobSettings())
-    obs, _ = env.reset(seed=3)
-    assert obs[env.unwrapped.observation_structure["fasm_margin_deg"]][0] < 25.0
+    env.reset(seed=3)
     before = env._steps
+    assert env.core.base.controller.phase == "monitor"
     _, reward, terminated, truncated, info = env.step(np.zeros(3, dtype=np.float32))
-    assert terminated or truncated
-    assert 0 < before < info["env_steps"] <= LIMIT
+    assert (terminated, truncated) == (True, False)
+    assert info["env_truncated"] and not info["env_terminated"]  # stood to the time limit
+    judged = env.core.base.controller.diagnostics["judgment_time"]
+    assert judged == pytest.approx(before * env.unwrapped.control_dt)
+    assert 0 < before < info["env_steps"] == LIMIT
 
     raw = _stewart()
-    policy = analytical_policy(raw)
-    obs, _ = raw.reset(seed=3)
-    policy.reset()
-    total, steps, done = 0.0, 0, False
-    while not done:
-        obs, r, term, trunc, last = raw.step(policy(obs))
-        total, steps, done = total + r, steps + 1, term or trunc
-    assert info["env_steps"] == steps
+    total, last = _episode(raw, analytical_policy(raw), seed=3)
     assert info["episode_return"] == pytest.approx(total, rel=0, abs=1e-9)
     assert reward == float(last["is_success"])
     assert info["knobs"] == {"rho": 0.9, "kappa": 0.7, "t_min": 0.5}
+
+
+def test_the_knobs_act_as_the_same_settings_given_at_construction():
+    """Setting the knobs at the judgment is the controller built with those settings, and
+    another setting changes the episode."""
+    action = [-0.5, 0.5, 1.0]  # exact in float32, the learned action's dtype
+    settings = KnobSettings()
+    values = knob_values(RecoveryConfig(), settings.names, action)
+    env = _stewart()
+    tuned, _ = _episode(env, KnobPolicy(_Constant(action), env, settings), seed=4)
+    built = TippingRecoveryPolicy(env, RecoveryConfig(threshold_deg=20.0, **values))
+    assert _episode(env, built, seed=4)[0] == pytest.approx(tuned, rel=0, abs=1e-9)
+    assert _episode(env, analytical_policy(env), seed=4)[0] != pytest.approx(tuned, abs=1e-3)
 
 
 def test_the_policy_asks_once_at_the_event_and_matches_the_training_env():
@@ -107,12 +128,7 @@ def test_the_policy_asks_once_at_the_event_and_matches_the_training_env():
     raw = _stewart()
     learned = _Constant(action)
     policy = KnobPolicy(learned, raw, KnobSettings())
-    obs, _ = raw.reset(seed=5)
-    policy.reset()
-    total, done = 0.0, False
-    while not done:
-        obs, r, term, trunc, _ = raw.step(policy(obs))
-        total, done = total + r, term or trunc
+    total, _ = _episode(raw, policy, seed=5)
     assert learned.calls == 1
     assert policy.core.values == info["knobs"]
     assert policy.core.base.controller.config.rho == pytest.approx(0.9 - 0.6 * 0.5)
@@ -140,9 +156,9 @@ def test_a_knobs_run_trains_and_loads_as_the_controller_it_tunes(tmp_path):
     env = _stewart()
     policy = PPOPolicy.load(tmp_path / "run", env)
     assert isinstance(policy, KnobPolicy)
-    obs, _ = env.reset(seed=0)
-    policy.reset()
-    assert env.action_space.contains(policy(obs))
+    _episode(env, policy, seed=0)
+    assert policy.core.decided and set(policy.core.values) == {"rho", "kappa", "t_min"}
     actor, actor_env, _ = load_actor(tmp_path / "run")
+    obs, _ = actor_env.reset(seed=0)
     assert actor(obs).shape == (3,)
     actor_env.close()
