@@ -61,6 +61,9 @@ def test_zero_is_the_controllers_setting_and_one_the_ranges_ends():
         assert (low[name], high[name]) == pytest.approx(KNOB_RANGES[name])
     assert knob_values(default, ("rho",), [-0.5])["rho"] == pytest.approx(0.65)
     assert knob_values(default, ("rho",), [3.0]) == knob_values(default, ("rho",), [1.0])
+    outside = RecoveryConfig(t_max=5.0)  # above the knob's range 1.5-4.0: the range widens to it
+    assert knob_values(outside, ("t_max",), [1.0]) == {"t_max": 5.0}
+    assert knob_values(outside, ("t_max",), [-1.0]) == {"t_max": 1.5}
     with pytest.raises(ValueError, match="one per knob"):
         knob_values(default, names, [0.0, np.nan, 0.0])
 
