@@ -165,3 +165,12 @@ def test_a_knobs_run_trains_and_loads_as_the_controller_it_tunes(tmp_path):
     obs, _ = actor_env.reset(seed=0)
     assert actor(obs).shape == (3,)
     actor_env.close()
+
+
+def test_episodes_without_a_judgment_are_skipped_and_too_many_are_an_error():
+    short = gym.make(STEWART, task_distribution="test", max_episode_steps=20)  # ends before
+    env = KnobsPerEvent(short, KnobSettings(), max_skipped=2)
+    with pytest.raises(RuntimeError, match="3 episodes in a row ended without a tipping judgment"):
+        env.reset(seed=0)
+    with pytest.raises(RuntimeError, match="reset"):
+        KnobsPerEvent(_stewart(), KnobSettings()).step(np.zeros(3, dtype=np.float32))
