@@ -39,8 +39,9 @@ from typing import Any
 
 import numpy as np
 
-from .knobs import KNOB_RANGES, KnobPolicy
+from .knobs import KNOB_RANGES
 from .pipeline.cli import _add_trust_pickle_option, _run
+from .policy import LearnedWithController
 from .run_files.artifacts import ModelFiles, find_model, read_meta
 from .run_files.errors import UserError
 from .run_files.model_files import NormalizationStats, atomic_path, atomic_write_text
@@ -409,7 +410,6 @@ def card_markdown(card: dict[str, Any]) -> str:
 def load_actor(path: str | Path, trust_pickle: bool = False) -> tuple[Any, Any, ModelFiles]:
     """(`agents.ppo.PPOPolicy` of the learned actor, the env it was trained on, its files): the
     env is built from the model's config (its id and kwargs, no wrappers)."""
-    from .hybrid import HybridPolicy
     from .pipeline.envs import EnvSpec
     from .ppo import PPOPolicy
 
@@ -432,7 +432,7 @@ def load_actor(path: str | Path, trust_pickle: bool = False) -> tuple[Any, Any, 
     except BaseException:
         env.close()
         raise
-    if isinstance(policy, HybridPolicy | KnobPolicy):
+    if isinstance(policy, LearnedWithController):  # a hybrid or knobs model: its learned actor
         policy = policy.learned
     return policy, env, files
 

@@ -52,7 +52,7 @@ import gymnasium as gym
 import numpy as np
 
 from .env_kwargs import POLICY_SETTINGS, constructor_defaults
-from .policy import LearnedWithController, Policy
+from .policy import LearnedWithController, Policy, settings_from_section
 from .registry import analytical_policy
 
 MODES = ("residual", "safety")
@@ -247,12 +247,7 @@ class HybridPolicy(LearnedWithController):
 
 def settings_from_config(section: Any) -> HybridSettings | None:
     """`HybridSettings` from a config's ``hybrid`` section (a dataclass or a mapping), or None."""
-    if section is None:
-        return None
-    if not isinstance(section, dict):
-        section = {k: getattr(section, k) for k in HybridSettings.__dataclass_fields__}
-    valid = set(HybridSettings.__dataclass_fields__)
-    return HybridSettings(**{k: v for k, v in section.items() if k in valid})
+    return settings_from_section(HybridSettings, section)
 
 
 def wrap(env: gym.Env, section: Any) -> gym.Env:

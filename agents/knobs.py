@@ -28,13 +28,13 @@ The config section ``knobs:`` of a training run (docs/training.md) builds both.
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 from typing import Any, Literal
 
 import gymnasium as gym
 import numpy as np
 
-from .policy import LearnedWithController, Policy
+from .policy import LearnedWithController, Policy, settings_from_section
 from .registry import analytical_policy
 from .tipping.controller import RecoveryConfig, TippingRecoveryPolicy
 
@@ -202,23 +202,27 @@ class KnobsPerEvent(gym.Wrapper):
         self._steps = 0
         self._return = 0.0
 
+    def _run(self, obs: np.ndarray, until_event: bool):
+        """Step the env with the controller from `obs` until the episode ends or, with
+        `until_event`, the policy is to be asked; returns (obs, summed reward, steps,
+        terminated, truncated, info of the last step; None without a step)."""
+        total, steps, terminated, truncated, info = 0.0, 0, False, False, None
+        while not (until_event and self.core.at_event(obs)):
+            obs, reward, terminated, truncated, info = self.env.step(self.core(obs))
+            total, steps = total + float(reward), steps + 1
+            if terminated or truncated:
+                break
+        return obs, total, steps, terminated, truncated, info
+
     def reset(self, **kwargs: Any):
         for skipped in range(self.max_skipped + 1):
             obs, info = self.env.reset(**kwargs)
             kwargs.pop("seed", None)  # a skipped task: the next one from the env's generator
             self.core.reset()
-            self._steps, self._return = 0, 0.0
-            ended = False
-            while not self.core.at_event(obs):
-                obs, reward, terminated, truncated, info = self.env.step(self.core(obs))
-                self._steps += 1
-                self._return += float(reward)
-                if terminated or truncated:
-                    ended = True
-                    break
-            if not ended:
+            obs, self._return, self._steps, terminated, truncated, last = self._run(obs, True)
+            if not (terminated or truncated):
                 self._obs, self._skipped = obs, skipped
-                return obs, info
+                return obs, info if last is None else last
         raise RuntimeError(
             f"{self.max_skipped + 1} episodes in a row ended without a tipping judgment: no "
             "event to tune the recovery for"
@@ -228,13 +232,7 @@ class KnobsPerEvent(gym.Wrapper):
         if self._obs is None:
             raise RuntimeError("call reset() before step()")
         values = self.core.set_knobs(action)
-        obs, steps, after_event = self._obs, 0, 0.0
-        while True:
-            obs, reward, terminated, truncated, info = self.env.step(self.core(obs))
-            steps += 1
-            after_event += float(reward)
-            if terminated or truncated:
-                break
+        obs, after_event, steps, terminated, truncated, info = self._run(self._obs, False)
         self._obs = None
         if self.core.settings.reward == "success":
             learner_reward = float(bool(info.get("is_success", False)))
@@ -268,9 +266,4 @@ class KnobPolicy(LearnedWithController):
 
 def settings_from_config(section: Any) -> KnobSettings | None:
     """`KnobSettings` from a config's ``knobs`` section (a dataclass or a mapping), or None."""
-    if section is None:
-        return None
-    names = [f.name for f in fields(KnobSettings)]
-    if not isinstance(section, dict):
-        section = {k: getattr(section, k) for k in names}
-    return KnobSettings(**{k: v for k, v in section.items() if k in names})
+    return settings_from_section(KnobSettings, section)

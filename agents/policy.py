@@ -9,6 +9,7 @@ same way. Analytical policies read the observation by name through the env's
 from __future__ import annotations
 
 import copy
+import dataclasses
 from typing import Any, Protocol, runtime_checkable
 
 import gymnasium as gym
@@ -39,6 +40,18 @@ class EnvBound:
             shared = key == "env"
             new.__dict__[key] = memo.get(id(value), value) if shared else copy.deepcopy(value, memo)
         return new
+
+
+def settings_from_section(cls: type, section: Any) -> Any:
+    """Settings dataclass `cls` from a config section: None stays None; a mapping or a
+    dataclass holding (at least) `cls`'s fields gives those fields, the rest (a training
+    config's own keys, such as ``zero_init_action_net``) are left out."""
+    if section is None:
+        return None
+    names = [f.name for f in dataclasses.fields(cls)]
+    if not isinstance(section, dict):
+        section = {name: getattr(section, name) for name in names}
+    return cls(**{name: section[name] for name in names if name in section})
 
 
 class LearnedWithController:

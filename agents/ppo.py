@@ -17,7 +17,7 @@ import gymnasium as gym
 import numpy as np
 
 from .hybrid import from_run_config
-from .knobs import KnobPolicy
+from .knobs import KnobPolicy, KnobSettings
 from .knobs import settings_from_config as knob_settings
 from .policy import Policy
 from .privileged_critic import pad_observation, privileged_space
@@ -103,7 +103,7 @@ class PPOPolicy:
         stats = load_stats(files.directory, trust_pickle, train_config.normalize.observation)
         train_kwargs = (config.get("env") or {}).get("kwargs") or {}
         policy = cls(model, stats, files, deterministic, train_kwargs, privileged)
-        return _as_trained(policy, env, config)
+        return _as_trained(policy, env, config, knobs)
 
     def reset(self) -> None:
         pass
@@ -122,12 +122,13 @@ class PPOPolicy:
         return action
 
 
-def _as_trained(policy: PPOPolicy, env: gym.Env, config: dict[str, Any]) -> Any:
+def _as_trained(
+    policy: PPOPolicy, env: gym.Env, config: dict[str, Any], knobs: KnobSettings | None
+) -> Any:
     """The policy as its run used it: a hybrid run's ``hybrid`` config section re-creates the
     combination with the env's analytical controller (`agents.hybrid.from_run_config`), a knobs
-    run's ``knobs`` section the controller it tunes (`agents.knobs.KnobPolicy`)."""
+    run's settings (its ``knobs`` section) the controller it tunes (`agents.knobs.KnobPolicy`)."""
     try:
-        knobs = knob_settings(config.get("knobs"))  # checked in PPOPolicy.load
         if knobs is not None:
             return KnobPolicy(policy, env, knobs)
         return from_run_config(policy, env, config)
