@@ -6,7 +6,8 @@ any of its action modes, reading the observation by name (``joint_pos``, ``foot_
 ``torso_height``) through the layout of the env's task description
 (``env.unwrapped.task_description.observation_structure``):
 
-- ``"gains"``: the env runs the controller itself; the policy just returns (k_z, k_α, k_β).
+- ``"gains"``: the env runs the controller itself; the policy just returns (k_z, k_α, k_β)
+  (and a zero torso-height offset where the env has that fourth action: the standing height).
 - ``"joint"``: the policy runs its own `AthenaPostureController` (same gait settings as the
   env, from the task description's ``reference["gait_config"]``) on the observed sensors and
   returns its joint targets, normalised to the action space.
@@ -43,6 +44,9 @@ class AthenaPosturePolicy:
         self.read = ObservationReader(task.observation_structure)
         self.gains = (float(kz), float(ka), float(kb))
         self._dtype = env.action_space.dtype
+        self._height_offset = (
+            (0.0,) * (env.action_space.shape[0] - 3) if task.action_mode == "gains" else ()
+        )
         self.action_map = JointActionMap(np.column_stack([task.joint_low, task.joint_high]))
         # Validates the gains (ValueError outside [0, 1]) in every mode.
         self.controller = AthenaPostureController(
@@ -72,7 +76,7 @@ class AthenaPosturePolicy:
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:
         if self.action_mode == "gains":
-            return np.array(self.gains, dtype=self._dtype)
+            return np.array(self.gains + self._height_offset, dtype=self._dtype)
         sensors = self.sensors(observation)
         targets = self.controller.step(sensors).reshape(-1)
         if self.action_mode == "joint":

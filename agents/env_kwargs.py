@@ -23,6 +23,7 @@ POLICY_SETTINGS = (
     "gait_ground_search",
     "terrain_scan",
     "foot_scan",
+    "gains_height_offset_m",
 )
 """Env kwargs that say how an action is read or what the observation holds (not which task is
 posed): a policy is evaluated with the ones it was built for, on the suite's task."""

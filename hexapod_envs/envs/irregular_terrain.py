@@ -47,6 +47,7 @@ non-adaptive "simple control".
 | torso_height | 1 | infrared torso-height reading along the torso's -z [m] (-1: nothing below) |
 | gait_phase | 3 | sin, cos of 2π x the gait-cycle phase; 1 if the next step starts a gait cycle |
 | posture_gains | 3 | ("gains" mode only) (k_z, k_α, k_β) in effect this cycle |
+| height_offset | 1 | (``gains_height_offset_m`` > 0) the height reference's offset this cycle [m] |
 | terrain_scan | 15 | (``terrain_scan=True``) torso height above the terrain at 5 x 3 points [m] |
 | foot_scan | 108 | (``foot_scan=True``) each foot's height above the terrain at 6 x 3 points [m] |
 
@@ -76,7 +77,10 @@ Action modes (``action_mode=``):
   (the action passed to `step` when the current observation's ``gait_phase[2]`` turns 1; while
   the gait waits there for its stance feet to touch, the flag stays 1 and those actions are
   ignored too; `gains_due` tells) and held for the cycle's two phases; the actions of the other
-  steps are ignored. Gains start at ``reference_gains``.
+  steps are ignored. Gains start at ``reference_gains``. With ``gains_height_offset_m`` > 0 a
+  fourth value in [-1, 1] moves the height control's torso-height reference by that value x
+  ``gains_height_offset_m`` for the cycle (0: the standing height, as the paper): a body-height
+  knob read with the gains.
   `hexapod_envs.wrappers.GainsPerCycle` turns this into one env step per gait cycle.
 
 ## Rewards
@@ -310,6 +314,10 @@ class IrregularTerrainSettings(EnvSettings):
     residual_scale: float = number(0.25)
     reference_gains: tuple[float, float, float] = numbers((0.0, 0.0, 0.0), size=3, high=1.0)
     """(k_z, k_α, k_β) of the reference gait's posture control (all 0: simple control)."""
+    gains_height_offset_m: float = number(0.0, high=0.05)
+    """"gains" mode: when > 0, a fourth action in [-1, 1] raises (or lowers) the torso-height
+    reference of the height control (δz of eq. 27) by that action x this many metres, read with
+    the gains at each cycle start [m] (0: the three gains alone)."""
     stride: float = number(0.06, strict=True)
     """Stride of the tripod gait [m]."""
     swing_height: float | None = number(None, strict=True, optional=True)
@@ -480,7 +488,18 @@ class IrregularTerrainEnv(HexapodEnv):
         self.reference_height = self.robot.standing_torso_height
         self.action_map = JointActionMap(np.tile(self.robot.joint_ranges, (6, 1)))
         self._residual_gain = self.residual_scale * self.action_map.half
-        if s.action_mode == "gains":
+        self.height_offset_range = float(s.gains_height_offset_m)
+        """Metres of torso-height reference per unit of the gains mode's fourth action."""
+        if self.height_offset_range and s.action_mode != "gains":
+            raise ValueError(
+                "gains_height_offset_m adds an action of the 'gains' action mode; got "
+                f"action_mode={s.action_mode!r} (set gains_height_offset_m=0 or "
+                "action_mode='gains')"
+            )
+        if s.action_mode == "gains" and self.height_offset_range:
+            low, high = np.array([0, 0, 0, -1], np.float32), np.ones(4, np.float32)
+            self.action_space = spaces.Box(low, high, dtype=np.float32)
+        elif s.action_mode == "gains":
             self.action_space = spaces.Box(0.0, 1.0, shape=(3,), dtype=np.float32)
         else:
             self.action_space = spaces.Box(-1.0, 1.0, shape=(18,), dtype=np.float32)
@@ -641,6 +660,7 @@ class IrregularTerrainEnv(HexapodEnv):
     def _start_episode(self) -> None:
         self.controller.reset()
         self.controller.set_gains(*self.reference_gains)
+        self.controller.reference_height = self.robot.standing_torso_height
         self._gains_read_for = -1
         self._collisions = 0
         self._touched_in_physics = False
@@ -676,7 +696,10 @@ class IrregularTerrainEnv(HexapodEnv):
             ctrl[self._act_ids] = self.action_map.to_joints(action)
             return
         if self.gains_due:
-            self.controller.set_gains(*action.tolist())
+            self.controller.set_gains(*action[:3].tolist())
+            if self.height_offset_range:
+                offset = float(action[3]) * self.height_offset_range
+                self.controller.reference_height = self.robot.standing_torso_height + offset
             self._gains_read_for = self.controller.next_phase_index
         targets = self.controller.step_readings(
             self._joints.reshape(6, 3), self._forces, self._height
@@ -725,6 +748,10 @@ class IrregularTerrainEnv(HexapodEnv):
     def _height_deviation(self) -> float:
         """Torso-height reading minus the standing reference, m (0 without a reading)."""
         return self._height - self.reference_height if self._height >= 0 else 0.0
+
+    def _height_offset(self) -> float:
+        """The height control's torso-height reference minus the standing height [m]."""
+        return self.controller.reference_height - self.robot.standing_torso_height
 
     def torso_clearance(self) -> float:
         """True distance (m) from the torso box's bottom to the terrain below the torso centre
@@ -821,6 +848,8 @@ class IrregularTerrainEnv(HexapodEnv):
         }
         if self.action_mode == "gains":
             pieces["posture_gains"] = (3, lambda: self.controller.gains)
+        if self.height_offset_range:
+            pieces["height_offset"] = (1, self._height_offset)
         if self.settings.terrain_scan:
             pieces["terrain_scan"] = (len(SCAN_X) * len(SCAN_Y), self.terrain_scan)
         if self.settings.foot_scan:

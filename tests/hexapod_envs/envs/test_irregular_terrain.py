@@ -147,6 +147,45 @@ def test_gains_are_applied_only_at_gait_cycle_starts():
     assert waits > 0  # the ramp start waits for a landing leg: those steps set nothing
 
 
+def test_height_knob_at_zero_walks_the_gains_modes_episode_and_otherwise_moves_the_reference():
+    """gains_height_offset_m adds a fourth gains-mode action: at 0 the episode is the one of
+    the three gains alone, bit for bit; otherwise the height control's reference moves by the
+    action x the range, read at cycle starts only, and the torso walks higher."""
+    kwargs = {"terrain": "blocks", "action_mode": "gains", "task_distribution": "train"}
+    plain = gym.make("HexapodIrregularTerrain-v1", **kwargs)
+    knob = gym.make("HexapodIrregularTerrain-v1", gains_height_offset_m=0.04, **kwargs)
+    assert knob.action_space.shape == (4,) and knob.action_space.low[3] == -1.0
+    assert AthenaPosturePolicy(knob, kz=0.6, ka=0.4, kb=0.4)(None).tolist() == pytest.approx(
+        [0.6, 0.4, 0.4, 0.0]
+    )
+    offset = knob.unwrapped.observation_structure["height_offset"]
+    obs_p, _ = plain.reset(seed=5)
+    obs_k, _ = knob.reset(seed=5)
+    gains = np.array([0.6, 0.4, 0.4], np.float32)
+    for _ in range(120):
+        obs_p, r_p, *_ = plain.step(gains)
+        obs_k, r_k, *_ = knob.step(np.append(gains, np.float32(0.0)))
+        assert r_k == r_p and np.array_equal(np.delete(obs_k, offset), obs_p)
+    assert obs_k[offset] == 0.0
+
+    base = knob.unwrapped
+    heights = {}
+    for action in (0.0, 0.75):
+        knob.reset(seed=5)
+        readings = []
+        for _ in range(6 * base.ticks_per_cycle):
+            due = base.gains_due
+            held = action if due else -1.0  # actions between cycle starts are ignored
+            obs, *_, info = knob.step(np.append(gains, np.float32(held)))
+            assert obs[offset][0] == pytest.approx(action * 0.04)
+            readings.append(info["torso_height"])
+        heights[action] = np.mean(readings[-2 * base.ticks_per_cycle :])
+    assert heights[0.75] > heights[0.0] + 0.005  # k_z = 0.6 of a 3 cm higher reference
+
+    with pytest.raises(ValueError, match="gains_height_offset_m.*'gains'"):
+        gym.make("HexapodIrregularTerrain-v1", gains_height_offset_m=0.04)
+
+
 def test_policy_gives_the_same_walk_in_every_action_mode():
     """The env's internal controller (gains, residual) and the policy's own (joint) agree."""
 
