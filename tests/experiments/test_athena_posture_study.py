@@ -22,7 +22,11 @@ import json
 import numpy as np
 import pytest
 
-from experiments.athena_posture import athena_gain_sweep, athena_posture_study
+from experiments.athena_posture import (
+    athena_gain_sweep,
+    athena_posture_study,
+    height_reference_scan,
+)
 from experiments.athena_posture.study import EpisodeRecord, change_interval, compare, pooled
 
 pytestmark = pytest.mark.slow
@@ -152,3 +156,17 @@ def test_study_and_sweep_scripts_write_their_outputs(tmp_path):
     athena_gain_sweep.main(["--cycles", "1", "--out", str(out)])
     text = out.read_text()
     assert text.count("| k_z = ") == 10 and "paper's tuned (0.6, 0.4, 0.4)" in text
+
+
+def test_height_reference_scan_runs_hard_training_tasks_and_tabulates_each_offset(tmp_path, capsys):
+    seeds = height_reference_scan.hard_train_seeds(2, 0.6)
+    assert len(seeds) == 2 and min(seeds) >= height_reference_scan.FIRST_SEED
+    out = tmp_path / "scan.json"
+    argv = ["--offsets", "0", "0.02", "--tasks", "2", "--min-difficulty", "0.6"]
+    height_reference_scan.main([*argv, "--max-steps", "30", "--json", str(out)])
+    episodes = json.loads(out.read_text())
+    assert list(episodes) == ["0.0", "0.02"]
+    assert [e["seed"] for e in episodes["0.02"]] == seeds
+    assert "| +0.020 | 0/2 |" in capsys.readouterr().out  # 30 steps: no episode succeeds
+    with pytest.raises(SystemExit):
+        height_reference_scan.main(["--offsets", "0.2"])
