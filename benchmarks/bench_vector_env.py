@@ -13,7 +13,10 @@ machinery costs). Configurations are measured in turn, `--rounds` times, best of
 CPU per env step (all threads, and the calling thread's: not for subprocess envs) and the rate
 those allow on 2 free cores (1 / CPU for the single env; 1 / max(main, CPU / 2) with the
 physics threads): the figure a loaded machine cannot show. Each env also gets its step profile
-(`common.step_profile`: physics against the env's Python, µs per step).
+(`common.step_profile`: physics against the env's Python, µs per step) and the ceiling of any
+batching on this machine: 16 worlds' physics alone (their `_simulate`, no other Python) on one
+thread and on the 2 threads, the rate against one env that a batched env with no Python cost
+would reach at that scaling, and the CPU per world step that the 1.8 x target allows.
 
 PPO rows: configs/cliff_walk_ppo.yaml on HexapodCliffWalk-v1 with the same rollout size
 (`--rollout` steps over all envs) and `--ppo-steps` steps: SubprocVecEnv(2), the batched
@@ -31,10 +34,12 @@ import os
 import sys
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 from typing import NamedTuple
 
 import gymnasium as gym
+import mujoco
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -141,6 +146,41 @@ def _vec_rate(envs, n_envs: int, seconds: float, space: gym.Space, local: bool =
     return rate
 
 
+def physics_ceiling(env_id: str, seconds: float, n_worlds: int = 16) -> tuple[float, float]:
+    """The batching's ceiling on this machine: µs of wall time per world and control period of
+    the physics alone (each world's `_simulate`, no other Python), `n_worlds` worlds in turn on
+    the calling thread, and split between `THREADS` threads. Each round restores every world to
+    the state it had after 50 random-action steps, so both figures step the same states."""
+    worlds = []
+    for seed in range(n_worlds):
+        env = gym.make(env_id, **KWARGS)
+        env.reset(seed=seed)
+        for action in _actions(env.action_space, 50, seed):
+            env.step(action)
+        world = env.unwrapped
+        spec = mujoco.mjtState.mjSTATE_INTEGRATION
+        state = np.empty(mujoco.mj_stateSize(world.model, spec))
+        mujoco.mj_getState(world.model, world.data, state, spec)
+        worlds.append((world, state, spec))
+
+    def periods(share: list) -> None:
+        for world, state, spec in share:
+            mujoco.mj_setState(world.model, world.data, state, spec)
+            world._simulate()
+
+    def per_world(run: Callable[[], None]) -> float:
+        rounds, start = 0, time.perf_counter()
+        while (elapsed := time.perf_counter() - start) < seconds:
+            run()
+            rounds += 1
+        return elapsed / (rounds * n_worlds) * 1e6
+
+    with ThreadPoolExecutor(THREADS) as pool:
+        shares = [worlds[k::THREADS] for k in range(THREADS)]
+        threaded = per_world(lambda: list(pool.map(periods, shares)))
+    return per_world(lambda: periods(worlds)), threaded
+
+
 CONFIGS = {
     "single": single_rate,
     f"subproc {THREADS}": subproc_rate,
@@ -221,7 +261,11 @@ def _time_calls(obj, name: str, seconds: dict[str, float], key: str) -> None:
     setattr(obj, name, timed)
 
 
-def print_env_rows(rates: dict[tuple[str, str], Rate], profile_steps: int) -> list[tuple]:
+def print_env_rows(
+    rates: dict[tuple[str, str], Rate],
+    ceilings: dict[str, tuple[float, float]],
+    profile_steps: int,
+) -> list[tuple]:
     """The env table; returns the ratios the targets judge (batched / single, / subproc).
 
     "CPU" is this process's CPU per env step (all threads), "main" the calling thread's; the
@@ -256,6 +300,16 @@ def print_env_rows(rates: dict[tuple[str, str], Rate], profile_steps: int) -> li
             f"  {env_id} step profile (single env): physics {physics:.0f} µs, the env's "
             f"Python {python:.0f} µs per step"
         )
+        one, threaded = ceilings[env_id]
+        scaling = one / threaded
+        print(
+            f"  physics alone, 16 worlds in turn: {one:.0f} µs per world and control period on "
+            f"1 thread, {threaded:.0f} on {THREADS} threads ({scaling:.2f} x); a batched env "
+            f"whose Python cost nothing would reach {1e6 / single.rate * scaling / physics:.2f} "
+            f"x one env (one env's step / its physics split {scaling:.2f} ways), and "
+            f"{SINGLE_TARGET} x needs the whole step of a world within "
+            f"{2e6 / single.rate / SINGLE_TARGET:.0f} µs of CPU over the {THREADS} cores"
+        )
     return judged
 
 
@@ -269,6 +323,10 @@ def main() -> None:
     args = parser.parse_args()
 
     rates = env_rates(args.seconds, args.rounds)
+    ceilings = {}
+    for env_id in ENV_IDS:  # the lowest of the rounds (interference only slows a run down)
+        runs = [physics_ceiling(env_id, args.seconds) for _ in range(args.rounds)]
+        ceilings[env_id] = (min(one for one, _ in runs), min(two for _, two in runs))
     ppo = {
         f"subproc {THREADS}": ppo_rate("subproc", 2, args.ppo_steps, args.rollout),
         "batched 2": ppo_rate("batched", 2, args.ppo_steps, args.rollout),
@@ -279,7 +337,7 @@ def main() -> None:
         f"\n{cores} usable cores (shared); physics threads of the batched env: {THREADS}; "
         f"best of {args.rounds} rounds of {args.seconds:g} s"
     )
-    judged = print_env_rows(rates, args.profile_steps)
+    judged = print_env_rows(rates, ceilings, args.profile_steps)
 
     print(
         f"\nPPO, configs/cliff_walk_ppo.yaml on HexapodCliffWalk-v1, {args.ppo_steps} steps, "

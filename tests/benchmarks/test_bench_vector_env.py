@@ -1,6 +1,8 @@
 """benchmarks/bench_vector_env.py: its measuring functions run (no timing assertions)."""
 
-from benchmarks.bench_vector_env import batched_rate, ppo_rate, single_rate
+import math
+
+from benchmarks.bench_vector_env import batched_rate, physics_ceiling, ppo_rate, single_rate
 
 
 def test_env_rates_count_steps_and_the_cpu_they_take():
@@ -14,3 +16,8 @@ def test_ppo_rate_splits_its_time_into_env_policy_and_update():
     row = ppo_rate("batched", 2, steps=128, rollout=64)
     assert row["rate"] > 0 and min(row["env"], row["policy"], row["update"]) > 0
     assert row["env"] + row["policy"] + row["update"] <= row["total"]
+
+
+def test_physics_ceiling_times_the_worlds_physics_on_one_thread_and_on_the_threads():
+    one, threaded = physics_ceiling("HexapodStewartTilt-v1", 0.05, n_worlds=2)
+    assert math.isfinite(one) and math.isfinite(threaded) and min(one, threaded) > 0
