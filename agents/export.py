@@ -174,6 +174,12 @@ def _learned_part(config: dict[str, Any]) -> str:
         notes.append(
             "gains model: the action is the posture gains (k_z, k_a, k_b) in [0, 1] of the env's "
             "analytical gait, which turns them into joint targets"
+            + (
+                f", and a fourth value in [-1, 1] x {kwargs['gains_height_offset_m']} m that "
+                "moves the height control's torso-height reference"
+                if kwargs.get("gains_height_offset_m")
+                else ""
+            )
             + (", chosen once per gait cycle" if env.get("decision") == "gait_cycle" else "")
         )
     return "; ".join(notes) if notes else "the complete policy (the env action itself)"

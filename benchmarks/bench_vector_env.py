@@ -16,7 +16,8 @@ physics threads): the figure a loaded machine cannot show. Each env also gets it
 (`common.step_profile`: physics against the env's Python, µs per step) and the ceiling of any
 batching on this machine: 16 worlds' physics alone (their `_simulate`, no other Python) on one
 thread and on the 2 threads, the rate against one env that a batched env with no Python cost
-would reach at that scaling, and the CPU per world step that the 1.8 x target allows.
+would reach at that scaling (from the step profile: its physics and Python), and the CPU per
+world step that the 1.8 x target allows with both cores fully used.
 
 PPO rows: configs/cliff_walk_ppo.yaml on HexapodCliffWalk-v1 with the same rollout size
 (`--rollout` steps over all envs) and `--ppo-steps` steps: SubprocVecEnv(2), the batched
@@ -161,10 +162,10 @@ def physics_ceiling(env_id: str, seconds: float, n_worlds: int = 16) -> tuple[fl
         spec = mujoco.mjtState.mjSTATE_INTEGRATION
         state = np.empty(mujoco.mj_stateSize(world.model, spec))
         mujoco.mj_getState(world.model, world.data, state, spec)
-        worlds.append((world, state, spec))
+        worlds.append((world, state, spec, env))
 
     def periods(share: list) -> None:
-        for world, state, spec in share:
+        for world, state, spec, _ in share:
             mujoco.mj_setState(world.model, world.data, state, spec)
             world._simulate()
 
@@ -178,7 +179,10 @@ def physics_ceiling(env_id: str, seconds: float, n_worlds: int = 16) -> tuple[fl
     with ThreadPoolExecutor(THREADS) as pool:
         shares = [worlds[k::THREADS] for k in range(THREADS)]
         threaded = per_world(lambda: list(pool.map(periods, shares)))
-    return per_world(lambda: periods(worlds)), threaded
+    one = per_world(lambda: periods(worlds))
+    for *_, env in worlds:
+        env.close()
+    return one, threaded
 
 
 CONFIGS = {
@@ -305,10 +309,10 @@ def print_env_rows(
         print(
             f"  physics alone, 16 worlds in turn: {one:.0f} µs per world and control period on "
             f"1 thread, {threaded:.0f} on {THREADS} threads ({scaling:.2f} x); a batched env "
-            f"whose Python cost nothing would reach {1e6 / single.rate * scaling / physics:.2f} "
-            f"x one env (one env's step / its physics split {scaling:.2f} ways), and "
+            f"whose Python cost nothing would reach {(physics + python) / physics * scaling:.2f}"
+            f" x one env (the profiled step / its physics split {scaling:.2f} ways), and "
             f"{SINGLE_TARGET} x needs the whole step of a world within "
-            f"{2e6 / single.rate / SINGLE_TARGET:.0f} µs of CPU over the {THREADS} cores"
+            f"{2e6 / single.rate / SINGLE_TARGET:.0f} µs of CPU with both cores fully used"
         )
     return judged
 

@@ -9,7 +9,7 @@ import pytest
 from helpers.paths import REPO
 
 import hexapod_envs  # noqa: F401  (registers the envs)
-from agents.export import card_paths, export_main, export_model
+from agents.export import _learned_part, card_paths, export_main, export_model
 from agents.hybrid import HybridPolicy
 from agents.ppo import PPOPolicy
 
@@ -116,3 +116,12 @@ def test_cli_refuses_to_overwrite_without_force(tmp_path, capsys):
     assert export_main([*argv, "--force"]) == 0
     assert export_main([str(tmp_path / "nothing")]) == 2
     assert "no PPO model" in capsys.readouterr().err
+
+
+def test_a_gains_cards_learned_part_names_the_height_knob_when_the_env_has_it():
+    env = {"decision": "gait_cycle", "kwargs": {"action_mode": "gains"}}
+    plain = _learned_part({"env": env})
+    assert "(k_z, k_a, k_b)" in plain and "torso-height" not in plain
+    env["kwargs"]["gains_height_offset_m"] = 0.04
+    knob = _learned_part({"env": env})
+    assert "fourth value in [-1, 1] x 0.04 m" in knob and knob.endswith("once per gait cycle")
