@@ -496,11 +496,11 @@ class IrregularTerrainEnv(HexapodEnv):
                 f"action_mode={s.action_mode!r} (set gains_height_offset_m=0 or "
                 "action_mode='gains')"
             )
-        if s.action_mode == "gains" and self.height_offset_range:
-            low, high = np.array([0, 0, 0, -1], np.float32), np.ones(4, np.float32)
-            self.action_space = spaces.Box(low, high, dtype=np.float32)
-        elif s.action_mode == "gains":
-            self.action_space = spaces.Box(0.0, 1.0, shape=(3,), dtype=np.float32)
+        if s.action_mode == "gains":  # (k_z, k_α, k_β) in [0, 1], the offset in [-1, 1]
+            low = [0.0, 0.0, 0.0] + ([-1.0] if self.height_offset_range else [])
+            self.action_space = spaces.Box(
+                np.array(low, np.float32), np.ones(len(low), np.float32), dtype=np.float32
+            )
         else:
             self.action_space = spaces.Box(-1.0, 1.0, shape=(18,), dtype=np.float32)
         self._contact_force_sq = self.contact_force**2
@@ -660,7 +660,7 @@ class IrregularTerrainEnv(HexapodEnv):
     def _start_episode(self) -> None:
         self.controller.reset()
         self.controller.set_gains(*self.reference_gains)
-        self.controller.reference_height = self.robot.standing_torso_height
+        self.controller.reference_height = self.reference_height
         self._gains_read_for = -1
         self._collisions = 0
         self._touched_in_physics = False
@@ -699,7 +699,7 @@ class IrregularTerrainEnv(HexapodEnv):
             self.controller.set_gains(*action[:3].tolist())
             if self.height_offset_range:
                 offset = float(action[3]) * self.height_offset_range
-                self.controller.reference_height = self.robot.standing_torso_height + offset
+                self.controller.reference_height = self.reference_height + offset
             self._gains_read_for = self.controller.next_phase_index
         targets = self.controller.step_readings(
             self._joints.reshape(6, 3), self._forces, self._height
@@ -751,7 +751,7 @@ class IrregularTerrainEnv(HexapodEnv):
 
     def _height_offset(self) -> float:
         """The height control's torso-height reference minus the standing height [m]."""
-        return self.controller.reference_height - self.robot.standing_torso_height
+        return self.controller.reference_height - self.reference_height
 
     def torso_clearance(self) -> float:
         """True distance (m) from the torso box's bottom to the terrain below the torso centre
