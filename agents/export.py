@@ -180,7 +180,10 @@ def _learned_part(config: dict[str, Any]) -> str:
                 if kwargs.get("gains_height_offset_m")
                 else ""
             )
-            + (", chosen once per gait cycle" if env.get("decision") == "gait_cycle" else "")
+            + {
+                "gait_cycle": ", chosen once per gait cycle",
+                "episode": ", chosen once per episode at its first observation and held",
+            }.get(env.get("decision"), "")
         )
     return "; ".join(notes) if notes else "the complete policy (the env action itself)"
 

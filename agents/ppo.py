@@ -127,10 +127,39 @@ def _as_trained(
 ) -> Any:
     """The policy as its run used it: a hybrid run's ``hybrid`` config section re-creates the
     combination with the env's analytical controller (`agents.hybrid.from_run_config`), a knobs
-    run's settings (its ``knobs`` section) the controller it tunes (`agents.knobs.KnobPolicy`)."""
+    run's settings (its ``knobs`` section) the controller it tunes (`agents.knobs.KnobPolicy`),
+    and a run that decided once per episode (``env.decision: episode``) holds its first action
+    (`HeldPerEpisode`)."""
+    learned: Policy = policy
+    if (config.get("env") or {}).get("decision") == "episode":
+        learned = HeldPerEpisode(policy)
     try:
         if knobs is not None:
             return KnobPolicy(policy, env, knobs)
-        return from_run_config(policy, env, config)
+        return from_run_config(learned, env, config)
     except ValueError as exc:
         raise UserError(f"cannot use the model at {policy.files.model}: {exc}") from None
+
+
+class HeldPerEpisode:
+    """A learned `Policy` asked once per episode, at its first observation, whose action is then
+    held: a model trained with ``env.decision: episode`` (`hexapod_envs.wrappers.GainsPerEpisode`)
+    run at every step of the plain env. Attributes it lacks are the learned policy's."""
+
+    def __init__(self, learned: Policy):
+        self.learned = learned
+        self._action: np.ndarray | None = None
+
+    def __getattr__(self, name: str) -> Any:
+        if name == "learned":
+            raise AttributeError(name)
+        return getattr(self.learned, name)
+
+    def reset(self) -> None:
+        self.learned.reset()
+        self._action = None
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        if self._action is None:
+            self._action = np.array(self.learned(observation))
+        return self._action.copy()

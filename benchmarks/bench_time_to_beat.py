@@ -14,8 +14,8 @@ counted, not averaged.
   learner step per gait cycle). There they are learner steps times the env steps per cycle,
   measured in the run as the mean evaluation episode length [env steps] over the mean training
   episode length [cycles] (``rollout/ep_len_mean``) logged nearest to that evaluation. A knobs
-  run's learner step is a whole episode (`agents.knobs`); its env steps are not logged and are
-  shown as "-".
+  run's learner step is a whole episode (`agents.knobs`), as is an ``env.decision: episode``
+  run's; their env steps are not logged and are shown as "-".
 
     python benchmarks/bench_time_to_beat.py runs/<sweep dir>            # every trial_* in it
     python benchmarks/bench_time_to_beat.py runs/a runs/b --reference-success 0.6
@@ -60,9 +60,9 @@ def tb_scalars(run_dir: Path, tag: str) -> list[tuple[int, float, float]]:
 
 
 def _env_steps_per_learner_step(run_dir: Path, step: int, curve: LearningCurve) -> float | None:
-    """1, for a gait-cycle run the env steps per cycle measured near `step`, for a knobs run
-    None (module doc)."""
-    if curve.unit == "tipping events":
+    """1, for a gait-cycle run the env steps per cycle measured near `step`, for a knobs or
+    per-episode run None (module doc)."""
+    if curve.unit in ("tipping events", "episodes"):
         return None
     if curve.unit != "gait cycles":
         return 1.0

@@ -1,6 +1,6 @@
 """Gymnasium wrappers that belong to one env's action mode.
 
-`GainsPerCycle`: HexapodIrregularTerrain-v0's "gains" mode reads its action once per gait cycle
+`GainsPerCycle`: HexapodIrregularTerrain's "gains" mode reads its action once per gait cycle
 (40 control steps at the defaults) and ignores it in between, so a learner that acts at every
 step sees 39 actions without consequence for each one that counts, and a per-step reward whose
 effect shows up over the whole cycle. The wrapper makes one wrapped step of each gait cycle: the
@@ -20,6 +20,11 @@ A policy trained through it acts identically without it: the env reads the actio
 cycle starts, and the wrapped env returns exactly the observation that the unwrapped env returns
 before each cycle start. Evaluation (which needs every step's info for its metrics) therefore
 runs the policy on the unwrapped env at every step.
+
+`GainsPerEpisode`: one wrapped step per episode, the action held over every gait cycle: the
+contextual bandit of "one setting per terrain", for knobs whose best value hardly changes within
+an episode (ATHENA's body height: the height control reaches a new reference over several
+cycles, so per-cycle rewards credit little of it). The step's reward is the episode's outcome.
 """
 
 from __future__ import annotations
@@ -56,17 +61,7 @@ class GainsPerCycle(gym.Wrapper):
                     f"baseline_action {baseline_action!r} is not in the action space "
                     f"{env.action_space}"
                 )
-        base = env.unwrapped
-        if not hasattr(type(base), "gains_due"):
-            raise ValueError(
-                "GainsPerCycle needs an env with a gains action mode "
-                f"(HexapodIrregularTerrain-v0), got {type(base).__name__}"
-            )
-        if getattr(base, "action_mode", None) != "gains":
-            raise ValueError(
-                f"GainsPerCycle needs action_mode='gains', got {base.action_mode!r}; the other "
-                "modes read their action at every step"
-            )
+        _require_gains_mode(env, type(self).__name__)
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         base = self.env.unwrapped
@@ -93,3 +88,46 @@ def _play(env: gym.Env, action: Any, done: Callable[[int], bool]) -> tuple[tuple
         steps += 1
         if result[2] or result[3] or done(steps):
             return result, total, steps
+
+
+EPISODE_REWARDS = ("success", "return")
+
+
+class GainsPerEpisode(gym.Wrapper):
+    """One step per episode of a "gains"-mode env (see the module docstring): ``step(action)``
+    holds `action` until the episode ends and returns its last observation, info and
+    ``terminated=True`` (the episode is the decision's whole consequence: nothing to bootstrap),
+    with ``info["episode_steps"]`` the control steps it ran and ``info["episode_truncated"]``
+    whether the env's time limit ended it.
+
+    The reward is ``reward="success"``: 1.0 when the episode meets the env's success rule
+    (``info["is_success"]``), else 0.0; or ``"return"``: the env's rewards summed."""
+
+    def __init__(self, env: gym.Env, reward: str = "success"):
+        super().__init__(env)
+        if reward not in EPISODE_REWARDS:
+            raise ValueError(f"reward must be one of {EPISODE_REWARDS}, got {reward!r}")
+        _require_gains_mode(env, type(self).__name__)
+        self.reward = reward
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        (obs, _, _, truncated, info), total, steps = _play(self.env, action, lambda _: False)
+        info.update(episode_steps=steps, episode_truncated=truncated)
+        if self.reward == "success":
+            total = float(bool(info.get("is_success", False)))
+        return obs, total, True, False, info
+
+
+def _require_gains_mode(env: gym.Env, wrapper: str) -> None:
+    """ValueError unless `env` is in a gains action mode (which reads its action per cycle)."""
+    base = env.unwrapped
+    if not hasattr(type(base), "gains_due"):
+        raise ValueError(
+            f"{wrapper} needs an env with a gains action mode (HexapodIrregularTerrain-*), "
+            f"got {type(base).__name__}"
+        )
+    if getattr(base, "action_mode", None) != "gains":
+        raise ValueError(
+            f"{wrapper} needs action_mode='gains', got {base.action_mode!r}; the other "
+            "modes read their action at every step"
+        )

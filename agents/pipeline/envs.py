@@ -76,7 +76,8 @@ class EnvSpec:
     `ExcludeRewardTerms`); empty: the env's reward."""
     decision: str = "step"
     """"step": the learner acts at every env step; "gait_cycle": once per gait cycle, through
-    `hexapod_envs.wrappers.GainsPerCycle` (the irregular terrain's "gains" mode)."""
+    `hexapod_envs.wrappers.GainsPerCycle` (the irregular terrain's "gains" mode); "episode":
+    once per episode, through `hexapod_envs.wrappers.GainsPerEpisode`."""
     cycle_baseline: str = "none"
     """With decision "gait_cycle": "zero_action" rewards each cycle relative to the zero action
     replayed from the same state (`GainsPerCycle`'s ``baseline_action``); "none": plain."""
@@ -86,6 +87,8 @@ class EnvSpec:
     knobs: Any = None
     """`agents.knobs.KnobSettings` (or the training config's ``knobs`` section): one learner
     step per tipping event, which sets the recovery's knobs (`agents.knobs.KnobsPerEvent`)."""
+    episode_reward: str = "success"
+    """With decision "episode": the reward of the learner's one step, "success" or "return"."""
 
     def make(self, **extra: Any) -> gym.Env:
         """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
@@ -131,13 +134,23 @@ class EnvSpec:
             except ValueError as exc:
                 env.close()
                 raise UserError(f"env.decision='gait_cycle' on {self.id}: {exc}") from None
+        if self.decision == "episode":
+            from hexapod_envs.wrappers import GainsPerEpisode
+
+            try:
+                env = GainsPerEpisode(env, reward=self.episode_reward)
+            except ValueError as exc:
+                env.close()
+                raise UserError(f"env.decision='episode' on {self.id}: {exc}") from None
         return env
 
     def _check_decision(self) -> None:
         """`decision` and `cycle_baseline` name valid choices that fit together (before any env
         is built)."""
-        if self.decision not in ("step", "gait_cycle"):
-            raise UserError(f"env.decision must be 'step' or 'gait_cycle', got {self.decision!r}")
+        if self.decision not in ("step", "gait_cycle", "episode"):
+            raise UserError(
+                f"env.decision must be 'step', 'gait_cycle' or 'episode', got {self.decision!r}"
+            )
         if self.cycle_baseline not in ("none", "zero_action"):
             raise UserError(
                 f"env.cycle_baseline must be 'none' or 'zero_action', got {self.cycle_baseline!r}"

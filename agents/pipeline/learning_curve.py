@@ -29,7 +29,8 @@ class LearningCurve:
     successes: np.ndarray | None  # (n, episodes) 0/1; None if the env reports no is_success
     unit: str = "env steps"
     """What ``timesteps`` counts: the learner's steps, "env steps", "gait cycles" for a run
-    whose learner acts once per gait cycle (``env.decision: gait_cycle`` in its config) or
+    whose learner acts once per gait cycle (``env.decision: gait_cycle`` in its config),
+    "episodes" for one that acts once per episode (``env.decision: episode``) or
     "tipping events" for a knobs run (one learner step per episode, `agents.knobs`)."""
 
     @property
@@ -66,7 +67,7 @@ def load_learning_curve(run_dir: str | Path) -> LearningCurve:
     if config.is_file():
         data = yaml.safe_load(config.read_text()) or {}
         env = data.get("env") or {}
-        unit = "gait cycles" if env.get("decision") == "gait_cycle" else unit
+        unit = {"gait_cycle": "gait cycles", "episode": "episodes"}.get(env.get("decision"), unit)
         unit = "tipping events" if data.get("knobs") is not None else unit
     with np.load(path) as data:
         successes = data["successes"] if "successes" in data and data["successes"].size else None

@@ -96,6 +96,7 @@ def env_spec(config: TrainConfig) -> EnvSpec:
         env.cycle_baseline,
         config.policy.critic_privileged,
         config.knobs,
+        env.episode_reward,
     )
 
 
@@ -114,7 +115,7 @@ def _probe(
             env.reset(seed=0)
             env.step(np.zeros(env.action_space.shape, env.action_space.dtype))
         dt, specs = env_time_step(env), metric_specs(env)
-        if spec.decision == "gait_cycle" or spec.knobs is not None:
+        if spec.decision != "step" or spec.knobs is not None:
             dt = None  # a learner step is a gait cycle or an episode: no durations or energy
         xi = getattr(env.unwrapped, "tipping_threshold_deg", XI_F_DEG)
         settings = resolved_settings(env)
@@ -150,9 +151,12 @@ def _vec_envs(config: TrainConfig, seed: int, stats: NormalizationStats | None =
             subprocess=config.vec_env.use_subprocess,
             start_method=config.vec_env.start_method,
         )
-    # Evaluations act at every env step (the same actions as per gait cycle, see GainsPerCycle),
-    # so that their episode metrics see every step's info.
-    eval_spec = dataclasses.replace(spec, decision="step", cycle_baseline="none")
+    # Evaluations of a per-cycle learner act at every env step (the same actions as per gait
+    # cycle, see GainsPerCycle), so that their episode metrics see every step's info; a
+    # per-episode learner's act once per episode, as it was trained.
+    eval_spec = spec
+    if spec.decision == "gait_cycle":
+        eval_spec = dataclasses.replace(spec, decision="step", cycle_baseline="none")
     eval_env = DummyVecEnv([EnvFactory(eval_spec)]) if config.eval.freq > 0 else None
     if eval_env is not None:
         eval_env.seed(seed + EVAL_SEED_OFFSET)

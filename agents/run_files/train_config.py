@@ -70,11 +70,17 @@ class EnvConfig:
     reward_exclude: list[str] = field(default_factory=list)
     """Reward terms (``info["reward_<term>"]``) taken out of the reward the learner sees
     (`agents.pipeline.envs.ExcludeRewardTerms`); the evaluation reports the env's own return."""
-    decision: Literal["step", "gait_cycle"] = "step"
-    """When the learner acts: every env step, or once per gait cycle (`gait_cycle`: the
+    decision: Literal["step", "gait_cycle", "episode"] = "step"
+    """When the learner acts: every env step, once per gait cycle (`gait_cycle`: the
     irregular terrain's "gains" mode through `hexapod_envs.wrappers.GainsPerCycle`; training
     steps then count gait cycles, and the training episodes' TensorBoard statistics see each
-    cycle's last step only; evaluations still run every env step, see the wrapper)."""
+    cycle's last step only; evaluations still run every env step, see the wrapper), or once
+    per episode (`episode`: the gains mode with one setting held over the whole episode,
+    `hexapod_envs.wrappers.GainsPerEpisode`; training steps and evaluations count episodes,
+    rewarded as ``episode_reward`` says)."""
+    episode_reward: Literal["success", "return"] = "success"
+    """With ``decision: episode``: the learner's reward per episode, "success" (1 when it meets
+    the env's success rule, else 0) or "return" (the env's rewards summed)."""
     cycle_baseline: Literal["none", "zero_action"] = "none"
     """With ``decision: gait_cycle``: "zero_action" makes each cycle's reward the difference to
     the same cycle replayed from the same state with the zero action (a hybrid run's paper

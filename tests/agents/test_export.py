@@ -125,3 +125,6 @@ def test_a_gains_cards_learned_part_names_the_height_knob_when_the_env_has_it():
     env["kwargs"]["gains_height_offset_m"] = 0.04
     knob = _learned_part({"env": env})
     assert "fourth value in [-1, 1] x 0.04 m" in knob and knob.endswith("once per gait cycle")
+    env["decision"] = "episode"
+    held = "chosen once per episode at its first observation and held"
+    assert _learned_part({"env": env}).endswith(held)

@@ -50,6 +50,12 @@ def test_gait_cycle_runs_count_env_steps_per_cycle(tmp_path):
     assert time_to_beat(run).beat_env_steps == 1000 * 200 / 4.0
 
 
+def test_per_episode_runs_have_no_env_step_count(tmp_path):
+    run = _run(tmp_path / "e", [0.2, 0.4], decision="episode")
+    result = time_to_beat(run)
+    assert result.beat_learner_steps == 1000 and result.beat_env_steps is None
+
+
 def test_a_sweep_directory_means_its_trials_and_the_table_counts_them(tmp_path, capsys):
     _run(tmp_path / "sweep" / "trial_00000", [0.5, 0.6])
     _run(tmp_path / "sweep" / "trial_00001", [0.5, 0.5])

@@ -72,7 +72,7 @@ def test_env_spec_decision_builds_the_wrapper_and_names_bad_values():
     assert env.step(np.zeros(3, dtype=np.float32))[-1]["cycle_steps"] >= 1
     with pytest.raises(UserError, match="gait_cycle.*action_mode='gains'"):
         EnvSpec(ENV_ID, gym_packages=["hexapod_envs"], decision="gait_cycle").make()
-    with pytest.raises(UserError, match="'step' or 'gait_cycle', got 'cycle'"):
+    with pytest.raises(UserError, match="'step', 'gait_cycle' or 'episode', got 'cycle'"):
         EnvSpec(ENV_ID, dict(GAINS), gym_packages=["hexapod_envs"], decision="cycle").make()
 
 
