@@ -9,6 +9,10 @@ it raises the level by `step` when the success rate of those episodes reached `p
 (and lowers it by `step` below `demote_at`).
 
     env = DifficultyCurriculum(gym.make("HexapodCliffWalk-v1", task_distribution="train"))
+
+`MinimumDifficulty` keeps the hard part of a distribution instead (tasks at least `minimum`):
+for a learner whose settings only matter on hard tasks, such as ATHENA's body height, which pays
+on tall block beds, so that its episodes carry a signal.
 """
 
 from __future__ import annotations
@@ -43,11 +47,7 @@ class DifficultyCurriculum(gym.Wrapper):
         max_draws: int = 50,
     ):
         super().__init__(env)
-        if getattr(env.unwrapped, "task_distribution", None) == "paper":
-            raise ValueError(
-                "DifficultyCurriculum draws sampled tasks: make the env with "
-                'task_distribution="train" (or "test"), not "paper"'
-            )
+        _require_sampled(env, type(self).__name__)
         check_number("level", level, high=1.0)
         check_number("step", step, high=1.0)
         if not 0.0 <= check_number("demote_at", demote_at) < promote_at <= 1.0:
@@ -62,11 +62,7 @@ class DifficultyCurriculum(gym.Wrapper):
         self._results: list[bool] = []
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        obs, info = self.env.reset(seed=seed, options=options)
-        for _ in range(self.max_draws - 1):
-            if info["task"]["difficulty"] <= self.level:
-                break
-            obs, info = self.env.reset(options=options)  # the next task from np_random
+        obs, info = _draw(self.env, seed, options, self.max_draws, lambda d: d <= self.level)
         return obs, {**info, "curriculum_level": self.level}
 
     def step(self, action):
@@ -85,3 +81,39 @@ class DifficultyCurriculum(gym.Wrapper):
         elif rate < self.demote_at:
             self.level = max(0.0, self.level - self.level_step)
         self._results.clear()
+
+
+class MinimumDifficulty(gym.Wrapper):
+    """Tasks of difficulty at least `minimum` (see the module docstring): each reset draws tasks
+    (through the env's own ``np_random``) until one is; after `max_draws` the last one is kept.
+    ``info["task_draws"]`` counts the draws of the reset."""
+
+    def __init__(self, env: gym.Env, minimum: float, max_draws: int = 100):
+        super().__init__(env)
+        _require_sampled(env, type(self).__name__)
+        self.minimum = check_number("minimum", minimum, high=1.0)
+        if int(max_draws) < 1:
+            raise ValueError(f"max_draws must be >= 1, got {max_draws!r}")
+        self.max_draws = int(max_draws)
+
+    def reset(self, *, seed: int | None = None, options: dict | None = None):
+        return _draw(self.env, seed, options, self.max_draws, lambda d: d >= self.minimum)
+
+
+def _require_sampled(env: gym.Env, wrapper: str) -> None:
+    if getattr(env.unwrapped, "task_distribution", None) == "paper":
+        raise ValueError(
+            f"{wrapper} draws sampled tasks: make the env with "
+            'task_distribution="train" (or "test"), not "paper"'
+        )
+
+
+def _draw(env: gym.Env, seed, options, max_draws: int, accept) -> tuple:
+    """Reset `env` (with `seed`, then from its ``np_random``) until ``accept(difficulty)`` or
+    `max_draws` resets; the last reset's result with ``info["task_draws"]``."""
+    obs, info = env.reset(seed=seed, options=options)
+    draws = 1
+    while draws < max_draws and not accept(info["task"]["difficulty"]):
+        obs, info = env.reset(options=options)  # the next task from np_random
+        draws += 1
+    return obs, {**info, "task_draws": draws}

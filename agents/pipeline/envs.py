@@ -89,6 +89,9 @@ class EnvSpec:
     step per tipping event, which sets the recovery's knobs (`agents.knobs.KnobsPerEvent`)."""
     episode_reward: str = "success"
     """With decision "episode": the reward of the learner's one step, "success" or "return"."""
+    min_task_difficulty: float | None = None
+    """Only sampled tasks of at least this difficulty (`hexapod_envs.curriculum.MinimumDifficulty`,
+    the innermost wrapper); None: every task of the distribution."""
 
     def make(self, **extra: Any) -> gym.Env:
         """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
@@ -103,6 +106,14 @@ class EnvSpec:
         except (TypeError, ValueError) as exc:
             message = str(exc).split(" was raised from the environment creator")[0]
             raise UserError(f"cannot create {self.id} with {self.kwargs}: {message}") from None
+        if self.min_task_difficulty is not None:
+            from hexapod_envs.curriculum import MinimumDifficulty
+
+            try:
+                env = MinimumDifficulty(env, self.min_task_difficulty)
+            except ValueError as exc:
+                env.close()
+                raise UserError(f"env.min_task_difficulty on {self.id}: {exc}") from None
         if self.privileged_critic:
             from ..privileged_critic import PrivilegedObservation
 

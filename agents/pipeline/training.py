@@ -97,6 +97,7 @@ def env_spec(config: TrainConfig) -> EnvSpec:
         config.policy.critic_privileged,
         config.knobs,
         env.episode_reward,
+        env.min_task_difficulty,
     )
 
 

@@ -81,6 +81,10 @@ class EnvConfig:
     episode_reward: Literal["success", "return"] = "success"
     """With ``decision: episode``: the learner's reward per episode, "success" (1 when it meets
     the env's success rule, else 0) or "return" (the env's rewards summed)."""
+    min_task_difficulty: float | None = None
+    """Train (and evaluate during training) on the sampled tasks of difficulty at least this
+    (`hexapod_envs.curriculum.MinimumDifficulty`, drawn through the env's ``np_random``); None:
+    the whole ``task_distribution``."""
     cycle_baseline: Literal["none", "zero_action"] = "none"
     """With ``decision: gait_cycle``: "zero_action" makes each cycle's reward the difference to
     the same cycle replayed from the same state with the zero action (a hybrid run's paper

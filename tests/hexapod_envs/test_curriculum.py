@@ -1,4 +1,5 @@
-"""The difficulty curriculum: tasks under the level, the level raised with success."""
+"""The difficulty curriculum (tasks under the level, the level raised with success) and the
+minimum difficulty (the hard part of a distribution)."""
 
 from __future__ import annotations
 
@@ -7,7 +8,7 @@ import numpy as np
 import pytest
 
 import hexapod_envs  # noqa: F401
-from hexapod_envs.curriculum import DifficultyCurriculum
+from hexapod_envs.curriculum import DifficultyCurriculum, MinimumDifficulty
 
 
 def _env(**kwargs):
@@ -51,3 +52,32 @@ def test_bad_settings_are_named():
         _env(promote_at=0.2, demote_at=0.5)
     with pytest.raises(ValueError, match='task_distribution="train"'):
         DifficultyCurriculum(gym.make("HexapodCliffWalk-v1"))
+
+
+def test_a_minimum_difficulty_keeps_the_hard_tasks_reproducibly():
+    def hard():
+        return MinimumDifficulty(gym.make("HexapodCliffWalk-v1", task_distribution="train"), 0.6)
+
+    env = hard()
+    infos = [env.reset(seed=s)[1] for s in (3, None, None, None)]
+    assert min(i["task"]["difficulty"] for i in infos) >= 0.6
+    assert max(i["task_draws"] for i in infos) > 1  # easier tasks were drawn and passed over
+    again = hard()
+    assert [again.reset(seed=s)[1]["task"] for s in (3, None, None, None)] == [
+        i["task"] for i in infos
+    ]
+    with pytest.raises(ValueError, match=r"minimum must be a finite number .*got 1.5"):
+        MinimumDifficulty(gym.make("HexapodCliffWalk-v1", task_distribution="train"), 1.5)
+    with pytest.raises(ValueError, match="MinimumDifficulty draws sampled tasks"):
+        MinimumDifficulty(gym.make("HexapodCliffWalk-v1"), 0.5)
+
+
+def test_the_training_config_builds_it_and_names_a_bad_value():
+    from agents.pipeline.envs import EnvSpec
+    from agents.run_files.errors import UserError
+
+    kwargs = {"task_distribution": "train"}
+    spec = EnvSpec("HexapodCliffWalk-v1", kwargs, min_task_difficulty=0.6)
+    assert spec.make().reset(seed=0)[1]["task"]["difficulty"] >= 0.6
+    with pytest.raises(UserError, match="env.min_task_difficulty on HexapodCliffWalk-v1"):
+        EnvSpec("HexapodCliffWalk-v1", kwargs, min_task_difficulty=-1).make()
