@@ -66,7 +66,9 @@ class HybridSettings:
 
     Attributes:
         mode: "residual" (analytical + scale x a) or "safety" (scale x a, analytical below ξ).
-        scale: multiplier of the learned action, in env action units (> 0).
+        scale: multiplier of the learned action, in env action units (> 0); or one per action
+            dimension (>= 0, not all 0: a 0 keeps that dimension at the analytical
+            controller's, e.g. the paper's gains while a learner sets the body height).
         safety_filter: residual mode: drop the residual while the FASM is below ξ.
         threshold_deg: ξ [deg]; None: ``env.unwrapped.tipping_threshold_deg`` or 20 (an env
             that declares None, judged by another criterion, needs it for the override).
@@ -77,7 +79,7 @@ class HybridSettings:
     """
 
     mode: Literal["residual", "safety"] = "residual"
-    scale: float = 0.1
+    scale: float | list[float] = 0.1
     safety_filter: bool = False
     threshold_deg: float | None = None
     release_margin_deg: float = 5.0
@@ -86,7 +88,16 @@ class HybridSettings:
     def __post_init__(self):
         if self.mode not in MODES:
             raise ValueError(f"hybrid mode must be one of {MODES}, got {self.mode!r}")
-        if not np.isfinite(self.scale) or self.scale <= 0:
+        if isinstance(self.scale, list | tuple):
+            scales = np.asarray(self.scale, dtype=float)
+            if not (scales.size and np.all(np.isfinite(scales)) and (scales >= 0).all()):
+                raise ValueError(
+                    f"hybrid scale per action dimension must be finite numbers >= 0, "
+                    f"got {self.scale}"
+                )
+            if not scales.any():
+                raise ValueError(f"hybrid scale must not be 0 in every dimension: {self.scale}")
+        elif not np.isfinite(self.scale) or self.scale <= 0:
             raise ValueError(f"hybrid scale must be a finite number > 0, got {self.scale}")
         if not np.isfinite(self.release_margin_deg) or self.release_margin_deg < 0:
             raise ValueError(
@@ -152,6 +163,12 @@ class HybridCore:
         self.threshold_deg = None if threshold is None else float(threshold)
         self.base = base if base is not None else analytical_policy(env)
         self.overriding = False
+        self.scale = np.asarray(settings.scale, dtype=self.space.dtype)
+        if self.scale.ndim and self.scale.shape != self.space.shape:
+            raise ValueError(
+                f"hybrid scale has {self.scale.size} values, one per action dimension, but "
+                f"the action space is {self.space}"
+            )
 
     def reset(self) -> None:
         self.base.reset()
@@ -186,9 +203,9 @@ class HybridCore:
         if override:
             action = base
         elif self.settings.mode == "residual":
-            action = base + self.settings.scale * learned
+            action = base + self.scale * learned
         else:
-            action = self.settings.scale * learned
+            action = self.scale * learned
         return np.clip(action, self.space.low, self.space.high).astype(self.space.dtype), override
 
 

@@ -132,6 +132,12 @@ def test_residual_adds_scale_times_action_and_clips_to_the_space():
     assert not override and base.calls == 1 and base.resets == 1
     big, _ = HybridCore(env, HybridSettings(scale=10.0), base=base)(obs, np.ones(18))
     np.testing.assert_array_equal(big, env.action_space.high)  # 0.3 + 10 clipped
+    # One scale per dimension: 0 keeps a dimension at the analytical action.
+    scales = [0.0] * 17 + [0.5]
+    per_dim, _ = HybridCore(env, HybridSettings(scale=scales), base=base)(obs, learned)
+    np.testing.assert_allclose(per_dim, np.r_[np.full(17, 0.3), 0.3 + 0.5], atol=1e-6)
+    with pytest.raises(ValueError, match="hybrid scale has 2 values, one per action dimension"):
+        HybridCore(env, HybridSettings(scale=[0.1, 0.2]), base=base)
 
 
 class ScriptedBase:
@@ -248,6 +254,8 @@ def test_policy_combines_a_learned_policy_like_the_wrapper():
         ({"mode": "blend"}, "hybrid mode must be one of"),
         ({"scale": 0.0}, "hybrid scale must be a finite number > 0"),
         ({"scale": float("nan")}, "hybrid scale must be a finite number > 0"),
+        ({"scale": [0.0, -0.1]}, "scale per action dimension must be finite numbers >= 0"),
+        ({"scale": [0.0, 0.0]}, "scale must not be 0 in every dimension"),
         ({"release_margin_deg": -1.0}, "release_margin_deg must be a finite number >= 0"),
         ({"threshold_deg": float("inf")}, "threshold_deg must be finite or None"),
     ],
