@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
+from ..run_files.artifacts import learner_step_unit
 from ..run_files.errors import UserError
 
 EVALUATIONS_FILE = "evaluations.npz"
@@ -62,13 +63,8 @@ def load_learning_curve(run_dir: str | Path) -> LearningCurve:
             f"{run_dir} has no {EVALUATIONS_FILE}: the run has not been evaluated yet "
             "(eval.freq 0, or fewer than eval.freq steps trained)"
         )
-    unit = "env steps"
     config = Path(run_dir) / "config.yaml"
-    if config.is_file():
-        data = yaml.safe_load(config.read_text()) or {}
-        env = data.get("env") or {}
-        unit = {"gait_cycle": "gait cycles", "episode": "episodes"}.get(env.get("decision"), unit)
-        unit = "tipping events" if data.get("knobs") is not None else unit
+    unit = learner_step_unit(yaml.safe_load(config.read_text()) if config.is_file() else None)
     with np.load(path) as data:
         successes = data["successes"] if "successes" in data and data["successes"].size else None
         return LearningCurve(

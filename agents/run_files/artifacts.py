@@ -128,16 +128,29 @@ def read_meta(model_dir: Path) -> dict[str, Any]:
 
 
 def checkpoint_note(model_dir: Path) -> str:
-    """The text ' (<kind> checkpoint at <n> env steps)' from a model directory's meta.json,
-    saying so when it is the initial policy (a best/ that no later evaluation beat); '' without
-    a meta.json."""
+    """The text ' (<kind> checkpoint at <n> <unit>)' from a model directory's meta.json (the
+    unit from the config.yaml beside it, `learner_step_unit`), saying so when it is the initial
+    policy (a best/ that no later evaluation beat); '' without a meta.json."""
     meta = read_meta(model_dir)
     steps = meta.get("num_timesteps")
     if steps is None:
         return ""
     kind = meta.get("kind", "saved")
     initial = ": the initial policy, no training step kept" if steps == 0 else ""
-    return f" ({kind} checkpoint at {steps} env steps{initial})"
+    config = Path(model_dir) / "config.yaml"
+    unit = learner_step_unit(load_yaml(config) if config.is_file() else None)
+    return f" ({kind} checkpoint at {steps} {unit}{initial})"
+
+
+def learner_step_unit(config: dict | None) -> str:
+    """What a run's learner steps count, from its resolved config: "env steps", "gait cycles"
+    (``env.decision: gait_cycle``), "episodes" (``env.decision: episode``) or "tipping events"
+    (a ``knobs`` run, one step per episode at the controller's tipping judgment)."""
+    config = config or {}
+    if config.get("knobs") is not None:
+        return "tipping events"
+    decision = (config.get("env") or {}).get("decision")
+    return {"gait_cycle": "gait cycles", "episode": "episodes"}.get(decision, "env steps")
 
 
 def checkpoint_dir(run_dir: Path, num_timesteps: int) -> Path:

@@ -208,6 +208,9 @@ def test_the_report_says_which_checkpoint_it_evaluated(report):
         assert f"({meta['kind']} checkpoint at {meta['num_timesteps']} env steps" in md
     note = checkpoint_note("models/HexapodIrregularTerrain-v0/hybrid")
     assert note == " (best checkpoint at 0 env steps: the initial policy, no training step kept)"
+    # learner steps in the run's own unit (its config.yaml)
+    assert "at 3072 tipping events)" in checkpoint_note("models/HexapodStewartTilt-v1/knobs")
+    assert "at 640 episodes)" in checkpoint_note("models/HexapodIrregularTerrain-v1/knobs")
 
 
 def test_speed_gets_no_verdict_where_the_robot_stands(report):
