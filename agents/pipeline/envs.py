@@ -109,11 +109,9 @@ class EnvSpec:
         if self.min_task_difficulty is not None:
             from hexapod_envs.curriculum import MinimumDifficulty
 
-            try:
-                env = MinimumDifficulty(env, self.min_task_difficulty)
-            except ValueError as exc:
-                env.close()
-                raise UserError(f"env.min_task_difficulty on {self.id}: {exc}") from None
+            minimum = self.min_task_difficulty
+            where = f"env.min_task_difficulty on {self.id}"
+            env = _wrapped(env, lambda e: MinimumDifficulty(e, minimum), where)
         if self.privileged_critic:
             from ..privileged_critic import PrivilegedObservation
 
@@ -121,17 +119,11 @@ class EnvSpec:
         if self.knobs is not None:
             from ..knobs import KnobsPerEvent, settings_from_config
 
-            try:
-                env = KnobsPerEvent(env, settings_from_config(self.knobs))
-            except ValueError as exc:
-                env.close()
-                raise UserError(f"cannot build the knobs env on {self.id}: {exc}") from None
+            where = f"cannot build the knobs env on {self.id}"
+            env = _wrapped(env, lambda e: KnobsPerEvent(e, settings_from_config(self.knobs)), where)
         if self.hybrid is not None:
-            try:
-                env = wrap(env, self.hybrid)
-            except ValueError as exc:
-                env.close()
-                raise UserError(f"cannot build the hybrid policy env on {self.id}: {exc}") from None
+            where = f"cannot build the hybrid policy env on {self.id}"
+            env = _wrapped(env, lambda e: wrap(e, self.hybrid), where)
         if self.reward_exclude:
             env = ExcludeRewardTerms(env, self.reward_exclude)
         if self.decision == "gait_cycle":
@@ -140,19 +132,13 @@ class EnvSpec:
             baseline = None
             if self.cycle_baseline == "zero_action":
                 baseline = np.zeros(env.action_space.shape, dtype=env.action_space.dtype)
-            try:
-                env = GainsPerCycle(env, baseline_action=baseline)
-            except ValueError as exc:
-                env.close()
-                raise UserError(f"env.decision='gait_cycle' on {self.id}: {exc}") from None
+            where = f"env.decision='gait_cycle' on {self.id}"
+            env = _wrapped(env, lambda e: GainsPerCycle(e, baseline_action=baseline), where)
         if self.decision == "episode":
             from hexapod_envs.wrappers import GainsPerEpisode
 
-            try:
-                env = GainsPerEpisode(env, reward=self.episode_reward)
-            except ValueError as exc:
-                env.close()
-                raise UserError(f"env.decision='episode' on {self.id}: {exc}") from None
+            where = f"env.decision='episode' on {self.id}"
+            env = _wrapped(env, lambda e: GainsPerEpisode(e, reward=self.episode_reward), where)
         return env
 
     def _check_decision(self) -> None:
@@ -171,6 +157,15 @@ class EnvSpec:
                 "env.cycle_baseline needs env.decision: gait_cycle (the baseline replays whole "
                 f"gait cycles), got decision {self.decision!r}"
             )
+
+
+def _wrapped(env: gym.Env, wrapper: Any, where: str) -> gym.Env:
+    """``wrapper(env)``; a ValueError of it closes `env` and becomes a UserError "where: ..."."""
+    try:
+        return wrapper(env)
+    except ValueError as exc:
+        env.close()
+        raise UserError(f"{where}: {exc}") from None
 
 
 class ExcludeRewardTerms(gym.Wrapper):
