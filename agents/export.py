@@ -20,10 +20,10 @@
 
 A hybrid model (its config has a ``hybrid`` section: the learned action combined with the env's
 analytical controller), a knobs model (a ``knobs`` section: the learned action sets the tipping
-recovery's settings at its judgment) and the irregular terrain's gains models (the learned
-action is the posture gains, applied once per gait cycle) are exported as their learned actor
-only; the card says what the robot must add around it. The export needs the ``[export]`` extra
-(``onnx``; ``onnxruntime`` to check the file).
+recovery's settings at its judgment, or the ditch planner's from the course) and the irregular
+terrain's gains models (the learned action is the posture gains, applied once per gait cycle)
+are exported as their learned actor only; the card says what the robot must add around it. The
+export needs the ``[export]`` extra (``onnx``; ``onnxruntime`` to check the file).
 """
 
 from __future__ import annotations
@@ -39,7 +39,7 @@ from typing import Any
 
 import numpy as np
 
-from .knobs import KNOB_RANGES
+from .knobs import KNOB_RANGES, PLANNER_KNOB_RANGES, KnobSettings
 from .pipeline.cli import _add_trust_pickle_option, _run
 from .policy import LearnedWithController
 from .run_files.artifacts import ModelFiles, find_model, read_meta
@@ -161,8 +161,21 @@ def _learned_part(config: dict[str, Any]) -> str:
             f"{hybrid.get('mode')!r}, scale {hybrid.get('scale')}, safety_filter "
             f"{hybrid.get('safety_filter')}; agents.hybrid), which the robot must run beside it"
         )
-    if config.get("knobs") is not None:
-        names = config["knobs"].get("names")
+    knobs = config.get("knobs")
+    if knobs is not None and KnobSettings(names=knobs["names"]).controller == "planner":
+        names = knobs["names"]
+        spans = ", ".join(
+            f"{n} {PLANNER_KNOB_RANGES[n][0]}..{PLANNER_KNOB_RANGES[n][1]} m" for n in names
+        )
+        notes.append(
+            f"planner knobs model: the input is the course (the ditch's distance ahead, width "
+            f"and depth [m]), the action {len(names)} values in [-1, 1] that set the ditch "
+            f"planner's settings (0: the env's own, +-1: the ends of the ranges {spans}; "
+            "agents.plan_knobs), chosen once per episode; the planner (agents.upu_gait) plans "
+            "and walks with them, with its own settings where they give no plan"
+        )
+    elif knobs is not None:
+        names = knobs.get("names")
         spans = ", ".join(f"{n} {KNOB_RANGES[n][0]}..{KNOB_RANGES[n][1]}" for n in names)
         notes.append(
             f"knobs model: the action is {len(names)} values in [-1, 1] that set the tipping "
@@ -298,6 +311,13 @@ def model_card(
     spec = env.spec
     unwrapped = env.unwrapped
     structure = getattr(unwrapped, "observation_structure", None) or {}
+    observation_space = env.observation_space
+    knobs = config.get("knobs")
+    if knobs is not None and KnobSettings(names=knobs["names"]).controller == "planner":
+        from .plan_knobs import COURSE_FEATURES, course_space
+
+        observation_space = course_space()  # a planner-knob actor sees the course, once
+        structure = {name: slice(i, i + 1) for i, name in enumerate(COURSE_FEATURES)}
     folded = []
     if stats is not None and stats.norm_obs:
         folded.append(
@@ -322,8 +342,8 @@ def model_card(
             "control_dt_s": None if control_dt is None else float(control_dt),
         },
         "observation": {
-            "shape": list(env.observation_space.shape),
-            "dtype": str(env.observation_space.dtype),
+            "shape": list(observation_space.shape),
+            "dtype": str(observation_space.dtype),
             "layout": [
                 {"name": name, "start": sl.start, "stop": sl.stop}
                 for name, sl in sorted(structure.items(), key=lambda item: item[1].start)
@@ -468,7 +488,7 @@ def export_model(
             )
         out.parent.mkdir(parents=True, exist_ok=True)
         module = actor_module(policy.model, policy.stats)
-        write_onnx(module, env.observation_space.shape[0], out)
+        write_onnx(module, policy.model.observation_space.shape[0], out)
         space = policy.model.action_space
         card = model_card(files, env, policy.stats, out.name, space, report)
     finally:

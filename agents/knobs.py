@@ -1,4 +1,8 @@
-"""Learned controller knobs: a policy that tunes the tipping recovery at its tipping judgment.
+"""Learned controller knobs: a policy that tunes an analytical controller's settings per situation.
+
+Two controllers have knobs. The ditch planner's (`agents.plan_knobs`, `PLANNER_KNOB_RANGES`) are
+set once per episode from the ditch the planner plans for. The heavy-duty robot's tipping
+recovery's are set at its tipping judgment, as follows.
 
 The heavy-duty robot's recovery (Zhang et al. 2024, `agents.tipping`) plans its rescue step when
 it judges tipping: the foothold's safety factor ρ, the swing time's share ϰ of the forecast
@@ -36,7 +40,7 @@ import numpy as np
 
 from .policy import LearnedWithController, Policy, settings_from_section
 from .registry import analytical_policy
-from .tipping.controller import RecoveryConfig, TippingRecoveryPolicy
+from .tipping.controller import TippingRecoveryPolicy
 
 KNOB_RANGES: dict[str, tuple[float, float]] = {
     "rho": (0.4, 1.0),
@@ -52,6 +56,17 @@ KNOB_RANGES: dict[str, tuple[float, float]] = {
 of the field: ρ, ϰ and the force gain dimensionless, angles in deg, times in s, the clearance in
 m, the touchdown speed in m/s). Only fields the controller reads when it uses them (at judgment,
 in the swing, at touchdown, in support) are here, so a setting made at the event takes effect."""
+
+PLANNER_KNOB_RANGES: dict[str, tuple[float, float]] = {
+    "edge_clearance": (0.0, 0.05),
+    "min_margin": (0.0, 0.03),
+    "max_stride": (0.10, 0.16),
+    "lift": (0.04, 0.10),
+}
+"""`hexapod_envs.robots.upu.gait_plan.GaitSettings` fields a policy may set per episode on the
+ditch crossing (`agents.plan_knobs`), with the range a learned knob spans [m]: the gap a landing
+foot keeps from a ditch edge, the static margin every three-leg support must keep, the longest
+platform step (eq. 17's 0.16 m is the most the mechanism allows) and the upper platform's lift."""
 
 REWARDS = ("success", "return")
 
@@ -75,10 +90,12 @@ class KnobSettings:
 
     def __post_init__(self):
         self.names = names = tuple(self.names)
-        unknown = [n for n in names if n not in KNOB_RANGES]
-        if not names or unknown or len(set(names)) != len(names):
+        table = next((t for t in (KNOB_RANGES, PLANNER_KNOB_RANGES) if set(names) <= set(t)), None)
+        if not names or table is None or len(set(names)) != len(names):
             raise ValueError(
-                f"knobs.names must be distinct names from {sorted(KNOB_RANGES)}, got {list(names)}"
+                f"knobs.names must be distinct names, all of the tipping recovery's "
+                f"{sorted(KNOB_RANGES)} or all of the ditch planner's "
+                f"{sorted(PLANNER_KNOB_RANGES)}, got {list(names)}"
             )
         if not np.isfinite(self.event_margin_deg) or self.event_margin_deg < 0:
             raise ValueError(
@@ -92,9 +109,20 @@ class KnobSettings:
         """The learned action: one value in [-1, 1] per knob."""
         return gym.spaces.Box(-1.0, 1.0, shape=(len(self.names),), dtype=np.float32)
 
+    @property
+    def controller(self) -> Literal["recovery", "planner"]:
+        """Whose knobs these are: the tipping recovery's or the ditch planner's."""
+        return "recovery" if set(self.names) <= set(KNOB_RANGES) else "planner"
 
-def knob_values(default: RecoveryConfig, names: tuple[str, ...], action) -> dict[str, float]:
-    """The settings a learned action means: ``a = 0`` the default, ``±1`` the range's ends.
+
+def knob_values(
+    default: Any,
+    names: tuple[str, ...],
+    action,
+    ranges: dict[str, tuple[float, float]] = KNOB_RANGES,
+) -> dict[str, float]:
+    """The settings a learned action means: ``a = 0`` the default (attribute of `default`),
+    ``±1`` the ends of the knob's range in `ranges`.
 
     Values of ``a`` outside [-1, 1] are clipped. A default outside a knob's range widens the
     range to it, so the mapping stays monotone.
@@ -107,7 +135,7 @@ def knob_values(default: RecoveryConfig, names: tuple[str, ...], action) -> dict
         )
     values = {}
     for name, a in zip(names, action, strict=True):
-        low, high = KNOB_RANGES[name]
+        low, high = ranges[name]
         base = float(getattr(default, name))
         end = max(high, base) if a >= 0 else min(low, base)
         values[name] = base + abs(float(a)) * (end - base)
@@ -267,3 +295,32 @@ class KnobPolicy(LearnedWithController):
 def settings_from_config(section: Any) -> KnobSettings | None:
     """`KnobSettings` from a config's ``knobs`` section (a dataclass or a mapping), or None."""
     return settings_from_section(KnobSettings, section)
+
+
+def knobs_env(env: gym.Env, settings: KnobSettings) -> gym.Env:
+    """The env a learner of `settings` trains on: `KnobsPerEvent` for the recovery's knobs,
+    `agents.plan_knobs.PlanKnobsPerEpisode` for the ditch planner's."""
+    if settings.controller == "planner":
+        from .plan_knobs import PlanKnobsPerEpisode
+
+        return PlanKnobsPerEpisode(env, settings)
+    return KnobsPerEvent(env, settings)
+
+
+def knobs_policy(learned: Policy, env: gym.Env, settings: KnobSettings) -> Policy:
+    """A trained knob policy with the controller it tunes, as a per-step `Policy` on `env`."""
+    if settings.controller == "planner":
+        from .plan_knobs import PlanKnobPolicy
+
+        return PlanKnobPolicy(learned, env, settings)
+    return KnobPolicy(learned, env, settings)
+
+
+def knobs_observation_space(env: gym.Env, settings: KnobSettings) -> gym.spaces.Box:
+    """What the knob policy sees: the env's observation at the tipping event (recovery), or the
+    course the planner plans for (`agents.plan_knobs.COURSE_FEATURES`)."""
+    if settings.controller == "planner":
+        from .plan_knobs import course_space
+
+        return course_space()
+    return env.observation_space

@@ -17,7 +17,7 @@ import gymnasium as gym
 import numpy as np
 
 from .hybrid import from_run_config
-from .knobs import KnobPolicy, KnobSettings
+from .knobs import KnobSettings, knobs_observation_space, knobs_policy
 from .knobs import settings_from_config as knob_settings
 from .policy import Policy
 from .privileged_critic import pad_observation, privileged_space
@@ -60,7 +60,7 @@ class PPOPolicy:
         `agents.run_files.model_files`; pickled files of older runs only with ``trust_pickle``).
         A hybrid run's model comes back combined with `env`'s analytical controller as in
         training (`agents.hybrid.HybridPolicy`), a knobs run's as the controller it tunes
-        (`agents.knobs.KnobPolicy`)."""
+        (`agents.knobs.knobs_policy`)."""
         files = find_model(path)
         config = files.training_config()
         env_id = env.spec.id if env.spec is not None else None
@@ -74,14 +74,16 @@ class PPOPolicy:
             raise other_env_error(files, trained_for, env_id)
         train_config = load_train_config(data=config)
         privileged = train_config.policy.critic_privileged
-        observation_space = env.observation_space
-        if privileged:
-            observation_space = privileged_space(observation_space)
         meta = read_meta(files.directory)
         try:
             knobs = knob_settings(config.get("knobs"))
         except ValueError as exc:
             raise UserError(f"cannot use the model at {files.model}: {exc}") from None
+        observation_space = env.observation_space
+        if knobs is not None:
+            observation_space = knobs_observation_space(env, knobs)
+        if privileged:
+            observation_space = privileged_space(observation_space)
         action_space = env.action_space if knobs is None else knobs.action_space
         for what, key, env_space in (
             ("observation", "observation_shape", observation_space),
@@ -127,7 +129,7 @@ def _as_trained(
 ) -> Any:
     """The policy as its run used it: a hybrid run's ``hybrid`` config section re-creates the
     combination with the env's analytical controller (`agents.hybrid.from_run_config`), a knobs
-    run's settings (its ``knobs`` section) the controller it tunes (`agents.knobs.KnobPolicy`),
+    run's settings (its ``knobs`` section) the controller it tunes (`agents.knobs.knobs_policy`),
     and a run that decided once per episode (``env.decision: episode``) holds its first action
     (`HeldPerEpisode`)."""
     learned: Policy = policy
@@ -135,7 +137,7 @@ def _as_trained(
         learned = HeldPerEpisode(policy)
     try:
         if knobs is not None:
-            return KnobPolicy(policy, env, knobs)
+            return knobs_policy(policy, env, knobs)
         return from_run_config(learned, env, config)
     except ValueError as exc:
         raise UserError(f"cannot use the model at {policy.files.model}: {exc}") from None

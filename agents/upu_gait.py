@@ -103,15 +103,16 @@ class UpuGaitPolicy(EnvBound):
         params = self.task.robot
         terrain, start_x, width, depth, x0, control_dt = course
         ditch = Ditch(start_x, width, depth)
-        if course not in self._cache:
+        key = (course, self.settings)  # learned planner knobs change the settings per episode
+        if key not in self._cache:
             if terrain == "flat":
                 plan = plan_flat_past(params, ditch.end_x, x0, self.settings)
             else:
                 plan = plan_ditch_crossing(params, ditch, x0, self.settings)
             if len(self._cache) >= 64:  # randomised ditches: keep the cache bounded
                 self._cache.clear()
-            self._cache[course] = (plan, GaitSchedule(plan, params, control_dt, self.timing))
-        self._plan, self._schedule = self._cache[course]
+            self._cache[key] = (plan, GaitSchedule(plan, params, control_dt, self.timing))
+        self._plan, self._schedule = self._cache[key]
         self._planned_for = course
         self.tick = 0
 

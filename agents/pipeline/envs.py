@@ -86,7 +86,8 @@ class EnvSpec:
     critic (`agents.privileged_critic.PrivilegedObservation`, the innermost wrapper)."""
     knobs: Any = None
     """`agents.knobs.KnobSettings` (or the training config's ``knobs`` section): one learner
-    step per tipping event, which sets the recovery's knobs (`agents.knobs.KnobsPerEvent`)."""
+    step per tipping event, which sets the recovery's knobs (`agents.knobs.KnobsPerEvent`), or
+    per episode, which sets the ditch planner's (`agents.plan_knobs.PlanKnobsPerEpisode`)."""
     episode_reward: str = "success"
     """With decision "episode": the reward of the learner's one step, "success" or "return"."""
     min_task_difficulty: float | None = None
@@ -117,10 +118,10 @@ class EnvSpec:
 
             env = PrivilegedObservation(env, env.spec.max_episode_steps)
         if self.knobs is not None:
-            from ..knobs import KnobsPerEvent, settings_from_config
+            from ..knobs import knobs_env, settings_from_config
 
             where = f"cannot build the knobs env on {self.id}"
-            env = _wrapped(env, lambda e: KnobsPerEvent(e, settings_from_config(self.knobs)), where)
+            env = _wrapped(env, lambda e: knobs_env(e, settings_from_config(self.knobs)), where)
         if self.hybrid is not None:
             where = f"cannot build the hybrid policy env on {self.id}"
             env = _wrapped(env, lambda e: wrap(e, self.hybrid), where)

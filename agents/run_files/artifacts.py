@@ -145,10 +145,15 @@ def checkpoint_note(model_dir: Path) -> str:
 def learner_step_unit(config: dict | None) -> str:
     """What a run's learner steps count, from its resolved config: "env steps", "gait cycles"
     (``env.decision: gait_cycle``), "episodes" (``env.decision: episode``) or "tipping events"
-    (a ``knobs`` run, one step per episode at the controller's tipping judgment)."""
+    (a recovery ``knobs`` run, one step per episode at the controller's tipping judgment; a
+    planner ``knobs`` run counts episodes)."""
     config = config or {}
     if config.get("knobs") is not None:
-        return "tipping events"
+        from ..knobs import KnobSettings
+
+        names = config["knobs"].get("names", KnobSettings.names)
+        planner = KnobSettings(names=names).controller == "planner"
+        return "episodes" if planner else "tipping events"
     decision = (config.get("env") or {}).get("decision")
     return {"gait_cycle": "gait cycles", "episode": "episodes"}.get(decision, "env steps")
 

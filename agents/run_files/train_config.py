@@ -341,7 +341,8 @@ class HybridConfig(HybridSettings):
 @dataclass
 class KnobConfig(KnobSettings):
     """``knobs:`` section: train a policy that sets the tipping recovery's knobs once per tipping
-    event (`agents.knobs`: names, event_margin_deg, reward). Absent (null): no knobs."""
+    event, or the ditch planner's once per episode (`agents.knobs`, `agents.plan_knobs`: names,
+    event_margin_deg, reward). Absent (null): no knobs."""
 
     zero_init_action_net: bool = True
     """Zero the action mean's last layer so that training starts from the controller's own
@@ -397,9 +398,17 @@ class TrainConfig:
             or self.env.reward_exclude
         ):
             raise ValueError(
-                "knobs: one learner step per tipping event, rewarded by the episode's outcome; "
+                "knobs: one learner step per tipping event or episode, rewarded by the "
+                "episode's outcome; "
                 "it needs no hybrid section, env.decision: step, env.vectorization: vec_env and "
                 "no env.reward_exclude"
+            )
+        planner_knobs = self.knobs is not None and self.knobs.controller == "planner"
+        if planner_knobs and self.policy.critic_privileged:
+            raise ValueError(
+                "policy.critic_privileged appends the task to the env's observation, but a "
+                "policy of the ditch planner's knobs sees the course instead (agents.plan_knobs); "
+                "set policy.critic_privileged: false"
             )
         if self.hybrid is not None and self.hybrid.mask_overridden and self.env.decision != "step":
             raise ValueError(
