@@ -40,7 +40,7 @@ import numpy as np
 from hexapod_envs.robots.upu.gait_plan import GaitSettings, max_stride
 
 from .knobs import PLANNER_KNOB_RANGES, KnobSettings, knob_values
-from .policy import LearnedWithController, Policy
+from .policy import EnvBound, LearnedWithController, Policy
 from .registry import analytical_policy
 from .upu_gait import UpuGaitPolicy
 
@@ -76,7 +76,7 @@ def resolved_settings(settings: GaitSettings, params: Any) -> GaitSettings:
     )
 
 
-class PlanKnobCore:
+class PlanKnobCore(EnvBound):
     """The env's ditch planner, and the settings a learned action gives it for one episode.
 
     Args:
