@@ -90,8 +90,8 @@ class KnobSettings:
 
     def __post_init__(self):
         self.names = names = tuple(self.names)
-        table = next((t for t in (KNOB_RANGES, PLANNER_KNOB_RANGES) if set(names) <= set(t)), None)
-        if not names or table is None or len(set(names)) != len(names):
+        one_controller = any(set(names) <= set(t) for t in (KNOB_RANGES, PLANNER_KNOB_RANGES))
+        if not names or not one_controller or len(set(names)) != len(names):
             raise ValueError(
                 f"knobs.names must be distinct names, all of the tipping recovery's "
                 f"{sorted(KNOB_RANGES)} or all of the ditch planner's "
