@@ -41,6 +41,7 @@ import numpy as np
 
 from .knobs import KNOB_RANGES, PLANNER_KNOB_RANGES, KnobSettings
 from .pipeline.cli import _add_trust_pickle_option, _run
+from .plan_knobs import COURSE_FEATURES, course_space
 from .policy import LearnedWithController
 from .run_files.artifacts import ModelFiles, find_model, read_meta
 from .run_files.errors import UserError
@@ -294,6 +295,15 @@ def report_scores(metrics_path: Path, model_dir: Path) -> list[dict[str, Any]]:
     return scores
 
 
+def actor_input_space(config: dict[str, Any], env: Any) -> Any:
+    """What the exported actor reads: the env's observation, or for a planner-knobs model (its
+    ``knobs`` section names the ditch planner's settings) the course (`COURSE_FEATURES`)."""
+    knobs = config.get("knobs")
+    if knobs is not None and KnobSettings(names=knobs["names"]).controller == "planner":
+        return course_space()
+    return env.observation_space
+
+
 def model_card(
     files: ModelFiles,
     env: Any,
@@ -311,12 +321,8 @@ def model_card(
     spec = env.spec
     unwrapped = env.unwrapped
     structure = getattr(unwrapped, "observation_structure", None) or {}
-    observation_space = env.observation_space
-    knobs = config.get("knobs")
-    if knobs is not None and KnobSettings(names=knobs["names"]).controller == "planner":
-        from .plan_knobs import COURSE_FEATURES, course_space
-
-        observation_space = course_space()  # a planner-knob actor sees the course, once
+    observation_space = actor_input_space(config, env)
+    if observation_space is not env.observation_space:  # a planner-knob actor sees the course
         structure = {name: slice(i, i + 1) for i, name in enumerate(COURSE_FEATURES)}
     folded = []
     if stats is not None and stats.norm_obs:
@@ -488,7 +494,7 @@ def export_model(
             )
         out.parent.mkdir(parents=True, exist_ok=True)
         module = actor_module(policy.model, policy.stats)
-        write_onnx(module, policy.model.observation_space.shape[0], out)
+        write_onnx(module, actor_input_space(files.training_config() or {}, env).shape[0], out)
         space = policy.model.action_space
         card = model_card(files, env, policy.stats, out.name, space, report)
     finally:

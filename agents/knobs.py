@@ -295,32 +295,3 @@ class KnobPolicy(LearnedWithController):
 def settings_from_config(section: Any) -> KnobSettings | None:
     """`KnobSettings` from a config's ``knobs`` section (a dataclass or a mapping), or None."""
     return settings_from_section(KnobSettings, section)
-
-
-def knobs_env(env: gym.Env, settings: KnobSettings) -> gym.Env:
-    """The env a learner of `settings` trains on: `KnobsPerEvent` for the recovery's knobs,
-    `agents.plan_knobs.PlanKnobsPerEpisode` for the ditch planner's."""
-    if settings.controller == "planner":
-        from .plan_knobs import PlanKnobsPerEpisode
-
-        return PlanKnobsPerEpisode(env, settings)
-    return KnobsPerEvent(env, settings)
-
-
-def knobs_policy(learned: Policy, env: gym.Env, settings: KnobSettings) -> Policy:
-    """A trained knob policy with the controller it tunes, as a per-step `Policy` on `env`."""
-    if settings.controller == "planner":
-        from .plan_knobs import PlanKnobPolicy
-
-        return PlanKnobPolicy(learned, env, settings)
-    return KnobPolicy(learned, env, settings)
-
-
-def knobs_observation_space(env: gym.Env, settings: KnobSettings) -> gym.spaces.Box:
-    """What the knob policy sees: the env's observation at the tipping event (recovery), or the
-    course the planner plans for (`agents.plan_knobs.COURSE_FEATURES`)."""
-    if settings.controller == "planner":
-        from .plan_knobs import course_space
-
-        return course_space()
-    return env.observation_space

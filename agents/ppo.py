@@ -17,7 +17,8 @@ import gymnasium as gym
 import numpy as np
 
 from .hybrid import from_run_config
-from .knobs import KnobSettings, knobs_observation_space, knobs_policy
+from .knob_wiring import knobs_observation_space, knobs_policy
+from .knobs import KnobSettings
 from .knobs import settings_from_config as knob_settings
 from .policy import Policy
 from .privileged_critic import pad_observation, privileged_space
@@ -60,7 +61,7 @@ class PPOPolicy:
         `agents.run_files.model_files`; pickled files of older runs only with ``trust_pickle``).
         A hybrid run's model comes back combined with `env`'s analytical controller as in
         training (`agents.hybrid.HybridPolicy`), a knobs run's as the controller it tunes
-        (`agents.knobs.knobs_policy`)."""
+        (`agents.knob_wiring.knobs_policy`)."""
         files = find_model(path)
         config = files.training_config()
         env_id = env.spec.id if env.spec is not None else None
@@ -129,7 +130,8 @@ def _as_trained(
 ) -> Any:
     """The policy as its run used it: a hybrid run's ``hybrid`` config section re-creates the
     combination with the env's analytical controller (`agents.hybrid.from_run_config`), a knobs
-    run's settings (its ``knobs`` section) the controller it tunes (`agents.knobs.knobs_policy`),
+    run's settings (its ``knobs`` section) the controller it tunes
+    (`agents.knob_wiring.knobs_policy`),
     and a run that decided once per episode (``env.decision: episode``) holds its first action
     (`HeldPerEpisode`)."""
     learned: Policy = policy

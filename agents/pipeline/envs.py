@@ -118,7 +118,8 @@ class EnvSpec:
 
             env = PrivilegedObservation(env, env.spec.max_episode_steps)
         if self.knobs is not None:
-            from ..knobs import knobs_env, settings_from_config
+            from ..knob_wiring import knobs_env
+            from ..knobs import settings_from_config
 
             where = f"cannot build the knobs env on {self.id}"
             env = _wrapped(env, lambda e: knobs_env(e, settings_from_config(self.knobs)), where)
