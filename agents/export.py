@@ -163,7 +163,7 @@ def _learned_part(config: dict[str, Any]) -> str:
             f"{hybrid.get('safety_filter')}; agents.hybrid), which the robot must run beside it"
         )
     knobs = config.get("knobs")
-    if knobs is not None and KnobSettings(names=knobs["names"]).controller == "planner":
+    if _planner_knobs(config):
         names = knobs["names"]
         spans = ", ".join(
             f"{n} {PLANNER_KNOB_RANGES[n][0]}..{PLANNER_KNOB_RANGES[n][1]} m" for n in names
@@ -295,13 +295,16 @@ def report_scores(metrics_path: Path, model_dir: Path) -> list[dict[str, Any]]:
     return scores
 
 
-def actor_input_space(config: dict[str, Any], env: Any) -> Any:
-    """What the exported actor reads: the env's observation, or for a planner-knobs model (its
-    ``knobs`` section names the ditch planner's settings) the course (`COURSE_FEATURES`)."""
+def _planner_knobs(config: dict[str, Any]) -> bool:
+    """Whether the run's ``knobs`` section names the ditch planner's settings."""
     knobs = config.get("knobs")
-    if knobs is not None and KnobSettings(names=knobs["names"]).controller == "planner":
-        return course_space()
-    return env.observation_space
+    return knobs is not None and KnobSettings(names=knobs["names"]).controller == "planner"
+
+
+def actor_input_space(config: dict[str, Any], env: Any) -> Any:
+    """What the exported actor reads: the env's observation, or for a planner-knobs model the
+    course (`COURSE_FEATURES`)."""
+    return course_space() if _planner_knobs(config) else env.observation_space
 
 
 def model_card(
@@ -322,7 +325,7 @@ def model_card(
     unwrapped = env.unwrapped
     structure = getattr(unwrapped, "observation_structure", None) or {}
     observation_space = actor_input_space(config, env)
-    if observation_space is not env.observation_space:  # a planner-knob actor sees the course
+    if _planner_knobs(config):
         structure = {name: slice(i, i + 1) for i, name in enumerate(COURSE_FEATURES)}
     folded = []
     if stats is not None and stats.norm_obs:
