@@ -39,11 +39,11 @@ from typing import Any
 
 import numpy as np
 
-from .knobs import KNOB_RANGES, PLANNER_KNOB_RANGES, KnobSettings
+from .knobs import KNOB_RANGES, PLANNER_KNOB_RANGES, settings_from_config
 from .pipeline.cli import _add_trust_pickle_option, _run
 from .plan_knobs import COURSE_FEATURES, course_space
 from .policy import LearnedWithController
-from .run_files.artifacts import ModelFiles, find_model, read_meta
+from .run_files.artifacts import ModelFiles, find_model, learner_step_unit, read_meta
 from .run_files.errors import UserError
 from .run_files.model_files import NormalizationStats, atomic_path, atomic_write_text
 
@@ -297,8 +297,8 @@ def report_scores(metrics_path: Path, model_dir: Path) -> list[dict[str, Any]]:
 
 def _planner_knobs(config: dict[str, Any]) -> bool:
     """Whether the run's ``knobs`` section names the ditch planner's settings."""
-    knobs = config.get("knobs")
-    return knobs is not None and KnobSettings(names=knobs["names"]).controller == "planner"
+    knobs = settings_from_config(config.get("knobs"))
+    return knobs is not None and knobs.controller == "planner"
 
 
 def actor_input_space(config: dict[str, Any], env: Any) -> Any:
@@ -367,6 +367,7 @@ def model_card(
         "folded_in": folded,
         "training": {
             "num_timesteps": meta.get("num_timesteps"),
+            "unit": learner_step_unit(config),
             "total_timesteps_configured": train.get("total_timesteps"),
             "checkpoint": meta.get("kind"),
             "saved_at": meta.get("saved_at"),
@@ -396,7 +397,8 @@ def card_markdown(card: dict[str, Any]) -> str:
         f"- **Output range**: low {_bounds(action['output_space']['low'])}, high "
         f"{_bounds(action['output_space']['high'])} (the env's action space: low "
         f"{_bounds(action['env_space']['low'])}, high {_bounds(action['env_space']['high'])})",
-        f"- **Training budget**: {train['num_timesteps']} env steps ({train['checkpoint']} "
+        f"- **Training budget**: {train['num_timesteps']} {train.get('unit', 'env steps')} "
+        f"({train['checkpoint']} "
         f"checkpoint; {train['total_timesteps_configured']} configured, seed {train['seed']}), "
         f"saved {train['saved_at']}",
         f"- **Source**: `{card['source']['model']}`",

@@ -76,10 +76,13 @@ class KnobSettings:
     """What the learned policy tunes and when (see the module docstring).
 
     Attributes:
-        names: the knobs, keys of `KNOB_RANGES`; the learned action has one value per name.
-        event_margin_deg: while the measured FASM (observation ``fasm_margin_deg``) is below
-            ξ + this [deg] (ξ: the controller's threshold), every step is checked for the
-            controller's judgment (its own FASM, from its body model, may differ a little).
+        names: the knobs, all keys of `KNOB_RANGES` (the recovery's) or all of
+            `PLANNER_KNOB_RANGES` (the ditch planner's); the learned action has one value per
+            name.
+        event_margin_deg: recovery knobs only: while the measured FASM (observation
+            ``fasm_margin_deg``) is below ξ + this [deg] (ξ: the controller's threshold), every
+            step is checked for the controller's judgment (its own FASM, from its body model,
+            may differ a little).
         reward: training only: "success" (1 when the episode meets the env's success rule, else
             0) or "return" (the env's reward summed from the event to the episode's end).
     """

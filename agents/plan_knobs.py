@@ -97,6 +97,12 @@ class PlanKnobCore(EnvBound):
                 f"{env.spec.id if env.spec else type(env.unwrapped).__name__} is "
                 f"{type(base).__name__} (envs with the planner: the ditch crossing)"
             )
+        terrain = getattr(env.unwrapped, "terrain", None)
+        if terrain != "ditch":
+            raise ValueError(
+                "planner knobs are set from the ditch the planner plans for; the env has "
+                f"terrain={terrain!r} (use terrain='ditch')"
+            )
         if base.task.action_mode != "joint":
             raise ValueError(
                 "planner knobs need the env in action_mode='joint' (the planner's closed-loop "
@@ -142,7 +148,8 @@ class PlanKnobsPerEpisode(gym.Wrapper):
     the settings of ``a`` and walks the plan to the episode's end. Its reward is
     `KnobSettings.reward`, and it ends the learner's episode as terminated: nothing follows the
     outcome (the env's own flags are ``info["env_terminated"]`` and ``info["env_truncated"]``).
-    ``info`` is the env's last step's, plus ``knobs`` (the settings), ``planner_fallback``,
+    ``info`` is the env's last step's, plus ``knobs`` (the settings the policy chose),
+    ``planner_fallback`` (True: they gave no plan, and the planner walked with the env's own),
     ``env_steps`` (control steps the episode took) and ``episode_return`` (the env's).
     """
 

@@ -32,7 +32,8 @@ class LearningCurve:
     """What ``timesteps`` counts: the learner's steps, "env steps", "gait cycles" for a run
     whose learner acts once per gait cycle (``env.decision: gait_cycle`` in its config),
     "episodes" for one that acts once per episode (``env.decision: episode``) or
-    "tipping events" for a knobs run (one learner step per episode, `agents.knobs`)."""
+    "tipping events" for a recovery knobs run (one learner step per episode, at the event,
+    `agents.knobs`); a planner knobs run counts "episodes" (`agents.plan_knobs`)."""
 
     @property
     def mean_return(self) -> np.ndarray:

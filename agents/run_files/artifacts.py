@@ -149,10 +149,9 @@ def learner_step_unit(config: dict | None) -> str:
     planner ``knobs`` run counts episodes)."""
     config = config or {}
     if config.get("knobs") is not None:
-        from ..knobs import KnobSettings
+        from ..knobs import settings_from_config
 
-        names = config["knobs"].get("names", KnobSettings.names)
-        planner = KnobSettings(names=names).controller == "planner"
+        planner = settings_from_config(config["knobs"]).controller == "planner"
         return "episodes" if planner else "tipping events"
     decision = (config.get("env") or {}).get("decision")
     return {"gait_cycle": "gait cycles", "episode": "episodes"}.get(decision, "env steps")

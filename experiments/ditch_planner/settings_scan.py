@@ -40,6 +40,9 @@ def parse_setting(text: str) -> dict[str, float]:
         name, _, value = item.partition("=")
         if name not in PLANNER_KNOB_RANGES:
             raise SystemExit(f"unknown knob {name!r}; knobs: {sorted(PLANNER_KNOB_RANGES)}")
+        low, high = PLANNER_KNOB_RANGES[name]
+        if not low <= float(value) <= high:
+            raise SystemExit(f"{name}={value} is outside the knob's range [{low}, {high}] m")
         values[name] = float(value)
     return values
 

@@ -85,6 +85,12 @@ def test_knob_names_come_from_one_controller_and_errors_name_the_choices():
         KnobSettings(names=("rho", "min_margin"))
     with pytest.raises(UserError, match="the ditch crossing"):
         EnvSpec("HexapodStewartTilt-v1", knobs=KnobSettings(names=NAMES)).make()
+    with pytest.raises(UserError, match="terrain='ditch'"):
+        EnvSpec(
+            DITCH,
+            kwargs={"terrain": "flat", "action_mode": "joint"},
+            knobs=KnobSettings(names=NAMES),
+        ).make()
     with pytest.raises(UserError, match="action_mode='joint'"):
         EnvSpec(DITCH, knobs=KnobSettings(names=NAMES)).make()  # the default residual mode
     with pytest.raises(ValueError, match="critic_privileged"):

@@ -22,6 +22,8 @@ def test_a_setting_round_trips_through_the_knob_action():
         assert knob_values(default, names, action, PLANNER_KNOB_RANGES) == pytest.approx(expected)
     with pytest.raises(SystemExit, match="knobs"):
         settings_scan.parse_setting("margin=0.02")
+    with pytest.raises(SystemExit, match="outside the knob's range"):
+        settings_scan.parse_setting("min_margin=0.05")
 
 
 def test_the_scan_compares_settings_on_the_same_tasks():
