@@ -38,6 +38,8 @@ from typing import Any, Literal
 import gymnasium as gym
 import numpy as np
 
+from hexapod_envs.wrappers import EPISODE_REWARDS, episode_reward
+
 from .policy import LearnedWithController, Policy, settings_from_section
 from .registry import analytical_policy
 from .tipping.controller import TippingRecoveryPolicy
@@ -68,7 +70,7 @@ ditch crossing (`agents.plan_knobs`), with the range a learned knob spans [m]: t
 foot keeps from a ditch edge, the static margin every three-leg support must keep, the longest
 platform step (eq. 17's 0.16 m is the most the mechanism allows) and the upper platform's lift."""
 
-REWARDS = ("success", "return")
+REWARDS = EPISODE_REWARDS
 
 
 @dataclass
@@ -265,10 +267,7 @@ class KnobsPerEvent(gym.Wrapper):
         values = self.core.set_knobs(action)
         obs, after_event, steps, terminated, truncated, info = self._run(self._obs, False)
         self._obs = None
-        if self.core.settings.reward == "success":
-            learner_reward = float(bool(info.get("is_success", False)))
-        else:
-            learner_reward = after_event
+        learner_reward = episode_reward(self.core.settings.reward, info, after_event)
         info = {
             **info,
             "knobs": values,

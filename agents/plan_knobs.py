@@ -38,6 +38,7 @@ import gymnasium as gym
 import numpy as np
 
 from hexapod_envs.robots.upu.gait_plan import GaitSettings, max_stride
+from hexapod_envs.wrappers import episode_reward
 
 from .knobs import PLANNER_KNOB_RANGES, KnobSettings, knob_values
 from .policy import EnvBound, LearnedWithController, Policy
@@ -112,6 +113,8 @@ class PlanKnobCore(EnvBound):
         self.settings = settings
         self.base = base
         self.default = base.settings
+        self._resolved = resolved_settings(self.default, base.task.robot)
+        """The env's settings with every knob's value explicit (what action 0 means)."""
         self.values: dict[str, float] = {}
         self.fallback = False
 
@@ -123,8 +126,7 @@ class PlanKnobCore(EnvBound):
     def set_knobs(self, action) -> dict[str, float]:
         """Plan this episode's course with the settings of `action`; where the planner finds no
         plan with them but does with the env's own, keep the env's own (`fallback`)."""
-        default = resolved_settings(self.default, self.base.task.robot)
-        self.values = knob_values(default, self.settings.names, action, PLANNER_KNOB_RANGES)
+        self.values = knob_values(self._resolved, self.settings.names, action, PLANNER_KNOB_RANGES)
         self.base.settings = replace(self.default, **self.values)
         self.base.reset()
         self.fallback = False
@@ -176,10 +178,7 @@ class PlanKnobsPerEpisode(gym.Wrapper):
             obs, reward, terminated, truncated, info = self.env.step(self.core(obs))
             total, steps = total + float(reward), steps + 1
         self._obs = None
-        if self.core.settings.reward == "success":
-            learner_reward = float(bool(info.get("is_success", False)))
-        else:
-            learner_reward = total
+        learner_reward = episode_reward(self.core.settings.reward, info, total)
         info = {
             **info,
             "knobs": values,

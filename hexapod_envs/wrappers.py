@@ -93,6 +93,13 @@ def _play(env: gym.Env, action: Any, done: Callable[[int], bool]) -> tuple[tuple
 EPISODE_REWARDS = ("success", "return")
 
 
+def episode_reward(kind: str, info: dict[str, Any], episode_return: float) -> float:
+    """The reward of a decision whose consequence is a whole episode: ``kind="success"``: 1.0
+    when the episode meets the env's success rule (``info["is_success"]`` of its last step),
+    else 0.0; ``"return"``: `episode_return`, the env's rewards summed over what it decided."""
+    return float(bool(info.get("is_success", False))) if kind == "success" else episode_return
+
+
 class GainsPerEpisode(gym.Wrapper):
     """One step per episode of a "gains"-mode env (see the module docstring): ``step(action)``
     holds `action` until the episode ends and returns its last observation, info and
@@ -113,9 +120,7 @@ class GainsPerEpisode(gym.Wrapper):
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         (obs, _, _, truncated, info), total, steps = _play(self.env, action, lambda _: False)
         info.update(episode_steps=steps, episode_truncated=truncated)
-        if self.reward == "success":
-            total = float(bool(info.get("is_success", False)))
-        return obs, total, True, False, info
+        return obs, episode_reward(self.reward, info, total), True, False, info
 
 
 def _require_gains_mode(env: gym.Env, wrapper: str) -> None:
