@@ -38,7 +38,7 @@ from typing import Any, Literal
 import gymnasium as gym
 import numpy as np
 
-from hexapod_envs.wrappers import EPISODE_REWARDS, episode_reward
+from hexapod_envs.wrappers import EPISODE_REWARDS, episode_reward, tilt_bound
 
 from .policy import LearnedWithController, Policy, settings_from_section
 from .registry import analytical_policy
@@ -86,12 +86,14 @@ class KnobSettings:
             step is checked for the controller's judgment (its own FASM, from its body model,
             may differ a little).
         reward: training only: "success" (1 when the episode meets the env's success rule, else
-            0) or "return" (the env's reward summed from the event to the episode's end).
+            0), "stable_success" (a success graded by its largest tilt, -v1 ids:
+            `hexapod_envs.wrappers.episode_reward`) or "return" (the env's reward summed from
+            the event (recovery knobs) or the start (planner knobs) to the episode's end).
     """
 
     names: tuple[str, ...] = ("rho", "kappa", "t_min")
     event_margin_deg: float = 5.0
-    reward: Literal["success", "return"] = "success"
+    reward: Literal["success", "stable_success", "return"] = "success"
 
     def __post_init__(self):
         self.names = names = tuple(self.names)
@@ -228,6 +230,7 @@ class KnobsPerEvent(gym.Wrapper):
     ):
         super().__init__(env)
         self.core = KnobCore(env, settings, base)
+        self._tilt_bound = tilt_bound(env, settings.reward)
         self.action_space = settings.action_space
         self.max_skipped = int(max_skipped)
         self._obs: np.ndarray | None = None
@@ -267,7 +270,9 @@ class KnobsPerEvent(gym.Wrapper):
         values = self.core.set_knobs(action)
         obs, after_event, steps, terminated, truncated, info = self._run(self._obs, False)
         self._obs = None
-        learner_reward = episode_reward(self.core.settings.reward, info, after_event)
+        learner_reward = episode_reward(
+            self.core.settings.reward, info, after_event, self._tilt_bound
+        )
         info = {
             **info,
             "knobs": values,

@@ -21,7 +21,8 @@ Two ways to run it, sharing `PlanKnobCore`:
 
 - `PlanKnobsPerEpisode`: the env a learner trains on. One learner step per episode: reset
   returns the course; step plans with the chosen settings and walks the plan to the episode's
-  end. The reward is the episode's ``info["is_success"]`` (the benchmark's rule) or its return.
+  end. The reward is the episode's ``info["is_success"]`` (the benchmark's rule), that success
+  graded by its largest tilt ("stable_success") or its return.
 - `PlanKnobPolicy`: a trained policy as a per-step `Policy` on the plain env (`evaluate.py`).
 
 A training config's ``knobs:`` section with the planner's knob names builds both
@@ -38,7 +39,7 @@ import gymnasium as gym
 import numpy as np
 
 from hexapod_envs.robots.upu.gait_plan import GaitSettings, max_stride
-from hexapod_envs.wrappers import episode_reward
+from hexapod_envs.wrappers import episode_reward, tilt_bound
 
 from .knobs import PLANNER_KNOB_RANGES, KnobSettings, knob_values
 from .policy import EnvBound, LearnedWithController, Policy
@@ -158,6 +159,7 @@ class PlanKnobsPerEpisode(gym.Wrapper):
     def __init__(self, env: gym.Env, settings: KnobSettings):
         super().__init__(env)
         self.core = PlanKnobCore(env, settings)
+        self._tilt_bound = tilt_bound(env, settings.reward)
         self.observation_space = course_space()
         self.action_space = settings.action_space
         self._obs: np.ndarray | None = None
@@ -178,7 +180,7 @@ class PlanKnobsPerEpisode(gym.Wrapper):
             obs, reward, terminated, truncated, info = self.env.step(self.core(obs))
             total, steps = total + float(reward), steps + 1
         self._obs = None
-        learner_reward = episode_reward(self.core.settings.reward, info, total)
+        learner_reward = episode_reward(self.core.settings.reward, info, total, self._tilt_bound)
         info = {
             **info,
             "knobs": values,

@@ -90,14 +90,52 @@ def _play(env: gym.Env, action: Any, done: Callable[[int], bool]) -> tuple[tuple
             return result, total, steps
 
 
-EPISODE_REWARDS = ("success", "return")
+EPISODE_REWARDS = ("success", "stable_success", "return")
+"""The rewards of a decision that spans an episode (`episode_reward`)."""
 
 
-def episode_reward(kind: str, info: dict[str, Any], episode_return: float) -> float:
-    """The reward of a decision whose consequence is a whole episode: ``kind="success"``: 1.0
-    when the episode meets the env's success rule (``info["is_success"]`` of its last step),
-    else 0.0; ``"return"``: `episode_return`, the env's rewards summed over what it decided."""
-    return float(bool(info.get("is_success", False))) if kind == "success" else episode_return
+def episode_reward(
+    kind: str, info: dict[str, Any], episode_return: float, tilt_bound_deg: float | None = None
+) -> float:
+    """The reward of a decision whose consequence is a whole episode.
+
+    - ``"success"``: 1.0 when the episode meets the env's success rule (``info["is_success"]``
+      of its last step), else 0.0.
+    - ``"stable_success"``: a success graded by how far its largest tilt stayed from the success
+      rule's bound: ``1 - info["max_tilt_deg"] / tilt_bound_deg`` for a success (in [0, 1]; the
+      rule holds the tilt within the bound), 0.0 for a failure. Among settings that all
+      succeed, it prefers the steadier one, which the 0/1 success cannot tell apart.
+    - ``"return"``: `episode_return`, the env's rewards summed over what it decided.
+
+    `tilt_bound_deg` is the env's ``success_max_tilt_deg`` (`tilt_bound`), needed by
+    "stable_success" only.
+    """
+    if kind == "return":
+        return episode_return
+    success = float(bool(info.get("is_success", False)))
+    if kind == "success" or not success:
+        return success
+    if tilt_bound_deg is None:
+        raise ValueError('episode reward "stable_success" needs the success rule\'s tilt bound')
+    return float(min(max(1.0 - info["max_tilt_deg"] / tilt_bound_deg, 0.0), 1.0))
+
+
+def tilt_bound(env: gym.Env, kind: str) -> float | None:
+    """The success rule's tilt bound [deg] of `env` (``success_max_tilt_deg``) where the episode
+    reward `kind` needs it; a ValueError that names the valid choices when `kind` is unknown,
+    or is "stable_success" on an env whose success rule bounds no tilt (the -v0 ids)."""
+    if kind not in EPISODE_REWARDS:
+        raise ValueError(f"the episode reward must be one of {EPISODE_REWARDS}, got {kind!r}")
+    if kind != "stable_success":
+        return None
+    bound = getattr(getattr(env.unwrapped, "settings", None), "success_max_tilt_deg", None)
+    if bound is None:
+        raise ValueError(
+            'the episode reward "stable_success" grades a success by the success rule\'s tilt '
+            f"bound, and {env.spec.id if env.spec else type(env.unwrapped).__name__} has none "
+            '(the -v1 ids have one); use "success" or "return"'
+        )
+    return float(bound)
 
 
 class GainsPerEpisode(gym.Wrapper):
@@ -107,20 +145,20 @@ class GainsPerEpisode(gym.Wrapper):
     with ``info["episode_steps"]`` the control steps it ran and ``info["episode_truncated"]``
     whether the env's time limit ended it.
 
-    The reward is ``reward="success"``: 1.0 when the episode meets the env's success rule
-    (``info["is_success"]``), else 0.0; or ``"return"``: the env's rewards summed."""
+    The reward is `episode_reward` of kind `reward` ("success", "stable_success" or
+    "return")."""
 
     def __init__(self, env: gym.Env, reward: str = "success"):
         super().__init__(env)
-        if reward not in EPISODE_REWARDS:
-            raise ValueError(f"reward must be one of {EPISODE_REWARDS}, got {reward!r}")
+        self._tilt_bound = tilt_bound(env, reward)
         _require_gains_mode(env, type(self).__name__)
         self.reward = reward
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         (obs, _, _, truncated, info), total, steps = _play(self.env, action, lambda _: False)
         info.update(episode_steps=steps, episode_truncated=truncated)
-        return obs, episode_reward(self.reward, info, total), True, False, info
+        reward = episode_reward(self.reward, info, total, self._tilt_bound)
+        return obs, reward, True, False, info
 
 
 def _require_gains_mode(env: gym.Env, wrapper: str) -> None:

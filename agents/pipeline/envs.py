@@ -89,7 +89,8 @@ class EnvSpec:
     step per tipping event, which sets the recovery's knobs (`agents.knobs.KnobsPerEvent`), or
     per episode, which sets the ditch planner's (`agents.plan_knobs.PlanKnobsPerEpisode`)."""
     episode_reward: str = "success"
-    """With decision "episode": the reward of the learner's one step, "success" or "return"."""
+    """With decision "episode": the reward of the learner's one step, one of
+    `hexapod_envs.wrappers.EPISODE_REWARDS`."""
     min_task_difficulty: float | None = None
     """Only sampled tasks of at least this difficulty (`hexapod_envs.curriculum.MinimumDifficulty`,
     the innermost wrapper); None: every task of the distribution."""

@@ -78,9 +78,10 @@ class EnvConfig:
     per episode (`episode`: the gains mode with one setting held over the whole episode,
     `hexapod_envs.wrappers.GainsPerEpisode`; training steps and evaluations count episodes,
     rewarded as ``episode_reward`` says)."""
-    episode_reward: Literal["success", "return"] = "success"
+    episode_reward: Literal["success", "stable_success", "return"] = "success"
     """With ``decision: episode``: the learner's reward per episode, "success" (1 when it meets
-    the env's success rule, else 0) or "return" (the env's rewards summed)."""
+    the env's success rule, else 0), "stable_success" (a success graded by its largest tilt,
+    `hexapod_envs.wrappers.episode_reward`; -v1 ids) or "return" (the env's rewards summed)."""
     min_task_difficulty: float | None = None
     """Train (and evaluate during training) on the sampled tasks of difficulty at least this
     (`hexapod_envs.curriculum.MinimumDifficulty`, drawn through the env's ``np_random``); None:

@@ -146,6 +146,14 @@ def test_the_zero_action_replays_the_analytical_controller():
     assert reward == float(last["is_success"]) == 1.0
 
 
+def test_the_stable_success_reward_grades_the_crossing_by_its_largest_tilt():
+    env = PlanKnobsPerEpisode(_ditch(), KnobSettings(names=NAMES, reward="stable_success"))
+    env.reset(seed=3)
+    _, reward, *_, info = env.step(np.zeros(2, dtype=np.float32))
+    assert info["is_success"] and 0.0 < info["max_tilt_deg"] < 2.0  # -v1's bound: 2 deg
+    assert reward == pytest.approx(1.0 - info["max_tilt_deg"] / 2.0, rel=0, abs=1e-12)
+
+
 def test_the_policy_asks_once_with_the_course_and_matches_the_training_env():
     action = [-0.25, 0.5]  # exact in float32
     env = PlanKnobsPerEpisode(_ditch(), KnobSettings(names=NAMES, reward="return"))

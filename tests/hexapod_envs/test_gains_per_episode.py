@@ -7,7 +7,7 @@ import pytest
 from helpers.paths import REPO
 
 import hexapod_envs  # noqa: F401  (registers the env ids)
-from hexapod_envs.wrappers import GainsPerEpisode
+from hexapod_envs.wrappers import GainsPerEpisode, episode_reward, tilt_bound
 
 ENV_ID = "HexapodIrregularTerrain-v1"
 GAINS = {
@@ -44,10 +44,34 @@ def test_the_success_reward_is_the_episodes_outcome():
     assert reward == float(bool(info["is_success"])) and reward in (0.0, 1.0)
 
 
+def test_stable_success_grades_a_success_by_how_far_its_tilt_stayed_from_the_bound():
+    success = {"is_success": True, "max_tilt_deg": 0.5}
+    assert episode_reward("stable_success", success, 7.0, 2.0) == 0.75
+    assert episode_reward("stable_success", {**success, "max_tilt_deg": 0.0}, 7.0, 2.0) == 1.0
+    assert episode_reward("stable_success", {**success, "max_tilt_deg": 3.0}, 7.0, 2.0) == 0.0
+    assert episode_reward("stable_success", {**success, "is_success": False}, 7.0, 2.0) == 0.0
+    assert episode_reward("success", success, 7.0) == 1.0
+    assert episode_reward("return", success, 7.0) == 7.0
+    with pytest.raises(ValueError, match="tilt bound"):
+        episode_reward("stable_success", success, 7.0)
+
+
+def test_stable_success_needs_an_env_whose_success_rule_bounds_the_tilt():
+    assert tilt_bound(gym.make(ENV_ID), "stable_success") == 25.0  # the -v1 blocks' bound
+    assert tilt_bound(gym.make("HexapodDitchCrossing-v1"), "stable_success") == 2.0
+    assert tilt_bound(gym.make(ENV_ID), "success") is None
+    with pytest.raises(ValueError, match="HexapodIrregularTerrain-v0 has none"):
+        tilt_bound(gym.make("HexapodIrregularTerrain-v0"), "stable_success")
+    with pytest.raises(ValueError, match=r"one of \('success', 'stable_success', 'return'\)"):
+        tilt_bound(gym.make(ENV_ID), "stable")
+
+
 def test_other_modes_and_rewards_are_refused_by_name():
     with pytest.raises(ValueError, match="GainsPerEpisode needs action_mode='gains'"):
         GainsPerEpisode(gym.make(ENV_ID))
-    with pytest.raises(ValueError, match=r"reward must be one of \('success', 'return'\)"):
+    with pytest.raises(
+        ValueError, match=r"reward must be one of \('success', 'stable_success', 'return'\)"
+    ):
         GainsPerEpisode(gym.make(ENV_ID, **GAINS), reward="returns")
 
 
