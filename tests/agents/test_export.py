@@ -66,19 +66,19 @@ def test_onnx_actions_equal_the_torch_policy(tmp_path, model):
 
 
 def _report(path, rates):
-    """A hexapod-evaluate metrics.json with these success rates on the cliff walk."""
+    """A hexapod-evaluate metrics.json with these success rates on the Stewart tilt (-v0)."""
     policies = {
         name: {"aggregate": {"episodes": 20, "success": {"mean": rate}}}
         for name, rate in rates.items()
     }
     env = {"kwargs": {"task_distribution": "test"}, "policies": policies}
     path.mkdir()
-    (path / "metrics.json").write_text(json.dumps({"envs": {"HexapodCliffWalk-v0": env}}))
+    (path / "metrics.json").write_text(json.dumps({"envs": {"HexapodStewartTilt-v0": env}}))
     return path
 
 
 def test_model_card(tmp_path):
-    model_dir = REPO / "models" / "HexapodCliffWalk-v0" / "hybrid"
+    model_dir = REPO / "models" / "HexapodStewartTilt-v0" / "hybrid"
     out = tmp_path / "out" / "cliff.onnx"
     rates = {"analytical": 0.8, "random": 0.2, "ppo:models/{env_id}/hybrid": 0.5}
     rates["ppo:models/{env_id}/ppo"] = 1.0  # another model: not this card's
@@ -86,12 +86,12 @@ def test_model_card(tmp_path):
     assert (result.card_json, result.card_md) == card_paths(out)
     card = json.loads(result.card_json.read_text())
     assert card == json.loads(json.dumps(result.card))
-    assert card["env"]["id"] == "HexapodCliffWalk-v0" and card["env"]["version"] == 0
+    assert card["env"]["id"] == "HexapodStewartTilt-v0" and card["env"]["version"] == 0
     layout = card["observation"]["layout"]
     assert layout[0]["start"] == 0 and layout[-1]["stop"] == card["observation"]["shape"][0]
     assert all(a["stop"] == b["start"] for a, b in zip(layout, layout[1:], strict=False))
     assert "fasm_margin_deg" in {p["name"] for p in layout}
-    assert card["action"]["mode"] == card["env"]["kwargs"]["action_mode"] == "residual"
+    assert card["action"]["mode"] == "residual"  # the env's default action mode
     assert card["action"]["exported"].startswith("hybrid model: the file holds the learned actor")
     assert card["action"]["output_space"]["low"] == [-1.0] * 18
     meta = json.loads((model_dir / "meta.json").read_text())
@@ -99,7 +99,7 @@ def test_model_card(tmp_path):
     assert any("normalisation" in item for item in card["folded_in"])
     assert card["training_evaluations"]["evaluations"] > 0
     (score,) = card["benchmark"]
-    assert score["env_id"] == "HexapodCliffWalk-v0" and score["success_rate"] == 0.5
+    assert score["env_id"] == "HexapodStewartTilt-v0" and score["success_rate"] == 0.5
     assert score["benchmark_score"] == pytest.approx(50.0)  # halfway from random to analytical
     text = result.card_md.read_text()
     for heading in ("Observation layout", "Folded into the graph", "Benchmark"):

@@ -109,6 +109,22 @@ def test_run_saves_statistics_without_pickle(run):
             assert data["obs_mean"].shape == tuple(meta(model_dir)["observation_shape"])
 
 
+UNTRAINED_BY_DESIGN = {"HexapodIrregularTerrain-v0/paper_gains"}
+"""Shipped models that are not learned agents: the paper's gains in a gains agent's shape, the
+like-for-like reference of the gains reports (docs/results.md)."""
+
+
+def test_no_shipped_agent_is_a_step_0_checkpoint():
+    """A run whose best evaluation was its starting point has learned nothing to ship: every
+    shipped agent's checkpoint is from after a training step."""
+    model_dirs = sorted(p.parent for p in (REPO / "models").glob("*/*/model.zip"))
+    assert model_dirs
+    for model_dir in model_dirs:
+        name = f"{model_dir.parent.name}/{model_dir.name}"
+        steps = json.loads((model_dir / "meta.json").read_text())["num_timesteps"]
+        assert (steps == 0) == (name in UNTRAINED_BY_DESIGN), (name, steps)
+
+
 def test_shipped_models_load_without_pickle():
     """Every shipped agent (models/<env id>/<ppo|hybrid|gains>/) loads without unpickling, in
     the action settings it was trained with, and acts inside the action space."""

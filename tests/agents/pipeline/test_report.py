@@ -197,16 +197,17 @@ def test_success_and_tip_over_differences_say_when_they_are_not_resolved():
     assert "lead in successes over `zero` is resolved" in verdict_paragraph(result, aggs)
 
 
-def test_the_report_says_which_checkpoint_it_evaluated(report):
+def test_the_report_says_which_checkpoint_it_evaluated(report, tmp_path):
     """A shipped model's sources name its checkpoint and steps; a best/ kept from step 0 says it
-    is the initial policy (models/HexapodIrregularTerrain-v0/hybrid: step 0)."""
+    is the initial policy."""
     from agents.run_files.artifacts import checkpoint_note, read_meta
 
     md = (report / "report.md").read_text()
     for env_id in ENVS:
         meta = read_meta(f"models/{env_id}/hybrid")
         assert f"({meta['kind']} checkpoint at {meta['num_timesteps']} env steps" in md
-    note = checkpoint_note("models/HexapodIrregularTerrain-v0/hybrid")
+    (tmp_path / "meta.json").write_text(json.dumps({"kind": "best", "num_timesteps": 0}))
+    note = checkpoint_note(tmp_path)
     assert note == " (best checkpoint at 0 env steps: the initial policy, no training step kept)"
     # learner steps in the run's own unit (its config.yaml)
     assert "at 3072 tipping events)" in checkpoint_note("models/HexapodStewartTilt-v1/knobs")
