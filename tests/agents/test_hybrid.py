@@ -331,12 +331,12 @@ def test_the_recovery_judges_tipping_at_the_envs_threshold():
 
 
 def test_a_hybrid_model_refuses_an_env_that_reads_its_action_otherwise():
-    """The shipped cliff hybrid learned its action at residual_scale 2: at the env's default
-    0.25 its actions would mean something else, so loading it there names the setting."""
+    """The shipped Stewart-tilt hybrid learned its action at the env's residual_scale 2: at 0.25
+    its actions would mean something else, so loading it there names the setting."""
     from agents.ppo import PPOPolicy
     from agents.run_files.errors import UserError
 
-    model = REPO / "models" / "HexapodCliffWalk-v0" / "hybrid"
+    model = REPO / "models" / "HexapodStewartTilt-v0" / "hybrid"
     with pytest.raises(UserError, match=r"residual_scale=2.0 but the env has residual_scale=0.25"):
-        PPOPolicy.load(model, gym.make("HexapodCliffWalk-v0"))
-    PPOPolicy.load(model, gym.make("HexapodCliffWalk-v0", residual_scale=2.0))
+        PPOPolicy.load(model, gym.make("HexapodStewartTilt-v0", residual_scale=0.25))
+    PPOPolicy.load(model, gym.make("HexapodStewartTilt-v0"))
