@@ -38,7 +38,7 @@ from typing import Any, Literal
 import gymnasium as gym
 import numpy as np
 
-from hexapod_envs.wrappers import EPISODE_REWARDS, episode_reward, tilt_bound
+from hexapod_envs.wrappers import EPISODE_REWARDS, EpisodeReward, episode_reward, tilt_bound
 
 from .policy import LearnedWithController, Policy, settings_from_section
 from .registry import analytical_policy
@@ -93,7 +93,7 @@ class KnobSettings:
 
     names: tuple[str, ...] = ("rho", "kappa", "t_min")
     event_margin_deg: float = 5.0
-    reward: Literal["success", "stable_success", "return"] = "success"
+    reward: EpisodeReward = "success"
 
     def __post_init__(self):
         self.names = names = tuple(self.names)

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Callable
-from typing import Any
+from typing import Any, Literal, get_args
 
 import gymnasium as gym
 import numpy as np
@@ -90,8 +90,9 @@ def _play(env: gym.Env, action: Any, done: Callable[[int], bool]) -> tuple[tuple
             return result, total, steps
 
 
-EPISODE_REWARDS = ("success", "stable_success", "return")
+EpisodeReward = Literal["success", "stable_success", "return"]
 """The rewards of a decision that spans an episode (`episode_reward`)."""
+EPISODE_REWARDS: tuple[str, ...] = get_args(EpisodeReward)
 
 
 def episode_reward(
@@ -110,6 +111,8 @@ def episode_reward(
     `tilt_bound_deg` is the env's ``success_max_tilt_deg`` (`tilt_bound`), needed by
     "stable_success" only.
     """
+    if kind not in EPISODE_REWARDS:
+        raise ValueError(f"the episode reward must be one of {EPISODE_REWARDS}, got {kind!r}")
     if kind == "return":
         return episode_return
     success = float(bool(info.get("is_success", False)))
@@ -117,7 +120,7 @@ def episode_reward(
         return success
     if tilt_bound_deg is None:
         raise ValueError('episode reward "stable_success" needs the success rule\'s tilt bound')
-    return float(min(max(1.0 - info["max_tilt_deg"] / tilt_bound_deg, 0.0), 1.0))
+    return max(1.0 - info["max_tilt_deg"] / tilt_bound_deg, 0.0)
 
 
 def tilt_bound(env: gym.Env, kind: str) -> float | None:

@@ -31,6 +31,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
 
+from hexapod_envs.wrappers import EpisodeReward
+
 from ..hybrid import HybridSettings
 from ..knobs import KnobSettings
 from .configtools import apply_overrides, from_mapping, load_yaml
@@ -78,7 +80,7 @@ class EnvConfig:
     per episode (`episode`: the gains mode with one setting held over the whole episode,
     `hexapod_envs.wrappers.GainsPerEpisode`; training steps and evaluations count episodes,
     rewarded as ``episode_reward`` says)."""
-    episode_reward: Literal["success", "stable_success", "return"] = "success"
+    episode_reward: EpisodeReward = "success"
     """With ``decision: episode``: the learner's reward per episode, "success" (1 when it meets
     the env's success rule, else 0), "stable_success" (a success graded by its largest tilt,
     `hexapod_envs.wrappers.episode_reward`; -v1 ids) or "return" (the env's rewards summed)."""

@@ -86,6 +86,31 @@ def test_env_spec_decision_episode_builds_the_wrapper():
         EnvSpec(ENV_ID, gym_packages=["hexapod_envs"], decision="episode").make()
 
 
+def test_a_config_asks_for_the_stable_success_reward_by_name():
+    from agents.pipeline.envs import EnvSpec
+    from agents.run_files.configtools import from_mapping
+    from agents.run_files.errors import ConfigError, UserError
+    from agents.run_files.train_config import EnvConfig
+
+    section = {"id": ENV_ID, "decision": "episode", "episode_reward": "stable_success"}
+    assert from_mapping(EnvConfig, section).episode_reward == "stable_success"
+    with pytest.raises(ConfigError, match="stable_success"):  # the choices, named
+        from_mapping(EnvConfig, {**section, "episode_reward": "steady"})
+    spec = EnvSpec(ENV_ID, dict(GAINS), gym_packages=["hexapod_envs"], decision="episode")
+    spec.episode_reward = "stable_success"
+    env = spec.make()
+    env.reset(seed=3)
+    _, reward, *_, info = env.step(ACTION)
+    expected = 1.0 - info["max_tilt_deg"] / 25.0 if info["is_success"] else 0.0
+    assert reward == pytest.approx(expected, rel=0, abs=1e-12)
+    v0 = EnvSpec(
+        "HexapodIrregularTerrain-v0", {"action_mode": "gains"}, gym_packages=["hexapod_envs"]
+    )
+    v0.decision, v0.episode_reward = "episode", "stable_success"
+    with pytest.raises(UserError, match="HexapodIrregularTerrain-v0 has none"):
+        v0.make()
+
+
 def test_a_held_policy_is_asked_once_per_episode():
     from agents.ppo import HeldPerEpisode
 
