@@ -59,29 +59,42 @@ def action_for(values: dict[str, float], default, names: tuple[str, ...]) -> np.
     return np.array(action, dtype=np.float32)
 
 
-def scan(distribution: str, seeds: range, settings: list[str]) -> dict[str, dict[int, str]]:
-    """{setting: {seed: outcome}}: "S" success, "T" tip-over, "F" other failure; a trailing
-    "*" marks a fallback to the env's settings."""
+def scan(
+    distribution: str, seeds: range, settings: list[str]
+) -> tuple[dict[str, dict[int, str]], dict[str, dict[int, float]]]:
+    """({setting: {seed: outcome}}, {setting: {seed: the episode's largest tilt [deg]}}):
+    outcome "S" success, "T" tip-over, "F" other failure; a trailing "*" marks a fallback to the
+    env's settings."""
     knobs = KnobSettings(names=tuple(PLANNER_KNOB_RANGES))
     raw = gym.make(ENV_ID, task_distribution=distribution, action_mode="joint")
     env = PlanKnobsPerEpisode(raw, knobs)
     default = resolved_settings(env.core.default, env.core.base.task.robot)
-    results = {}
+    results, tilts = {}, {}
     for text in settings:
         action = action_for(parse_setting(text), default, knobs.names)
-        outcomes = {}
+        outcomes, tilt = {}, {}
         for seed in seeds:
             env.reset(seed=seed)
             _, success, *_, info = env.step(action)
             outcome = "S" if success else ("T" if info["is_tipped_over"] else "F")
             outcomes[seed] = outcome + ("*" if info["planner_fallback"] else "")
-        results[text] = outcomes
-        print(summary(text, outcomes, results.get("")), flush=True)
+            tilt[seed] = float(info["max_tilt_deg"])
+        results[text], tilts[text] = outcomes, tilt
+        print(summary(text, outcomes, results.get(""), tilt, tilts.get("")), flush=True)
     env.close()
-    return results
+    return results, tilts
 
 
-def summary(text: str, outcomes: dict[int, str], reference: dict[int, str] | None) -> str:
+def summary(
+    text: str,
+    outcomes: dict[int, str],
+    reference: dict[int, str] | None,
+    tilt: dict[int, float] | None = None,
+    reference_tilt: dict[int, float] | None = None,
+) -> str:
+    """One line per setting: successes, tip-overs, fallbacks; against the reference (the env's
+    settings) the tasks won and lost and, with the tilts, on how many tasks both succeed and
+    this setting's largest tilt is lower, and the median change of it there [deg]."""
     ok = {s for s, o in outcomes.items() if o.startswith("S")}
     line = (
         f"{text or '(env settings)'}: {len(ok)}/{len(outcomes)} successes, "
@@ -91,6 +104,13 @@ def summary(text: str, outcomes: dict[int, str], reference: dict[int, str] | Non
     if reference is not None and text:
         base = {s for s, o in reference.items() if o.startswith("S")}
         line += f"; wins {sorted(ok - base)}, losses {sorted(base - ok)}"
+        both = sorted(ok & base)
+        if tilt is not None and reference_tilt is not None and both:
+            change = np.array([tilt[s] - reference_tilt[s] for s in both])
+            line += (
+                f"; largest tilt lower on {int((change < 0).sum())} of the {len(both)} tasks both "
+                f"cross, median change {np.median(change):+.3f} deg"
+            )
     return line
 
 
@@ -102,7 +122,7 @@ def main() -> None:
     parser.add_argument("--json", type=Path, default=None)
     args = parser.parse_args()
     settings = [""] + [s for s in args.settings if s]  # the env's own first: the reference
-    results = scan(args.distribution, range(*args.seeds), settings)
+    results, _ = scan(args.distribution, range(*args.seeds), settings)
     if args.json is not None:
         args.json.write_text(json.dumps(results, indent=1) + "\n")
 
