@@ -111,8 +111,7 @@ def episode_reward(
     `tilt_bound_deg` is the env's ``success_max_tilt_deg`` (`tilt_bound`), needed by
     "stable_success" only.
     """
-    if kind not in EPISODE_REWARDS:
-        raise ValueError(f"the episode reward must be one of {EPISODE_REWARDS}, got {kind!r}")
+    _check_episode_reward(kind)
     if kind == "return":
         return episode_return
     success = float(bool(info.get("is_success", False)))
@@ -123,12 +122,16 @@ def episode_reward(
     return max(1.0 - info["max_tilt_deg"] / tilt_bound_deg, 0.0)
 
 
+def _check_episode_reward(kind: str) -> None:
+    if kind not in EPISODE_REWARDS:
+        raise ValueError(f"the episode reward must be one of {EPISODE_REWARDS}, got {kind!r}")
+
+
 def tilt_bound(env: gym.Env, kind: str) -> float | None:
     """The success rule's tilt bound [deg] of `env` (``success_max_tilt_deg``) where the episode
     reward `kind` needs it; a ValueError that names the valid choices when `kind` is unknown,
     or is "stable_success" on an env whose success rule bounds no tilt (the -v0 ids)."""
-    if kind not in EPISODE_REWARDS:
-        raise ValueError(f"the episode reward must be one of {EPISODE_REWARDS}, got {kind!r}")
+    _check_episode_reward(kind)
     if kind != "stable_success":
         return None
     bound = getattr(getattr(env.unwrapped, "settings", None), "success_max_tilt_deg", None)
