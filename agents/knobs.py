@@ -38,7 +38,7 @@ from typing import Any, Literal
 import gymnasium as gym
 import numpy as np
 
-from hexapod_envs.wrappers import EPISODE_REWARDS, EpisodeReward, episode_reward, tilt_bound
+from hexapod_envs.wrappers import EPISODE_REWARDS, EpisodeReward, episode_reward_of
 
 from .policy import LearnedWithController, Policy, settings_from_section
 from .registry import analytical_policy
@@ -230,7 +230,7 @@ class KnobsPerEvent(gym.Wrapper):
     ):
         super().__init__(env)
         self.core = KnobCore(env, settings, base)
-        self._tilt_bound = tilt_bound(env, settings.reward)
+        self._reward = episode_reward_of(env, settings.reward)
         self.action_space = settings.action_space
         self.max_skipped = int(max_skipped)
         self._obs: np.ndarray | None = None
@@ -270,9 +270,7 @@ class KnobsPerEvent(gym.Wrapper):
         values = self.core.set_knobs(action)
         obs, after_event, steps, terminated, truncated, info = self._run(self._obs, False)
         self._obs = None
-        learner_reward = episode_reward(
-            self.core.settings.reward, info, after_event, self._tilt_bound
-        )
+        learner_reward = self._reward(info, after_event)
         info = {
             **info,
             "knobs": values,

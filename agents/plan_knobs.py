@@ -39,7 +39,7 @@ import gymnasium as gym
 import numpy as np
 
 from hexapod_envs.robots.upu.gait_plan import GaitSettings, max_stride
-from hexapod_envs.wrappers import episode_reward, tilt_bound
+from hexapod_envs.wrappers import episode_reward_of
 
 from .knobs import PLANNER_KNOB_RANGES, KnobSettings, knob_values
 from .policy import EnvBound, LearnedWithController, Policy
@@ -159,7 +159,7 @@ class PlanKnobsPerEpisode(gym.Wrapper):
     def __init__(self, env: gym.Env, settings: KnobSettings):
         super().__init__(env)
         self.core = PlanKnobCore(env, settings)
-        self._tilt_bound = tilt_bound(env, settings.reward)
+        self._reward = episode_reward_of(env, settings.reward)
         self.observation_space = course_space()
         self.action_space = settings.action_space
         self._obs: np.ndarray | None = None
@@ -180,7 +180,7 @@ class PlanKnobsPerEpisode(gym.Wrapper):
             obs, reward, terminated, truncated, info = self.env.step(self.core(obs))
             total, steps = total + float(reward), steps + 1
         self._obs = None
-        learner_reward = episode_reward(self.core.settings.reward, info, total, self._tilt_bound)
+        learner_reward = self._reward(info, total)
         info = {
             **info,
             "knobs": values,

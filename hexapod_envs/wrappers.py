@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Callable
+from functools import partial
 from typing import Any, Literal, get_args
 
 import gymnasium as gym
@@ -122,6 +123,12 @@ def episode_reward(
     return max(1.0 - info["max_tilt_deg"] / tilt_bound_deg, 0.0)
 
 
+def episode_reward_of(env: gym.Env, kind: str) -> Callable[[dict[str, Any], float], float]:
+    """`episode_reward` of kind `kind` on `env`, checked once (`tilt_bound`'s errors):
+    ``rule(info, episode_return)``."""
+    return partial(episode_reward, kind, tilt_bound_deg=tilt_bound(env, kind))
+
+
 def _check_episode_reward(kind: str) -> None:
     if kind not in EPISODE_REWARDS:
         raise ValueError(f"the episode reward must be one of {EPISODE_REWARDS}, got {kind!r}")
@@ -156,15 +163,14 @@ class GainsPerEpisode(gym.Wrapper):
 
     def __init__(self, env: gym.Env, reward: str = "success"):
         super().__init__(env)
-        self._tilt_bound = tilt_bound(env, reward)
+        self._reward = episode_reward_of(env, reward)
         _require_gains_mode(env, type(self).__name__)
         self.reward = reward
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         (obs, _, _, truncated, info), total, steps = _play(self.env, action, lambda _: False)
         info.update(episode_steps=steps, episode_truncated=truncated)
-        reward = episode_reward(self.reward, info, total, self._tilt_bound)
-        return obs, reward, True, False, info
+        return obs, self._reward(info, total), True, False, info
 
 
 def _require_gains_mode(env: gym.Env, wrapper: str) -> None:

@@ -96,17 +96,25 @@ def test_a_config_asks_for_the_stable_success_reward_by_name():
     assert from_mapping(EnvConfig, section).episode_reward == "stable_success"
     with pytest.raises(ConfigError, match="stable_success"):  # the choices, named
         from_mapping(EnvConfig, {**section, "episode_reward": "steady"})
-    spec = EnvSpec(ENV_ID, dict(GAINS), gym_packages=["hexapod_envs"], decision="episode")
-    spec.episode_reward = "stable_success"
+    spec = EnvSpec(
+        ENV_ID,
+        dict(GAINS),
+        gym_packages=["hexapod_envs"],
+        decision="episode",
+        episode_reward="stable_success",
+    )
     env = spec.make()
     env.reset(seed=3)
     _, reward, *_, info = env.step(ACTION)
     expected = 1.0 - info["max_tilt_deg"] / 25.0 if info["is_success"] else 0.0
     assert reward == pytest.approx(expected, rel=0, abs=1e-12)
     v0 = EnvSpec(
-        "HexapodIrregularTerrain-v0", {"action_mode": "gains"}, gym_packages=["hexapod_envs"]
+        "HexapodIrregularTerrain-v0",
+        {"action_mode": "gains"},
+        gym_packages=["hexapod_envs"],
+        decision="episode",
+        episode_reward="stable_success",
     )
-    v0.decision, v0.episode_reward = "episode", "stable_success"
     with pytest.raises(UserError, match="HexapodIrregularTerrain-v0 has none"):
         v0.make()
 

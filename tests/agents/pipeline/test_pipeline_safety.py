@@ -117,11 +117,13 @@ like-for-like reference of the gains reports (docs/results.md)."""
 def test_no_shipped_agent_is_a_step_0_checkpoint():
     """A run whose best evaluation was its starting point has learned nothing to ship: every
     shipped agent's checkpoint is from after a training step."""
+    from agents.run_files.artifacts import read_meta
+
     model_dirs = sorted(p.parent for p in (REPO / "models").glob("*/*/model.zip"))
     assert model_dirs
     for model_dir in model_dirs:
         name = f"{model_dir.parent.name}/{model_dir.name}"
-        steps = json.loads((model_dir / "meta.json").read_text())["num_timesteps"]
+        steps = read_meta(model_dir)["num_timesteps"]
         assert (steps == 0) == (name in UNTRAINED_BY_DESIGN), (name, steps)
 
 
