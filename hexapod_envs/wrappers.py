@@ -1,4 +1,4 @@
-"""Gymnasium wrappers that belong to one env's action mode.
+"""Gymnasium wrappers: one decision per gait cycle or per episode, and stability-rule penalties.
 
 `GainsPerCycle`: HexapodIrregularTerrain's "gains" mode reads its action once per gait cycle
 (40 control steps at the defaults) and ignores it in between, so a learner that acts at every
@@ -25,6 +25,9 @@ runs the policy on the unwrapped env at every step.
 contextual bandit of "one setting per terrain", for knobs whose best value hardly changes within
 an episode (ATHENA's body height: the height control reaches a new reference over several
 cycles, so per-cycle rewards credit little of it). The step's reward is the episode's outcome.
+
+`StabilityRulePenalty`: per-step penalties that mirror a ``-v1`` success rule's bounds on the
+time spent tipping and the largest tilt, for learners that act at every step.
 """
 
 from __future__ import annotations
@@ -36,6 +39,8 @@ from typing import Any, Literal, get_args
 
 import gymnasium as gym
 import numpy as np
+
+from . import info_keys as keys
 
 
 class GainsPerCycle(gym.Wrapper):
@@ -186,3 +191,45 @@ def _require_gains_mode(env: gym.Env, wrapper: str) -> None:
             f"{wrapper} needs action_mode='gains', got {base.action_mode!r}; the other "
             "modes read their action at every step"
         )
+
+
+class StabilityRulePenalty(gym.Wrapper):
+    """Per-step reward terms that mirror the stability part of a ``-v1`` success rule, for
+    learners that act at every step.
+
+    The ``-v1`` success rules bound the share of the episode spent tipping (the FASM below the
+    robot's ξ) and the episode's largest tilt, but the envs' rewards pay neither: a residual
+    policy that lifts ATHENA's torso off the blocks earns more return while it leans past the
+    25° bound and tips for a third of the episode, failing every task. Two terms, each in
+    ``info`` beside the env's own, close that gap:
+
+    - ``reward_rule_tipping`` = -`weight` on every step with ``info["is_tipping"]``;
+    - ``reward_rule_tilt`` = -`weight` on every step whose tilt exceeds the success rule's bound
+      (``success_max_tilt_deg``): from then on the episode can no longer succeed.
+
+    Choose `weight` against the env's alive term (what an upright step earns) so that a tipping
+    step costs a visible share of it. A ValueError names the problem for an env without the
+    bound (the -v0 ids) or a weight that is not a positive number.
+    """
+
+    TERMS = ("rule_tipping", "rule_tilt")
+
+    def __init__(self, env: gym.Env, weight: float):
+        super().__init__(env)
+        if not (np.isfinite(weight) and weight > 0):
+            raise ValueError(f"the stability-rule penalty weight must be > 0, got {weight}")
+        bound = getattr(getattr(env.unwrapped, "settings", None), "success_max_tilt_deg", None)
+        if bound is None:
+            name = env.spec.id if env.spec else type(env.unwrapped).__name__
+            raise ValueError(
+                f"{name} has no success tilt bound (success_max_tilt_deg) for the stability-rule "
+                "penalty to mirror; the -v1 ids have one"
+            )
+        self.weight, self.tilt_bound_deg = float(weight), float(bound)
+
+    def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        obs, reward, terminated, truncated, info = self.env.step(action)
+        tipping = -self.weight * float(bool(info.get(keys.IS_TIPPING, False)))
+        tilt = -self.weight * float(info.get(keys.TILT_DEG, 0.0) > self.tilt_bound_deg)
+        info = {**info, "reward_rule_tipping": tipping, "reward_rule_tilt": tilt}
+        return obs, float(reward) + tipping + tilt, terminated, truncated, info

@@ -94,6 +94,9 @@ class EnvSpec:
     min_task_difficulty: float | None = None
     """Only sampled tasks of at least this difficulty (`hexapod_envs.curriculum.MinimumDifficulty`,
     the innermost wrapper); None: every task of the distribution."""
+    stability_penalty: float = 0.0
+    """Weight of `hexapod_envs.wrappers.StabilityRulePenalty` (the next wrapper: every other
+    one sees its penalised rewards); 0: none."""
 
     def make(self, **extra: Any) -> gym.Env:
         """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
@@ -114,6 +117,12 @@ class EnvSpec:
             minimum = self.min_task_difficulty
             where = f"env.min_task_difficulty on {self.id}"
             env = _wrapped(env, lambda e: MinimumDifficulty(e, minimum), where)
+        if self.stability_penalty:
+            from hexapod_envs.wrappers import StabilityRulePenalty
+
+            weight = self.stability_penalty
+            where = f"env.stability_penalty on {self.id}"
+            env = _wrapped(env, lambda e: StabilityRulePenalty(e, weight), where)
         if self.privileged_critic:
             from ..privileged_critic import PrivilegedObservation
 

@@ -98,6 +98,7 @@ def env_spec(config: TrainConfig) -> EnvSpec:
         config.knobs,
         env.episode_reward,
         env.min_task_difficulty,
+        env.stability_penalty,
     )
 
 

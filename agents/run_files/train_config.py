@@ -84,6 +84,11 @@ class EnvConfig:
     """With ``decision: episode``: the learner's reward per episode, "success" (1 when it meets
     the env's success rule, else 0), "stable_success" (a success graded by its largest tilt,
     `hexapod_envs.wrappers.episode_reward`; -v1 ids) or "return" (the env's rewards summed)."""
+    stability_penalty: float = 0.0
+    """A per-step penalty of this weight while the robot tips and while its tilt is past the
+    success rule's bound (`hexapod_envs.wrappers.StabilityRulePenalty`, terms ``rule_tipping``
+    and ``rule_tilt``; -v1 ids): the return then pays for what the v1 success rule demands;
+    0: off. The evaluation reports the env's own return."""
     min_task_difficulty: float | None = None
     """Train (and evaluate during training) on the sampled tasks of difficulty at least this
     (`hexapod_envs.curriculum.MinimumDifficulty`, drawn through the env's ``np_random``); None:
@@ -387,6 +392,16 @@ class TrainConfig:
             raise ValueError(
                 "policy.critic_privileged appends the task to each env's observation, which "
                 "env.vectorization: batched does not do; use env.vectorization: vec_env"
+            )
+        if self.env.vectorization == "batched" and self.env.stability_penalty:
+            raise ValueError(
+                "env.stability_penalty wraps each env, which env.vectorization: batched does "
+                "not do; use env.vectorization: vec_env"
+            )
+        if not (self.env.stability_penalty >= 0 and math.isfinite(self.env.stability_penalty)):
+            raise ValueError(
+                f"env.stability_penalty must be a number >= 0 (0: off), got "
+                f"{self.env.stability_penalty}"
             )
         if self.env.vectorization == "batched" and self.vec_env.type == "subprocess":
             raise ValueError(

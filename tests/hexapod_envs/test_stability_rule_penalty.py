@@ -1,0 +1,87 @@
+"""StabilityRulePenalty and ``env.stability_penalty``: per-step penalties that mirror a -v1
+success rule's bounds on the time spent tipping and the largest tilt."""
+
+from types import SimpleNamespace
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from helpers.paths import REPO
+
+import hexapod_envs  # noqa: F401  (registers the env ids)
+from agents.pipeline.training import env_spec
+from agents.run_files.errors import ConfigError
+from agents.run_files.train_config import load_train_config
+from hexapod_envs.wrappers import StabilityRulePenalty
+
+CONFIG = REPO / "configs" / "irregular_terrain_v1_ppo.yaml"
+
+
+def test_the_terms_count_the_tipping_steps_and_the_reward_carries_them():
+    kwargs = {"task_distribution": "train", "max_episode_steps": 60}
+    wrapped = StabilityRulePenalty(gym.make("HexapodIrregularTerrain-v1", **kwargs), 2.5)
+    plain = gym.make("HexapodIrregularTerrain-v1", **kwargs)
+    wrapped.reset(seed=1000)
+    plain.reset(seed=1000)
+    tipping_steps = 0
+    for _ in range(60):
+        _, reward, *_, info = wrapped.step(np.zeros(18))
+        _, plain_reward, *_, plain_info = plain.step(np.zeros(18))
+        tipping_steps += bool(plain_info["is_tipping"])
+        assert info["reward_rule_tipping"] == -2.5 * bool(plain_info["is_tipping"])
+        assert info["reward_rule_tilt"] == -2.5 * (plain_info["tilt_deg"] > 25.0)
+        expected = plain_reward + info["reward_rule_tipping"] + info["reward_rule_tilt"]
+        assert reward == pytest.approx(expected, abs=1e-9)
+    assert tipping_steps > 0  # the zero action sags onto the blocks: the term is exercised
+
+
+class _Scripted(gym.Env):
+    """Steps through given (is_tipping, tilt_deg) pairs with reward 1."""
+
+    observation_space = gym.spaces.Box(-1.0, 1.0, (1,))
+    action_space = gym.spaces.Box(-1.0, 1.0, (1,))
+    settings = SimpleNamespace(success_max_tilt_deg=8.0)
+
+    def __init__(self, states):
+        self.states = list(states)
+
+    def reset(self, *, seed=None, options=None):
+        return np.zeros(1, np.float32), {}
+
+    def step(self, action):
+        tipping, tilt = self.states.pop(0)
+        info = {"is_tipping": tipping, "tilt_deg": tilt}
+        return np.zeros(1, np.float32), 1.0, False, False, info
+
+
+def test_the_tilt_term_pays_only_past_the_bound():
+    env = StabilityRulePenalty(_Scripted([(False, 7.9), (False, 8.0), (True, 8.1), (True, 3.0)]), 1)
+    env.reset()
+    rewards = [env.step(np.zeros(1))[1] for _ in range(4)]
+    assert rewards == [1.0, 1.0, -1.0, 0.0]
+
+
+def test_bad_uses_are_named():
+    with pytest.raises(ValueError, match="HexapodCliffWalk-v0 has no success tilt bound"):
+        StabilityRulePenalty(gym.make("HexapodCliffWalk-v0"), 1.0)
+    for weight in (0.0, -1.0, float("nan")):
+        with pytest.raises(ValueError, match="must be > 0"):
+            StabilityRulePenalty(_Scripted([]), weight)
+
+
+def test_the_training_config_wraps_the_env_and_checks_the_weight():
+    config = load_train_config(CONFIG, ["env.max_episode_steps=5"])
+    assert config.env.stability_penalty == 2.0
+    env = env_spec(config).make()
+    wrappers = []
+    while isinstance(env, gym.Wrapper):
+        wrappers.append(type(env).__name__)
+        env = env.env
+    assert "StabilityRulePenalty" in wrappers
+    with pytest.raises((ConfigError, ValueError), match="stability_penalty must be a number >= 0"):
+        load_train_config(CONFIG, ["env.stability_penalty=-1"])
+    with pytest.raises((ConfigError, ValueError), match="batched does not do"):
+        load_train_config(
+            CONFIG,
+            ["env.vectorization=batched", "policy.critic_privileged=false"],
+        )
