@@ -520,7 +520,7 @@ def export_parser(prog: str = "hexapod-export") -> argparse.ArgumentParser:
         "(<stem>_card.json, <stem>_card.md). A relative models/... path that is not in the "
         "working directory is a shipped model. Needs: pip install 'hexapod_envs[export]'.",
         epilog="examples:\n"
-        f"  {prog} models/HexapodCliffWalk-v0/ppo\n"
+        f"  {prog} models/HexapodIrregularTerrain-v0/ppo\n"
         f"  {prog} runs/HexapodCliffWalk-v0__ppo__0__20250101-120000 --output cliff.onnx "
         "--report reports/mine",
         formatter_class=argparse.RawDescriptionHelpFormatter,

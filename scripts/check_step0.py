@@ -4,11 +4,12 @@ For each model: rebuild its step-0 policy (`agents.run_files.step0`: the model w
 zero-initialised output layer zeroed again), then evaluate both on the same tasks of the
 training env (its config's env id and kwargs; `--distribution train` by default: the tasks
 training drew from) with `evaluate.py`, the step-0 policy as the reference. Each model's suite
-and report go to ``<output-dir>/<env id>__<model name>/`` (the rebuilt step-0 model is removed
-after its evaluation); one line per model gives the success counts, tip-overs, the paired 95 %
-intervals of the success and return differences and the verdict of `verdict`.
-``<output-dir>/summary.json`` keeps every model's figures, keyed by the model path given and
-with the SHA-256 of its model.zip; a rerun replaces the entry.
+and report go to ``<output-dir>/<env id>__<model name>__<distribution>/`` (the rebuilt step-0
+model is removed after its evaluation); one line per model gives the success counts,
+tip-overs, the paired 95 % intervals of the success and return differences and the verdict of
+`verdict`.
+``<output-dir>/summary.json`` keeps every model's figures, keyed by the model path given, then
+the task distribution, with the SHA-256 of its model.zip; a rerun replaces the entry.
 
     python scripts/check_step0.py models/HexapodIrregularTerrain-v0/ppo [more models] \
         --episodes 50 --seed 1000 --output-dir reports/step0_check
@@ -123,7 +124,7 @@ def main(argv: list[str] | None = None) -> int:
     summary_path = args.output_dir / SUMMARY_FILE
     summary = json.loads(summary_path.read_text()) if summary_path.is_file() else {}
     for model in args.models:
-        name = "__".join(find_model(model).directory.parts[-2:])
+        name = "__".join([*find_model(model).directory.parts[-2:], args.distribution])
         out_dir = args.output_dir / name
         out_dir.mkdir(parents=True, exist_ok=True)
         step0 = write_step0_model(model, out_dir / STEP0_DIR)
@@ -134,12 +135,14 @@ def main(argv: list[str] | None = None) -> int:
         if code != 0:
             return code
         metrics = json.loads((out_dir / REPORT_DIR / "metrics.json").read_text())
-        summary[str(model)] = check_record(model, metrics)
+        record = check_record(model, metrics)
+        summary.setdefault(str(model), {})[args.distribution] = record
         summary_path.write_text(json.dumps(summary, indent=2, sort_keys=True) + "\n")
-        print(summary_line(str(model), summary[str(model)]), flush=True)
+        print(summary_line(str(model), record), flush=True)
     print("\nsummary (" + str(summary_path) + "):")
-    for model, record in sorted(summary.items()):
-        print(summary_line(model, record))
+    for model, records in sorted(summary.items()):
+        for distribution, record in sorted(records.items()):
+            print(f"[{distribution}] {summary_line(model, record)}")
     return 0
 
 

@@ -7,6 +7,9 @@ To train with the same hyperparameters as ``train.py``, pass the generated file 
 
     python -m agents.pipeline.zoo configs/*_ppo.yaml > configs/rl_zoo_hyperparams.yaml
 
+A config with something the zoo has no counterpart for (a privileged critic, a wrapper that
+train.py adds around the env) is left out and named in the file's header.
+
 The zoo evaluates its ``policy_kwargs`` string itself (``activation_fn=nn.Tanh``); nothing here
 evaluates strings.
 """
@@ -71,7 +74,23 @@ def zoo_hyperparams(config: TrainConfig) -> dict[str, Any]:
     return entry
 
 
+def zoo_unsupported(config: TrainConfig) -> str | None:
+    """Why the zoo cannot train `config` as train.py does (None: it can): a critic that sees the
+    task, or a wrapper train.py adds around the env."""
+    if config.policy.critic_privileged:
+        return "policy.critic_privileged (the zoo's MlpPolicy has no privileged critic)"
+    if config.env.stability_penalty:
+        return "env.stability_penalty (a wrapper train.py adds)"
+    if config.env.reward_exclude or config.env.decision != "step":
+        return "env.reward_exclude or env.decision (wrappers train.py adds)"
+    if config.hybrid is not None or config.knobs is not None:
+        return "a hybrid or knobs section (wrappers train.py adds)"
+    return None
+
+
 def zoo_file(config_paths: list[str | Path]) -> str:
+    """The hyperparameter file of the configs the zoo can train as train.py does; the others
+    are named in its header with the reason."""
     header = (
         "# rl-baselines3-zoo hyperparameters (PPO) generated from configs/*_ppo.yaml by\n"
         "#   python -m agents.pipeline.zoo configs/*_ppo.yaml > configs/rl_zoo_hyperparams.yaml\n"
@@ -81,6 +100,10 @@ def zoo_file(config_paths: list[str | Path]) -> str:
     entries = {}
     for path in sorted(config_paths):
         config = load_train_config(path)
+        reason = zoo_unsupported(config)
+        if reason is not None:
+            header += f"# Left out: {Path(path).name}, for {reason}.\n"
+            continue
         entries[config.env.id] = zoo_hyperparams(config)
     return header + yaml.safe_dump(entries, sort_keys=True, width=1000)
 

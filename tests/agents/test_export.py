@@ -2,11 +2,13 @@
 gives the torch policy's deterministic actions, and its model card describes the model."""
 
 import json
+import shutil
 
 import gymnasium as gym
 import numpy as np
 import pytest
 from helpers.paths import REPO
+from helpers.stewart_hybrid_runs import train
 
 import hexapod_envs  # noqa: F401  (registers the envs)
 from agents.export import _learned_part, card_paths, export_main, export_model
@@ -41,7 +43,7 @@ def _onnx_actions(path, observations):
 
 
 @pytest.mark.parametrize(
-    "model", ["HexapodCliffWalk-v0/ppo", "HexapodIrregularTerrain-v0/gains"]
+    "model", ["HexapodIrregularTerrain-v0/ppo", "HexapodIrregularTerrain-v0/gains"]
 )  # a plain PPO model; a hybrid one whose learned part acts once per gait cycle
 def test_onnx_actions_equal_the_torch_policy(tmp_path, model):
     model_dir = REPO / "models" / model
@@ -78,10 +80,12 @@ def _report(path, rates):
 
 
 def test_model_card(tmp_path):
-    model_dir = REPO / "models" / "HexapodStewartTilt-v0" / "hybrid"
+    run = train(tmp_path, "hybrid")  # a tiny Stewart-tilt hybrid, shipped as its final model
+    model_dir = run / "final"
+    shutil.copy(run / "evaluations.npz", model_dir)
     out = tmp_path / "out" / "cliff.onnx"
-    rates = {"analytical": 0.8, "random": 0.2, "ppo:models/{env_id}/hybrid": 0.5}
-    rates["ppo:models/{env_id}/ppo"] = 1.0  # another model: not this card's
+    rates = {"analytical": 0.8, "random": 0.2, f"ppo:{model_dir}": 0.5}
+    rates[f"ppo:{REPO / 'models' / 'HexapodIrregularTerrain-v0' / 'ppo'}"] = 1.0  # not this card's
     result = export_model(model_dir, out, report=_report(tmp_path / "report", rates))
     assert (result.card_json, result.card_md) == card_paths(out)
     card = json.loads(result.card_json.read_text())
@@ -108,7 +112,7 @@ def test_model_card(tmp_path):
 
 def test_cli_refuses_to_overwrite_without_force(tmp_path, capsys):
     out = tmp_path / "a.onnx"
-    argv = [str(REPO / "models" / "HexapodCliffWalk-v0" / "ppo"), "--output", str(out)]
+    argv = [str(REPO / "models" / "HexapodIrregularTerrain-v0" / "ppo"), "--output", str(out)]
     assert export_main(argv) == 0
     assert out.is_file() and all(p.is_file() for p in card_paths(out))
     assert export_main(argv) == 2

@@ -82,7 +82,7 @@ def test_wheel_installed_in_a_fresh_venv_evaluates_from_an_empty_folder(tmp_path
     code = (
         "import json, agents, agents.pipeline.cli as cli, agents.run_files.shipped as s;"
         "print(json.dumps([agents.__file__, str(s.shipped_root()), str(cli.DEFAULT_SUITE),"
-        " str(s.resolve_shipped('models/HexapodCliffWalk-v0/ppo'))]))"
+        " str(s.resolve_shipped('models/HexapodIrregularTerrain-v0/ppo'))]))"
     )
     where = _run([str(python), "-c", code], cwd=empty)
     assert where.returncode == 0, where.stderr[-3000:]
@@ -94,7 +94,7 @@ def test_wheel_installed_in_a_fresh_venv_evaluates_from_an_empty_folder(tmp_path
     assert (root / "configs" / "cliff_walk_ppo.yaml").is_file()
 
     # The default suite (its env kwargs) with a shipped model, on a tiny budget.
-    argv = [str(bin_dir / "hexapod-evaluate"), "--envs", "HexapodCliffWalk-v0", "--policies",
+    argv = [str(bin_dir / "hexapod-evaluate"), "--envs", "HexapodIrregularTerrain-v0", "--policies",
             "analytical", "ppo:models/{env_id}/ppo", "--episodes", "1",
             "--max-episode-steps", "10", "--no-progress"]  # fmt: skip
     for _ in range(2):  # the second run replaces the default report
@@ -102,6 +102,6 @@ def test_wheel_installed_in_a_fresh_venv_evaluates_from_an_empty_folder(tmp_path
         assert evaluated.returncode == 0, evaluated.stderr[-3000:]
     report = empty / "reports" / "default"
     metrics = json.loads((report / "metrics.json").read_text())
-    runs = metrics["envs"]["HexapodCliffWalk-v0"]["policies"]
+    runs = metrics["envs"]["HexapodIrregularTerrain-v0"]["policies"]
     assert set(runs) == {"analytical", "ppo:models/{env_id}/ppo"}
     assert str(model / "model.zip") in (report / "report.md").read_text()

@@ -127,15 +127,37 @@ def test_no_shipped_agent_is_a_step_0_checkpoint():
         assert (steps == 0) == (name in UNTRAINED_BY_DESIGN), (name, steps)
 
 
+def test_every_shipped_agent_beat_its_step_0():
+    """Every shipped learned agent has a committed check against its own step-0 policy on at
+    least 50 tasks (`scripts/check_step0.py`, reports/step0_check/summary.json) made with these
+    very weights, and a check of it says it beats its step 0."""
+    import hashlib
+
+    summary = json.loads((REPO / "reports" / "step0_check" / "summary.json").read_text())
+    for model_dir in sorted(p.parent for p in (REPO / "models").glob("*/*/model.zip")):
+        name = f"{model_dir.parent.name}/{model_dir.name}"
+        if name in UNTRAINED_BY_DESIGN:
+            continue
+        records = summary.get(f"models/{name}", {})
+        assert records, f"no step-0 check of models/{name}: run scripts/check_step0.py"
+        digest = hashlib.sha256((model_dir / "model.zip").read_bytes()).hexdigest()
+        for record in records.values():
+            assert record["model_sha256"] == digest, f"models/{name} changed since its check"
+        passed = [
+            r for r in records.values() if r["tasks"] >= 50 and r["verdict"].startswith("beats")
+        ]
+        assert passed, (name, records)
+
+
 def test_shipped_models_load_without_pickle():
-    """Every shipped agent (models/<env id>/<ppo|hybrid|gains>/) loads without unpickling, in
+    """Every shipped agent (models/<env id>/<ppo|gains|knobs>/) loads without unpickling, in
     the action settings it was trained with, and acts inside the action space."""
     import yaml
 
     import hexapod_envs  # noqa: F401  (registers the env ids)
 
     model_dirs = sorted(p.parent for p in (REPO / "models").glob("*/*/model.zip"))
-    assert {d.name for d in model_dirs} >= {"ppo", "hybrid", "gains"}
+    assert {d.name for d in model_dirs} >= {"ppo", "gains", "knobs"}
     for model_dir in model_dirs:
         assert not list(model_dir.glob("*.pkl")), model_dir
         env_id = model_dir.parent.name

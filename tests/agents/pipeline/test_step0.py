@@ -75,7 +75,7 @@ def test_check_step0_reports_the_paired_success_difference(model, tmp_path, caps
     line = [text for text in capsys.readouterr().out.splitlines() if text.startswith(f"{model} ")]
     assert "HexapodCliffWalk-v0: step 0 " in line[-1] and "/2 successes" in line[-1]
     assert "return" in line[-1] and "step 0" in line[-1].rsplit(":", 1)[1]
-    record = json.loads((out_dir / "summary.json").read_text())[str(model)]
+    record = json.loads((out_dir / "summary.json").read_text())[str(model)]["train"]
     assert record["tasks"] == 2 and record["seeds"] == [1000, 1001]
     assert record["model_sha256"] == hashlib.sha256((model / "model.zip").read_bytes()).hexdigest()
     (report,) = [path for path in out_dir.iterdir() if path.is_dir()]
