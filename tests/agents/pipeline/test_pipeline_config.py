@@ -37,7 +37,8 @@ def test_default_suite_is_the_v1_benchmark_and_the_v0_suite_keeps_the_shipped_mo
     suite = load_suite(CONFIGS / "evaluate_default.yaml")
     v1_ids = [env_id.replace("-v0", "-v1") for env_id in TRAIN_CONFIGS.values()]
     assert [e.id for e in suite.envs] == v1_ids
-    assert suite.policies == ["analytical", "zero", "random", "ppo:models/{env_id}/knobs"]
+    learned = ["ppo:models/{env_id}/knobs", "ppo:models/{env_id}/ppo"]
+    assert suite.policies == ["analytical", "zero", "random", *learned]
     assert all(e.kwargs["task_distribution"] == "test" for e in suite.envs)
     full = load_suite(CONFIGS / "evaluate_full.yaml")
     assert full.policies == suite.policies and full.envs == suite.envs
