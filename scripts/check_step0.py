@@ -2,12 +2,12 @@
 
 For each model: rebuild its step-0 policy (`agents.run_files.step0`: the model with its actor's
 zero-initialised output layer zeroed again), then evaluate both on the same tasks of the
-training env (its config's env id and kwargs; `--distribution train` by default: the tasks
-training drew from) with `evaluate.py`, the step-0 policy as the reference. Each model's suite
-and report go to ``<output-dir>/<env id>__<model name>__<distribution>/`` (the rebuilt step-0
-model is removed after its evaluation); one line per model gives the success counts,
-tip-overs, the paired 95 % intervals of the success and return differences and the verdict of
-`verdict`.
+training env (its config's env id, kwargs and minimum task difficulty; `--distribution train`
+by default: the tasks training drew from) with `evaluate.py`, the step-0 policy as the
+reference. Each model's suite and report go to
+``<output-dir>/<env id>__<model name>__<distribution>/`` (the rebuilt step-0 model is removed
+after its evaluation); one line per model gives the success counts, tip-overs, the paired 95 %
+intervals of the success and return differences and the verdict of `verdict`.
 ``<output-dir>/summary.json`` keeps every model's figures, keyed by the model path given, then
 the task distribution, with the SHA-256 of its model.zip; a rerun replaces the entry.
 
@@ -21,11 +21,13 @@ import argparse
 import hashlib
 import json
 import shutil
+import sys
 from pathlib import Path
 
 from agents.pipeline.cli import evaluate_main
 from agents.run_files.artifacts import find_model
 from agents.run_files.configtools import dump_yaml
+from agents.run_files.errors import UserError
 from agents.run_files.step0 import write_step0_model
 from agents.run_files.train_config import load_train_config
 
@@ -36,16 +38,13 @@ def suite_for(model: Path, step0: Path, args: argparse.Namespace, out_dir: Path)
     """The evaluation suite (`agents.pipeline.eval_config`) of one model against its step 0."""
     config = load_train_config(data=find_model(model).training_config())
     kwargs = {**config.env.kwargs, "task_distribution": args.distribution}
+    env = {"id": config.env.id, "kwargs": kwargs, "max_episode_steps": config.env.max_episode_steps}
+    if config.env.min_task_difficulty is not None:  # the part of the distribution it trained on
+        env["min_task_difficulty"] = config.env.min_task_difficulty
     trained, start = f"ppo:{model}", f"ppo:{step0}"
     return {
         "title": f"{model} against its step-0 policy",
-        "envs": [
-            {
-                "id": config.env.id,
-                "kwargs": kwargs,
-                "max_episode_steps": config.env.max_episode_steps,
-            }
-        ],
+        "envs": [env],
         "policies": [start, trained],
         "references": [start],
         "episodes": args.episodes,
@@ -124,14 +123,20 @@ def main(argv: list[str] | None = None) -> int:
     summary_path = args.output_dir / SUMMARY_FILE
     summary = json.loads(summary_path.read_text()) if summary_path.is_file() else {}
     for model in args.models:
-        name = "__".join([*find_model(model).directory.parts[-2:], args.distribution])
-        out_dir = args.output_dir / name
-        out_dir.mkdir(parents=True, exist_ok=True)
-        step0 = write_step0_model(model, out_dir / STEP0_DIR)
+        try:
+            name = "__".join([*find_model(model).directory.parts[-2:], args.distribution])
+            out_dir = args.output_dir / name
+            out_dir.mkdir(parents=True, exist_ok=True)
+            step0 = write_step0_model(model, out_dir / STEP0_DIR)
+        except UserError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            return 2
         suite_path = out_dir / "suite.yaml"
         suite_path.write_text(dump_yaml(suite_for(model, step0, args, out_dir / REPORT_DIR)))
-        code = evaluate_main(["--config", str(suite_path), "--force"])
-        shutil.rmtree(step0)  # rebuilt from the model by the next run; the report is the record
+        try:
+            code = evaluate_main(["--config", str(suite_path), "--force"])
+        finally:
+            shutil.rmtree(step0)  # rebuilt from the model by the next run; the report is the record
         if code != 0:
             return code
         metrics = json.loads((out_dir / REPORT_DIR / "metrics.json").read_text())

@@ -83,7 +83,8 @@ class EnvSpec:
     replayed from the same state (`GainsPerCycle`'s ``baseline_action``); "none": plain."""
     privileged_critic: bool = False
     """Append the task and the episode's elapsed share to the observation for an asymmetric
-    critic (`agents.privileged_critic.PrivilegedObservation`, the innermost wrapper)."""
+    critic (`agents.privileged_critic.PrivilegedObservation`, inside every wrapper but
+    `MinimumDifficulty` and `StabilityRulePenalty`)."""
     knobs: Any = None
     """`agents.knobs.KnobSettings` (or the training config's ``knobs`` section): one learner
     step per tipping event, which sets the recovery's knobs (`agents.knobs.KnobsPerEvent`), or

@@ -26,10 +26,14 @@ class SuiteEnv:
     id: str
     kwargs: dict[str, Any] = field(default_factory=dict)
     max_episode_steps: int | None = None  # None: the registered limit
+    min_task_difficulty: float | None = None
+    """Only sampled tasks at least this difficult (`hexapod_envs.curriculum.MinimumDifficulty`,
+    drawn through the env's ``np_random``: the same tasks for every policy); None: all."""
 
 
 def _parse_envs(value: Any, where: str) -> list[SuiteEnv]:
-    """A list of env ids or of ``{id, kwargs, max_episode_steps}`` mappings."""
+    """A list of env ids or of ``{id, kwargs, max_episode_steps, min_task_difficulty}``
+    mappings."""
     if not isinstance(value, list) or not value:
         raise ConfigError(f"{where}: expected a non-empty list of env ids or mappings")
     envs = []

@@ -145,7 +145,9 @@ def run_episode(
 
 
 def _env_spec(suite: EvaluationSuite, env: SuiteEnv, **extra: Any) -> EnvSpec:
-    return EnvSpec(env.id, {**env.kwargs, **extra}, suite.env_time_limit(env), suite.gym_packages)
+    kwargs = {**env.kwargs, **extra}
+    limit, packages = suite.env_time_limit(env), suite.gym_packages
+    return EnvSpec(env.id, kwargs, limit, packages, min_task_difficulty=env.min_task_difficulty)
 
 
 def policy_env_kwargs(name: str, env_id: str, suite_kwargs: dict | None = None) -> dict[str, Any]:

@@ -81,6 +81,8 @@ def zoo_unsupported(config: TrainConfig) -> str | None:
         return "policy.critic_privileged (the zoo's MlpPolicy has no privileged critic)"
     if config.env.stability_penalty:
         return "env.stability_penalty (a wrapper train.py adds)"
+    if config.env.min_task_difficulty is not None:
+        return "env.min_task_difficulty (a wrapper train.py adds)"
     if config.env.reward_exclude or config.env.decision != "step":
         return "env.reward_exclude or env.decision (wrappers train.py adds)"
     if config.hybrid is not None or config.knobs is not None:

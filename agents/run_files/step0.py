@@ -43,6 +43,10 @@ def write_step0_model(model_path: str | Path, out_dir: str | Path) -> Path:
     exists) and return it. UserError when the model's run did not zero-initialise its actor:
     its step 0 was a random network that the model no longer holds."""
     files = find_model(model_path)
+    if files.model.name != MODEL_FILE:
+        raise UserError(
+            f"{files.model}: give the model's directory (its {MODEL_FILE}) to rebuild its step 0"
+        )
     config = files.training_config()
     if config is None or not zero_initialised(config):
         raise UserError(

@@ -88,7 +88,8 @@ class EnvConfig:
     """A per-step penalty of this weight while the robot tips and while its tilt is past the
     success rule's bound (`hexapod_envs.wrappers.StabilityRulePenalty`, terms ``rule_tipping``
     and ``rule_tilt``; -v1 ids): the return then pays for what the v1 success rule demands;
-    0: off. The evaluation reports the env's own return."""
+    0: off. Training-time evaluations include it (their returns in ``evaluations.npz`` and the
+    return tie-break of ``eval.select``); ``evaluate.py`` reports the env's own return."""
     min_task_difficulty: float | None = None
     """Train (and evaluate during training) on the sampled tasks of difficulty at least this
     (`hexapod_envs.curriculum.MinimumDifficulty`, drawn through the env's ``np_random``); None:

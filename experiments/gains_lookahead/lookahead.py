@@ -1,7 +1,7 @@
 """How much per-gait-cycle posture gains can gain over the paper's fixed gains, without learning.
 
-A gains policy (HexapodIrregularTerrain-v0's ``action_mode="gains"``, e.g. the shipped
-``models/HexapodIrregularTerrain-v0/gains_blocks``) picks (k_z, k_α, k_β) of Coelho et al.
+A gains policy (HexapodIrregularTerrain-v0's ``action_mode="gains"``, e.g. a run of
+``configs/irregular_terrain_gains_blocks.yaml``) picks (k_z, k_α, k_β) of Coelho et al.
 2024's posture controller once per gait cycle. Two measurements show what such choices can
 achieve on a task distribution:
 

@@ -330,13 +330,15 @@ def test_the_recovery_judges_tipping_at_the_envs_threshold():
     )
 
 
-def test_a_hybrid_model_refuses_an_env_that_reads_its_action_otherwise():
-    """The shipped Stewart-tilt hybrid learned its action at the env's residual_scale 2: at 0.25
-    its actions would mean something else, so loading it there names the setting."""
+def test_a_hybrid_model_refuses_an_env_that_reads_its_action_otherwise(tmp_path):
+    """A Stewart-tilt hybrid learns its action at the env's residual_scale 2: at 0.25 its actions
+    would mean something else, so loading it there names the setting."""
+    from helpers.stewart_hybrid_runs import train
+
     from agents.ppo import PPOPolicy
     from agents.run_files.errors import UserError
 
-    model = REPO / "models" / "HexapodStewartTilt-v0" / "hybrid"
+    model = train(tmp_path, "hybrid") / "final"
     with pytest.raises(UserError, match=r"residual_scale=2.0 but the env has residual_scale=0.25"):
         PPOPolicy.load(model, gym.make("HexapodStewartTilt-v0", residual_scale=0.25))
     PPOPolicy.load(model, gym.make("HexapodStewartTilt-v0"))

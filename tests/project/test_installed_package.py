@@ -21,7 +21,7 @@ def test_shipped_configs_and_models_resolve_from_another_folder(tmp_path, monkey
     assert shipped_root() == REPO  # a source checkout reads the repository root
     config = resolve_shipped("configs/evaluate_default.yaml")
     assert config == REPO / "configs" / "evaluate_default.yaml"
-    model = resolve_shipped(Path("models", "HexapodCliffWalk-v0", "ppo"))
+    model = resolve_shipped(Path("models", "HexapodIrregularTerrain-v0", "ppo"))
     assert (model / "model.zip").is_file()
     assert resolve_shipped("configs/no_such.yaml") == Path("configs/no_such.yaml")  # as given
     assert resolve_shipped("elsewhere/x.yaml") == Path("elsewhere/x.yaml")

@@ -74,7 +74,7 @@ def test_check_step0_reports_the_paired_success_difference(model, tmp_path, caps
     assert check_step0.main(argv) == 0
     line = [text for text in capsys.readouterr().out.splitlines() if text.startswith(f"{model} ")]
     assert "HexapodCliffWalk-v0: step 0 " in line[-1] and "/2 successes" in line[-1]
-    assert "return" in line[-1] and "step 0" in line[-1].rsplit(":", 1)[1]
+    assert "return" in line[-1] and line[-1].rsplit(": ", 1)[1] == record_verdict(out_dir, model)
     record = json.loads((out_dir / "summary.json").read_text())[str(model)]["train"]
     assert record["tasks"] == 2 and record["seeds"] == [1000, 1001]
     assert record["model_sha256"] == hashlib.sha256((model / "model.zip").read_bytes()).hexdigest()
@@ -84,6 +84,21 @@ def test_check_step0_reports_the_paired_success_difference(model, tmp_path, caps
     assert suite["references"] == [f"ppo:{report / 'step0_model'}"]
     assert (report / "report" / "report.md").is_file()
     assert not (report / "step0_model").exists()  # rebuilt on demand, not kept
+
+
+def record_verdict(out_dir, model):
+    return json.loads((out_dir / "summary.json").read_text())[str(model)]["train"]["verdict"]
+
+
+def test_a_missing_or_renamed_model_is_a_clear_error(model, tmp_path, capsys):
+    assert check_step0.main([str(tmp_path / "nothing"), "--output-dir", str(tmp_path)]) == 2
+    assert "no PPO model" in capsys.readouterr().err
+    renamed = tmp_path / "renamed"
+    renamed.mkdir()
+    for path in model.iterdir():
+        (renamed / path.name.replace("model.zip", "other.zip")).write_bytes(path.read_bytes())
+    with pytest.raises(UserError, match="give the model's directory"):
+        write_step0_model(renamed / "other.zip", tmp_path / "step0")
 
 
 def test_verdict_takes_the_return_only_where_success_does_not_separate():
@@ -105,3 +120,29 @@ def test_verdict_takes_the_return_only_where_success_does_not_separate():
     assert check_step0.verdict(tie, flat_return) == "does not beat its step 0"
     fewer = comparison(0.48, 0.5, [-0.06, 0.0], False)
     assert check_step0.verdict(fewer, better_return) == "does not beat its step 0"
+
+
+def test_an_evaluation_suite_can_keep_the_hard_part_of_a_distribution(tmp_path):
+    """``min_task_difficulty`` of a suite env: every evaluated task is at least that difficult,
+    the same tasks for every policy (the check of a model trained on the hard part)."""
+    from agents.pipeline.cli import evaluate_main
+
+    suite = {
+        "envs": [
+            {
+                "id": "HexapodIrregularTerrain-v1",
+                "kwargs": {"task_distribution": "train"},
+                "min_task_difficulty": 0.6,
+            }
+        ],
+        "policies": ["zero", "random"],
+        "episodes": 3,
+        "max_episode_steps": 5,
+        "output_dir": str(tmp_path / "report"),
+    }
+    (tmp_path / "suite.yaml").write_text(dump_yaml(suite))
+    assert evaluate_main(["--config", str(tmp_path / "suite.yaml"), "--no-progress"]) == 0
+    metrics = json.loads((tmp_path / "report" / "metrics.json").read_text())
+    runs = metrics["envs"]["HexapodIrregularTerrain-v1"]["policies"]
+    tasks = {name: [e["task"] for e in run["episodes"]] for name, run in runs.items()}
+    assert all(t["difficulty"] >= 0.6 for t in tasks["zero"]) and tasks["zero"] == tasks["random"]
