@@ -46,7 +46,11 @@ def test_default_suite_is_the_v1_benchmark_and_the_v0_suite_keeps_the_shipped_mo
     assert suite.output_dir == "reports/default" and suite.missing_models == "skip"
     v0 = load_suite(CONFIGS / "evaluate_v0_shipped.yaml")
     assert [e.id for e in v0.envs] == list(TRAIN_CONFIGS.values())
-    assert v0.policies[3:] == ["ppo:models/{env_id}/ppo", "ppo:models/{env_id}/gains"]
+    assert v0.policies[3:] == [
+        "ppo:models/{env_id}/ppo",
+        "ppo:models/{env_id}/hybrid",
+        "ppo:models/{env_id}/gains",
+    ]
     assert v0.output_dir == "reports/shipped_v0"
 
 
