@@ -203,7 +203,10 @@ class StabilityRulePenalty(gym.Wrapper):
     25° bound and tips for a third of the episode, failing every task. Two terms, each in
     ``info`` beside the env's own, close that gap:
 
-    - ``reward_rule_tipping`` = -`weight` on every step with ``info["is_tipping"]``;
+    - ``reward_rule_tipping`` = -`weight` on every step with ``info["is_tipping"]``, where the
+      rule bounds the time spent tipping (``success_max_tipping_share``; the Stewart tilt's does
+      not, since on a platform tilted to 40° every stance is below ξ after the recovery, and
+      there the term stays 0);
     - ``reward_rule_tilt`` = -`weight` on every step whose tilt exceeds the success rule's bound
       (``success_max_tilt_deg``): from then on the episode can no longer succeed.
 
@@ -211,8 +214,6 @@ class StabilityRulePenalty(gym.Wrapper):
     step costs a visible share of it. A ValueError names the problem for an env without the
     bound (the -v0 ids) or a weight that is not a positive number.
     """
-
-    TERMS = ("rule_tipping", "rule_tilt")
 
     def __init__(self, env: gym.Env, weight: float):
         super().__init__(env)
@@ -226,10 +227,12 @@ class StabilityRulePenalty(gym.Wrapper):
                 "penalty to mirror; the -v1 ids have one"
             )
         self.weight, self.tilt_bound_deg = float(weight), float(bound)
+        self.bounds_tipping = env.unwrapped.settings.success_max_tipping_share is not None
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         obs, reward, terminated, truncated, info = self.env.step(action)
-        tipping = -self.weight * float(bool(info.get(keys.IS_TIPPING, False)))
+        is_tipping = self.bounds_tipping and bool(info.get(keys.IS_TIPPING, False))
+        tipping = -self.weight * float(is_tipping)
         tilt = -self.weight * float(info.get(keys.TILT_DEG, 0.0) > self.tilt_bound_deg)
         info = {**info, "reward_rule_tipping": tipping, "reward_rule_tilt": tilt}
         return obs, float(reward) + tipping + tilt, terminated, truncated, info

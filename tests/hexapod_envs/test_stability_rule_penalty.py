@@ -40,10 +40,12 @@ class _Scripted(gym.Env):
 
     observation_space = gym.spaces.Box(-1.0, 1.0, (1,))
     action_space = gym.spaces.Box(-1.0, 1.0, (1,))
-    settings = SimpleNamespace(success_max_tilt_deg=8.0)
 
-    def __init__(self, states):
+    def __init__(self, states, tipping_share=0.1):
         self.states = list(states)
+        self.settings = SimpleNamespace(
+            success_max_tilt_deg=8.0, success_max_tipping_share=tipping_share
+        )
 
     def reset(self, *, seed=None, options=None):
         return np.zeros(1, np.float32), {}
@@ -59,6 +61,16 @@ def test_the_tilt_term_pays_only_past_the_bound():
     env.reset()
     rewards = [env.step(np.zeros(1))[1] for _ in range(4)]
     assert rewards == [1.0, 1.0, -1.0, 0.0]
+
+
+def test_tipping_costs_nothing_where_the_rule_does_not_bound_it():
+    """The Stewart tilt's rule bounds the tilt but not the time below xi (every stance on the
+    tilted platform is below it after the recovery): only the tilt term applies there."""
+    env = StabilityRulePenalty(_Scripted([(True, 1.0), (True, 9.0)], tipping_share=None), 1.0)
+    env.reset()
+    assert [env.step(np.zeros(1))[1] for _ in range(2)] == [1.0, 0.0]
+    stewart = StabilityRulePenalty(gym.make("HexapodStewartTilt-v1"), 1.0)
+    assert not stewart.bounds_tipping and stewart.tilt_bound_deg == 2.5
 
 
 def test_bad_uses_are_named():
