@@ -146,14 +146,23 @@ def tilt_bound(env: gym.Env, kind: str) -> float | None:
     _check_episode_reward(kind)
     if kind != "stable_success":
         return None
-    bound = getattr(getattr(env.unwrapped, "settings", None), "success_max_tilt_deg", None)
+    bound = _rule_setting(env, "success_max_tilt_deg")
     if bound is None:
         raise ValueError(
             'the episode reward "stable_success" grades a success by the success rule\'s tilt '
-            f"bound, and {env.spec.id if env.spec else type(env.unwrapped).__name__} has none "
+            f"bound, and {_env_name(env)} has none "
             '(the -v1 ids have one); use "success" or "return"'
         )
     return float(bound)
+
+
+def _rule_setting(env: gym.Env, name: str) -> Any:
+    """The success-rule setting `name` of `env` (None where the env has none: the -v0 ids)."""
+    return getattr(getattr(env.unwrapped, "settings", None), name, None)
+
+
+def _env_name(env: gym.Env) -> str:
+    return env.spec.id if env.spec else type(env.unwrapped).__name__
 
 
 class GainsPerEpisode(gym.Wrapper):
@@ -219,15 +228,14 @@ class StabilityRulePenalty(gym.Wrapper):
         super().__init__(env)
         if not (np.isfinite(weight) and weight > 0):
             raise ValueError(f"the stability-rule penalty weight must be > 0, got {weight}")
-        bound = getattr(getattr(env.unwrapped, "settings", None), "success_max_tilt_deg", None)
+        bound = _rule_setting(env, "success_max_tilt_deg")
         if bound is None:
-            name = env.spec.id if env.spec else type(env.unwrapped).__name__
             raise ValueError(
-                f"{name} has no success tilt bound (success_max_tilt_deg) for the stability-rule "
-                "penalty to mirror; the -v1 ids have one"
+                f"{_env_name(env)} has no success tilt bound (success_max_tilt_deg) for the "
+                "stability-rule penalty to mirror; the -v1 ids have one"
             )
         self.weight, self.tilt_bound_deg = float(weight), float(bound)
-        self.bounds_tipping = env.unwrapped.settings.success_max_tipping_share is not None
+        self.bounds_tipping = _rule_setting(env, "success_max_tipping_share") is not None
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         obs, reward, terminated, truncated, info = self.env.step(action)

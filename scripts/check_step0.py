@@ -101,7 +101,9 @@ def check_record(model: Path, metrics: dict) -> dict:
 
 
 def summary_line(model: str, record: dict) -> str:
-    (s0, s1), (t0, t1) = record["successes"].values(), record["tip_overs"].values()
+    (s0, s1), (t0, t1) = (
+        (record[k]["step0"], record[k]["trained"]) for k in ("successes", "tip_overs")
+    )
     n, (lo, hi), (rlo, rhi) = record["tasks"], record["success_interval"], record["return_interval"]
     return (
         f"{model} on {record['env_id']}: step 0 {s0}/{n} successes ({t0} tip-overs), trained "

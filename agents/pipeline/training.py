@@ -199,9 +199,7 @@ def new_model(config: TrainConfig, venv: Any) -> Any:
         verbose=config.logging.verbose,
         **_ppo_kwargs(config),
     )
-    hybrid_zero = config.hybrid is not None and config.hybrid.zero_init_action_net
-    knobs_zero = config.knobs is not None and config.knobs.zero_init_action_net
-    if hybrid_zero or knobs_zero or config.policy.zero_init_action_net:
+    if config.starts_at_zero_action:
         from ..hybrid import zero_init_action_net
 
         zero_init_action_net(model)

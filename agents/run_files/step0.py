@@ -23,6 +23,7 @@ from pathlib import Path
 from .artifacts import META_FILE, MODEL_FILE, find_model, read_meta
 from .errors import UserError
 from .model_files import atomic_path
+from .train_config import load_train_config
 
 POLICY_WEIGHTS = "policy.pth"
 """The entry of an SB3 ``model.zip`` that holds the policy's state dict."""
@@ -30,12 +31,6 @@ ACTION_NET = ("action_net.weight", "action_net.bias")
 """The actor's last layer: its output is the action's mean."""
 STEP0_KIND = "step0"
 """``meta.json`` kind of a rebuilt step-0 model."""
-
-
-def zero_initialised(config: dict) -> bool:
-    """Whether a resolved training config started its actor at a deterministic action of 0."""
-    sections = [config.get("policy") or {}, config.get("hybrid") or {}, config.get("knobs") or {}]
-    return any(bool(section.get("zero_init_action_net")) for section in sections)
 
 
 def write_step0_model(model_path: str | Path, out_dir: str | Path) -> Path:
@@ -48,7 +43,7 @@ def write_step0_model(model_path: str | Path, out_dir: str | Path) -> Path:
             f"{files.model}: give the model's directory (its {MODEL_FILE}) to rebuild its step 0"
         )
     config = files.training_config()
-    if config is None or not zero_initialised(config):
+    if config is None or not load_train_config(data=config).starts_at_zero_action:
         raise UserError(
             f"the model at {files.model} was not trained from a zero-initialised actor "
             "(zero_init_action_net in its config.yaml), so its step-0 policy cannot be rebuilt"

@@ -372,6 +372,14 @@ class TrainConfig:
     hybrid: HybridConfig | None = None  # None: plain PPO; see agents/hybrid.py
     knobs: KnobConfig | None = None  # None: no controller knobs; see agents/knobs.py
 
+    @property
+    def starts_at_zero_action(self) -> bool:
+        """Whether training zeroes the actor's output layer first (``zero_init_action_net`` of
+        ``policy``, ``hybrid`` or ``knobs``): a deterministic step-0 action of exactly 0."""
+        hybrid = self.hybrid is not None and self.hybrid.zero_init_action_net
+        knobs = self.knobs is not None and self.knobs.zero_init_action_net
+        return hybrid or knobs or self.policy.zero_init_action_net
+
     def __post_init__(self):
         rollout = self.ppo.n_steps * self.vec_env.n_envs
         if rollout < 2:
