@@ -4,18 +4,21 @@ single envs return.
 Each world is an ordinary env instance (its own `MjModel`, `MjData`, task, controllers and
 `np_random`), wrapped as ``gym.make`` wraps it (the time limit). A vector step:
 
-1. on the calling thread, every stepping world validates its action and applies it (the
-   servo commands, residual filters and gait controllers: `HexapodEnv._apply_action`);
-2. the control period's physics of those worlds (each world's own `HexapodEnv._simulate`,
-   ATHENA's contact checks included) is queued, in world order, on ``nthread`` threads;
-   MuJoCo releases the GIL inside ``mj_step``, so the worlds' physics runs in parallel (a
-   world that no thread has started when the calling thread needs it runs on the calling
-   thread);
+1. on the calling thread, every stepping world validates its action; then, world by world, it
+   applies the action (the servo commands, residual filters and gait controllers:
+   `HexapodEnv._apply_action`)
+2. and queues that world's control period of physics (its own `HexapodEnv._simulate`,
+   ATHENA's contact checks included) on ``nthread`` threads, so the first worlds' physics
+   starts while later actions are applied; MuJoCo releases the GIL inside ``mj_step``, so the
+   worlds' physics runs in parallel (a world that no thread has started when the calling
+   thread needs it runs on the calling thread);
 3. meanwhile the calling thread runs Gymnasium's `SyncVectorEnv.step`, which steps every world
    as usual with its action application and physics replaced, for this one call, by phase 1
    and by waiting for its physics: world k's measurement, tip-over, success, reward,
-   observation and info run while later worlds' physics goes on. The time limit, the
-   autoreset (any `AutoresetMode`) and the vector info dict are Gymnasium's own code.
+   observation and info run while later worlds' physics goes on. The time limit and the
+   autoreset (any `AutoresetMode`) are Gymnasium's own code; the vector info dict is built
+   once after the worlds have stepped (`hexapod_envs.vector.infos.merge_infos`), equal to
+   Gymnasium's world-by-world merge.
 
 So the results are bit-identical to `SyncVectorEnv` over ``gym.make(id)`` envs with the same
 seeds (tests/hexapod_envs/test_vector_env.py), whatever the thread count: each world runs its
@@ -50,6 +53,7 @@ from gymnasium.vector import AutoresetMode, SyncVectorEnv
 from gymnasium.vector.utils import iterate
 
 from ..envs.base import HexapodEnv
+from .infos import merge_infos
 
 __all__ = ["BatchedPhysics", "BatchedVectorEnv"]
 
@@ -92,10 +96,8 @@ class BatchedPhysics:
         worlds = self.worlds
         # Validate every action before any world changes: a bad action leaves all worlds alone.
         applied = {i: worlds[i]._validate_action(actions[i]).copy() for i in stepping}
-        for i in stepping:
-            worlds[i]._apply_action(worlds[i]._action)
-        physics = self._start(stepping)
         try:
+            physics = self._start(stepping)
             for i in stepping:
                 _replace_once(worlds[i], "_apply_action", partial(_check_action, i, applied[i]))
                 _replace_once(worlds[i], "_simulate", physics[i])
@@ -112,16 +114,21 @@ class BatchedPhysics:
                     worlds[i].__dict__.pop(name, None)
 
     def _start(self, worlds: Sequence[int]) -> dict[int, Callable[[], bool]]:
-        """Queue one control period of physics of each of `worlds` (its own `_simulate`) on the
-        threads, in world order; world -> a call that waits for it and returns whether it stayed
-        stable. Without threads the call runs the physics itself."""
-        if self._pool is None:
-            return {i: self.worlds[i]._simulate for i in worlds}
-        self._running = [self._pool.submit(self.worlds[i]._simulate) for i in worlds]
-        return {
-            i: partial(_take, future, self.worlds[i]._simulate)
-            for i, future in zip(worlds, self._running, strict=True)
-        }
+        """Apply each of `worlds`' action and queue its control period of physics (its own
+        `_simulate`) on the threads at once, in world order, so that the first worlds' physics
+        runs while the later actions are applied; world -> a call that waits for it and returns
+        whether it stayed stable. Without threads the call runs the physics itself."""
+        physics = {}
+        for i in worlds:
+            world = self.worlds[i]
+            world._apply_action(world._action)
+            if self._pool is None:
+                physics[i] = world._simulate
+            else:
+                future = self._pool.submit(world._simulate)
+                self._running.append(future)
+                physics[i] = partial(_take, future, world._simulate)
+        return physics
 
     def close(self) -> None:
         if self._pool is not None:
@@ -144,6 +151,7 @@ class BatchedVectorEnv(SyncVectorEnv):
         copy: bool = True,
         autoreset_mode: str | AutoresetMode = AutoresetMode.NEXT_STEP,
     ):
+        self._collected_infos: list[tuple[dict, int]] | None = None
         super().__init__(env_fns, copy=copy, autoreset_mode=autoreset_mode)
         self.physics = BatchedPhysics([env.unwrapped for env in self.envs], nthread)
 
@@ -154,14 +162,28 @@ class BatchedVectorEnv(SyncVectorEnv):
 
     def step(self, actions):
         """`SyncVectorEnv.step` with the physics of the worlds that step (not those that
-        autoreset now) batched (`BatchedPhysics.step`)."""
+        autoreset now) batched (`BatchedPhysics.step`), and the vector info built once."""
         stepping = [
             i
             for i in range(self.num_envs)
             if self.autoreset_mode != AutoresetMode.NEXT_STEP or not self._autoreset_envs[i]
         ]
-        with self.physics.step(stepping, list(iterate(self.action_space, actions))):
-            return super().step(actions)
+        self._collected_infos = []
+        try:
+            with self.physics.step(stepping, list(iterate(self.action_space, actions))):
+                observations, rewards, terminations, truncations, _ = super().step(actions)
+        finally:
+            collected, self._collected_infos = self._collected_infos, None
+        infos = merge_infos(collected, self.num_envs, self._add_info)
+        return observations, rewards, terminations, truncations, infos
+
+    def _add_info(self, vector_infos: dict, env_info: dict, env_num: int) -> dict:
+        """In a step, collect each world's info for `merge_infos`; elsewhere (the reset)
+        Gymnasium's merge."""
+        if self._collected_infos is None:
+            return super()._add_info(vector_infos, env_info, env_num)
+        self._collected_infos.append((env_info, env_num))
+        return vector_infos
 
     def close_extras(self, **kwargs: Any) -> None:
         super().close_extras(**kwargs)

@@ -10,6 +10,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 from gymnasium.vector import AutoresetMode
+from helpers.same import assert_same
 
 import hexapod_envs  # noqa: F401  (registers the ids)
 from hexapod_envs.vector import BatchedVectorEnv
@@ -39,39 +40,16 @@ def _pair(env_id: str, num_envs: int, nthread: int = 2, **kwargs):
     return batched, sync
 
 
-def _assert_same(a, b, where: str) -> None:
-    """Bit-identical values: arrays (NaN equal to NaN), dicts, sequences, scalars."""
-    if isinstance(a, dict):
-        assert isinstance(b, dict) and list(a) == list(b), where  # the keys in order
-        for key in a:
-            _assert_same(a[key], b[key], f"{where}[{key!r}]")
-    elif isinstance(a, np.ndarray):
-        assert isinstance(b, np.ndarray) and a.dtype == b.dtype and a.shape == b.shape, where
-        if a.dtype == object:
-            for k, (x, y) in enumerate(zip(a, b, strict=True)):
-                _assert_same(x, y, f"{where}[{k}]")
-        else:
-            assert np.array_equal(a, b, equal_nan=a.dtype.kind in "fc"), where
-    elif isinstance(a, list | tuple):
-        assert type(a) is type(b) and len(a) == len(b), where
-        for k, (x, y) in enumerate(zip(a, b, strict=True)):
-            _assert_same(x, y, f"{where}[{k}]")
-    elif isinstance(a, float) and np.isnan(a):
-        assert isinstance(b, float) and np.isnan(b), where
-    else:
-        assert a == b and type(a) is type(b), where
-
-
 def _run_both(batched, sync, steps: int, seed: int) -> tuple[int, int]:
     """Step both with the same random actions; (terminations, truncations) seen."""
-    _assert_same(batched.reset(seed=seed), sync.reset(seed=seed), "reset")
+    assert_same(batched.reset(seed=seed), sync.reset(seed=seed), "reset")
     rng = np.random.default_rng(seed)
     shape = (batched.num_envs, *batched.single_action_space.shape)
     ended = np.zeros(2, dtype=int)
     for k in range(steps):
         actions = rng.uniform(-1.0, 1.0, shape).astype(np.float32)
         got, expected = batched.step(actions), sync.step(actions)
-        _assert_same(got, expected, f"step {k}")
+        assert_same(got, expected, f"step {k}")
         ended += [int(got[2].sum()), int(got[3].sum())]
     batched.close()
     sync.close()
@@ -144,7 +122,7 @@ def test_bad_action_leaves_every_world_alone():
         batched.step(bad)
     assert not any("_simulate" in w.__dict__ for w in batched.worlds)
     good = np.full((2, 18), 0.1, dtype=np.float32)
-    _assert_same(batched.step(good), sync.step(good), "after the refused action")
+    assert_same(batched.step(good), sync.step(good), "after the refused action")
 
 
 def test_nthread_is_checked():
