@@ -8,7 +8,8 @@ and, without a recovery controller, the robot tips over.
 ## Action Space
 18 values in [-1, 1] (J_x, J_z, J_theta per leg in LF LM LR RF RM RR order): joint targets in
 ``action_mode="joint"``, or offsets from the reference tripod gait in ``"residual"`` (default;
-see `HeavyDutyEnv`).
+see `HeavyDutyEnv`). ``clock_action=True`` (residual mode) adds a 19th: the reference gait's
+clock rate, 1 + min(a, 0), so that a policy can slow or hold the gait.
 
 ## Observation Space
 

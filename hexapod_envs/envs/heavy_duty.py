@@ -5,7 +5,10 @@ Action modes:
   (J_x, J_z, J_theta per leg, legs in LEG_NAMES order).
 - ``"residual"``: 18 offsets in [-1, 1] added to the reference tripod gait's targets, scaled by
   ``residual_scale`` times each joint's half range and low-pass filtered with time constant
-  ``residual_filter_tau`` [s]; a zero action walks the paper's gait.
+  ``residual_filter_tau`` [s]; a zero action walks the paper's gait. With ``clock_action=True``
+  (walking scenarios) a 19th value sets the rate of the reference gait's clock this step,
+  1 + min(a, 0): 0 keeps the paper's pace, -1 holds the gait where it is (every leg's target
+  stays; the ``gait_phase`` observation follows the clock).
 
 ``is_success``: not tipped over and, in walking scenarios, at least ``min_progress`` of the
 distance the reference gait covers in the elapsed walking time.
@@ -107,6 +110,11 @@ class HeavyDutySettings(EnvSettings):
     """Share of the reference gait's distance a successful walking episode covers."""
     gait: TripodGaitParams | None = option(None, kind=TripodGaitParams)
     """The reference tripod gait (None: the paper's)."""
+    clock_action: bool = choice(False, (False, True))
+    """Residual mode of a walking scenario: add the reference gait's clock rate as a 19th action
+    (see the module docstring). The reference's pace is the one thing per-step joint residuals
+    cannot change: slowing or holding the whole gait would take a residual that tracks the
+    moving reference."""
 
 
 class HeavyDutyEnv(HexapodEnv):
@@ -136,7 +144,16 @@ class HeavyDutyEnv(HexapodEnv):
         self.weight_n = self.robot.total_mass * 9.81
         self._contact_force_sq = (s.contact_threshold * self.weight_n) ** 2
         self.action_map = JointActionMap(np.tile(self.robot.joint_ranges, (6, 1)))
-        self.action_space = spaces.Box(-1.0, 1.0, shape=(18,), dtype=np.float32)
+        if s.clock_action and (s.action_mode != "residual" or not self.walks):
+            raise ValueError(
+                "clock_action=True adds the reference gait's clock rate to the residual action of "
+                f"a walking scenario; got action_mode={s.action_mode!r} on "
+                f"{type(self).__name__} (walks: {self.walks})"
+            )
+        self.clock_action = s.clock_action
+        self.action_space = spaces.Box(
+            -1.0, 1.0, shape=(19 if s.clock_action else 18,), dtype=np.float32
+        )
         self._residual_gain = s.residual_scale * self.action_map.half
         # First-order low-pass on the residual (a servo command filter): a step-to-step
         # jittering residual would otherwise hammer 5 t through 4e6 N/m servos.
@@ -195,6 +212,8 @@ class HeavyDutyEnv(HexapodEnv):
     # --- time and reference gait ------------------------------------------------------------
     def _gait_step(self) -> int:
         """Index into the reference table (the gait clock is frozen while standing)."""
+        if self.clock_action:
+            return int(self._clock) % self._steps_per_cycle
         return max(0, self._step_count - self._stand_steps) % self._steps_per_cycle
 
     def reference_joints(self) -> np.ndarray:
@@ -216,7 +235,9 @@ class HeavyDutyEnv(HexapodEnv):
         self.data.ctrl[self._act_ids] = targets
 
     def _start_episode(self) -> None:
-        self._residual = np.zeros(self.action_space.shape)
+        self._residual = np.zeros(18)
+        self._clock = 0.0
+        """With `clock_action`: reference-gait control steps walked so far (fractional)."""
 
     def _apply_action(self, action: np.ndarray) -> None:
         """Joint targets from the action (MuJoCo clamps them to the servo ranges, ctrlrange):
@@ -225,16 +246,18 @@ class HeavyDutyEnv(HexapodEnv):
         self._before_physics()
         if self.action_mode == "joint":
             self.data.ctrl[self._act_ids] = self.action_map.to_joints(action)
-        else:
-            _compiled.filtered_residual_targets(
-                action,
-                self._residual_gain,
-                self._filter_alpha,
-                self._residual,
-                self.reference_joints(),
-                self.data.ctrl,
-                self._act_ids,
-            )
+            return
+        _compiled.filtered_residual_targets(
+            action[:18],
+            self._residual_gain,
+            self._filter_alpha,
+            self._residual,
+            self.reference_joints(),
+            self.data.ctrl,
+            self._act_ids,
+        )
+        if self.clock_action and self._step_count >= self._stand_steps:
+            self._clock += 1.0 + min(float(action[18]), 0.0)
 
     def _before_physics(self) -> None:
         """Hook run before each control period's physics (e.g. driving a platform)."""

@@ -118,3 +118,49 @@ def test_unstable_simulation_truncates_with_a_flag():
     env.unwrapped.data.qvel[:] = 1e12  # blow the simulation up
     _, _, terminated, truncated, info = env.step(np.zeros(18))
     assert truncated and not terminated and info["sim_unstable"]
+
+
+def _walk_with_clock(env, rates, seed=0):
+    """Step `env` (clock_action) with zero residuals and the given clock actions; the infos."""
+    env.reset(seed=seed)
+    action = np.zeros(19, dtype=np.float32)
+    infos = []
+    for rate in rates:
+        action[18] = rate
+        infos.append(env.step(action)[4])
+    return infos
+
+
+def test_clock_action_at_or_above_zero_walks_the_reference():
+    plain = gym.make("HexapodCliffWalk-v1", terrain="flat")
+    clocked = gym.make("HexapodCliffWalk-v1", terrain="flat", clock_action=True)
+    assert clocked.action_space.shape == (19,)
+    expected = run(plain, TripodGaitPolicy(plain), 250)[1:]  # after the reset's info
+    got = _walk_with_clock(clocked, [0.0] * 125 + [0.7] * 125)
+    np.testing.assert_array_equal([i["cog"] for i in got], [i["cog"] for i in expected])
+
+
+def test_clock_action_minus_one_holds_the_gait_and_half_walks_at_half_pace():
+    env = gym.make("HexapodCliffWalk-v1", terrain="flat", clock_action=True)
+    walk = 150 + 100  # the 3 s of standing, then 2 s of walking
+    infos = _walk_with_clock(env, [0.0] * walk + [-1.0] * 100)
+    held = np.array([i["cog"][0] for i in infos[walk + 25 :]])
+    assert np.ptp(held) < 0.005  # the body stops once the held targets are reached [m]
+    obs_phase = env.unwrapped._gait_phase().copy()
+    env.step(np.r_[np.zeros(18), -1.0].astype(np.float32))
+    np.testing.assert_array_equal(env.unwrapped._gait_phase(), obs_phase)  # the clock is held
+    half = _walk_with_clock(env, [0.0] * 150 + [-0.5] * 600)
+    full = _walk_with_clock(env, [0.0] * 750)
+    progress = (half[-1]["cog"][0] - half[149]["cog"][0]) / (
+        full[-1]["cog"][0] - full[149]["cog"][0]
+    )
+    assert 0.4 < progress < 0.6
+
+
+@pytest.mark.parametrize(
+    ("env_id", "kwargs"),
+    [("HexapodCliffWalk-v1", {"action_mode": "joint"}), ("HexapodStewartTilt-v1", {})],
+)
+def test_clock_action_needs_the_residual_mode_of_a_walking_scenario(env_id, kwargs):
+    with pytest.raises(ValueError, match="clock_action.*walking scenario"):
+        gym.make(env_id, clock_action=True, **kwargs)
