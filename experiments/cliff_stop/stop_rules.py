@@ -1,0 +1,142 @@
+"""What the analytical controller's successes on HexapodCliffWalk-v1 amount to: stopping.
+
+Three policies on the tasks of a distribution, each task's outcome printed:
+
+- ``analytical``: the paper's judgment and recovery (`GaitWithRecoveryPolicy`, joint mode, as the
+  benchmark runs it): it walks the reference gait until the FASM falls below ξ_f, then puts the
+  adjustment leg down and holds the recovered stance.
+- ``hold``: the reference gait, held where it is (`clock_action`: the gait's clock stopped)
+  from the first step the FASM falls below ξ_f. No recovery step: what stopping alone gives.
+- ``sensed_hold``: the same hold from the sensors of the current step alone (no memory, as a
+  per-step policy without a recurrent state acts): hold while the FASM is below ξ_f or a leg
+  the gait's phase puts in stance carries no load. Held over the void, a leg stays unloaded,
+  so the hold lasts.
+
+If ``hold`` and ``sensed_hold`` succeed where the controller does, the cliff's success rule
+asks for a stop at the edge, and a per-step policy with the clock action can express it
+(`configs/cliff_walk_v1_ppo_clock.yaml`, docs/results.md).
+
+    python experiments/cliff_stop/stop_rules.py --distribution train --seeds 1000 1020 \
+        [--policies analytical hold sensed_hold] [--json out.json]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Callable
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # run as a script from anywhere
+
+import hexapod_envs  # noqa: E402, F401  (registers the ids)
+from agents.policy import ObservationReader  # noqa: E402
+from agents.registry import ANALYTICAL_ENV_KWARGS, analytical_factory  # noqa: E402
+from hexapod_envs.robots.heavy_duty import LEG_NAMES  # noqa: E402
+from hexapod_envs.robots.heavy_duty.gait import INITIAL_PHASE  # noqa: E402
+
+ENV_ID = "HexapodCliffWalk-v1"
+POLICIES = ("analytical", "hold", "sensed_hold")
+STANCE_MARGIN = 0.02
+"""Share of the cycle after touch-down (and before lift-off) in which a stance leg may still be
+unloaded: the foot takes a few control steps to carry its share."""
+
+
+class HoldAtTipping:
+    """Zero residuals; the gait's clock stopped for good once the FASM falls below ξ_f (or,
+    with `sensed`, on every step the sensors show tipping or an unloaded stance leg)."""
+
+    def __init__(self, env: gym.Env, sensed: bool):
+        base = env.unwrapped
+        self.read = ObservationReader(base.task_description.observation_structure)
+        self.threshold = base.tipping_threshold_deg
+        self.duty = base.gait.gait.duty_factor
+        self.sensed = sensed
+        self.action = np.zeros(env.action_space.shape, dtype=np.float32)
+        self.held = False
+
+    def reset(self) -> None:
+        self.held = False
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        o = self.read(observation)
+        sin, cos, walking = o["gait_phase"]
+        tipping = walking > 0.5 and o["fasm_margin_deg"][0] < self.threshold
+        if self.sensed:
+            self.held = walking > 0.5 and (tipping or self._unloaded_stance_leg(sin, cos, o))
+        else:
+            self.held = self.held or tipping
+        self.action[-1] = -1.0 if self.held else 0.0
+        return self.action.copy()
+
+    def _unloaded_stance_leg(self, sin: float, cos: float, o: dict) -> bool:
+        phase = (np.arctan2(sin, cos) / (2 * np.pi)) % 1.0
+        for k, leg in enumerate(LEG_NAMES):
+            leg_phase = (phase + INITIAL_PHASE[leg] - INITIAL_PHASE["LM"]) % 1.0
+            if STANCE_MARGIN < leg_phase < self.duty - STANCE_MARGIN and o["foot_contact"][k] < 0.5:
+                return True
+        return False
+
+
+def make(policy: str, distribution: str) -> tuple[gym.Env, Callable]:
+    """The env and the policy of `policy` (one of `POLICIES`)."""
+    if policy == "analytical":
+        env = gym.make(ENV_ID, task_distribution=distribution, **ANALYTICAL_ENV_KWARGS[ENV_ID])
+        return env, analytical_factory(ENV_ID)(env)
+    env = gym.make(ENV_ID, task_distribution=distribution, clock_action=True)
+    return env, HoldAtTipping(env, sensed=policy == "sensed_hold")
+
+
+def run(policy: str, distribution: str, seeds: range) -> list[dict]:
+    """Each task's outcome: success, tip-over, largest tilt, share below ξ_f, distance [m]."""
+    env, act = make(policy, distribution)
+    rows = []
+    for seed in seeds:
+        obs, info = env.reset(seed=seed)
+        act.reset()
+        done = False
+        while not done:
+            obs, _, terminated, truncated, info = env.step(act(obs))
+            done = terminated or truncated
+        rows.append(
+            {
+                "seed": seed,
+                "success": bool(info["is_success"]),
+                "tipped_over": bool(info["is_tipped_over"]),
+                "max_tilt_deg": float(info["max_tilt_deg"]),
+                "tipping_share": float(info["tipping_share"]),
+                "distance_m": float(info["distance"]),
+                "cliff_x": float(info["task"]["cliff_x"]),
+            }
+        )
+    env.close()
+    return rows
+
+
+def main(argv: list[str] | None = None) -> dict[str, list[dict]]:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--distribution", default="train", choices=("train", "test"))
+    parser.add_argument("--seeds", nargs=2, type=int, default=(1000, 1020), metavar=("A", "B"))
+    parser.add_argument("--policies", nargs="+", default=list(POLICIES), choices=POLICIES)
+    parser.add_argument("--json", type=Path, help="write every task's outcome here")
+    args = parser.parse_args(argv)
+    out = {}
+    for policy in args.policies:
+        rows = out[policy] = run(policy, args.distribution, range(*args.seeds))
+        print(
+            f"{policy}: {sum(r['success'] for r in rows)} of {len(rows)} successes, "
+            f"{sum(r['tipped_over'] for r in rows)} tip-overs; distances "
+            + " ".join(f"{r['distance_m']:.2f}" for r in rows),
+            flush=True,
+        )
+    if args.json:
+        args.json.write_text(json.dumps(out, indent=1) + "\n")
+    return out
+
+
+if __name__ == "__main__":
+    main()
