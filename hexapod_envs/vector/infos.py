@@ -3,8 +3,8 @@
 Gymnasium's vector envs merge each world's info into the vector info as the world steps
 (`gymnasium.vector.VectorEnv._add_info`): for every key of every world it looks the key up,
 allocates the batch array and its ``_key`` mask on first sight and assigns one element. With the
-21-32 keys of a hexapod env's info that costs about 25 µs a world, a sixth of a heavy-duty
-world's step. `merge_infos` builds the same dict (the same keys in the same order, the same
+21-32 keys of a hexapod env's info that is a tenth or more of a heavy-duty world's step
+(benchmarks/README.md). `merge_infos` builds the same dict (the same keys in the same order, the same
 dtypes and values, the same masks) from the list of ``(info, world)`` pairs the step collected,
 one batch assignment per key where the worlds' values are alike (a key whose type changes
 between worlds is assigned world by world, as Gymnasium does). Where the infos leave what that
