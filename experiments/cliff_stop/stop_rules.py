@@ -84,6 +84,8 @@ class HoldAtTipping:
 
 def make(policy: str, distribution: str) -> tuple[gym.Env, Callable]:
     """The env and the policy of `policy` (one of `POLICIES`)."""
+    if policy not in POLICIES:
+        raise ValueError(f"unknown policy {policy!r}; policies: {list(POLICIES)}")
     if policy == "analytical":
         env = gym.make(ENV_ID, task_distribution=distribution, **ANALYTICAL_ENV_KWARGS[ENV_ID])
         return env, analytical_factory(ENV_ID)(env)

@@ -6,9 +6,10 @@ Action modes:
 - ``"residual"``: 18 offsets in [-1, 1] added to the reference tripod gait's targets, scaled by
   ``residual_scale`` times each joint's half range and low-pass filtered with time constant
   ``residual_filter_tau`` [s]; a zero action walks the paper's gait. With ``clock_action=True``
-  (walking scenarios) a 19th value sets the rate of the reference gait's clock this step,
-  1 + min(a, 0): 0 keeps the paper's pace, -1 holds the gait where it is (every leg's target
-  stays; the ``gait_phase`` observation follows the clock).
+  (walking scenarios) a 19th value sets how far the reference gait's clock advances after this
+  step, 1 + min(a, 0) control steps: 0 keeps the paper's pace, -1 holds the gait where it is
+  (every leg's target stays from the next step on; the ``gait_phase`` observation follows the
+  clock).
 
 ``is_success``: not tipped over and, in walking scenarios, at least ``min_progress`` of the
 distance the reference gait covers in the elapsed walking time.
@@ -217,7 +218,7 @@ class HeavyDutyEnv(HexapodEnv):
         return max(0, self._step_count - self._stand_steps) % self._steps_per_cycle
 
     def reference_joints(self) -> np.ndarray:
-        """(18,) reference tripod-gait joint targets at the current time."""
+        """(18,) reference tripod-gait joint targets at the gait clock's current step."""
         return self._reference_table[self._gait_step()]
 
     # --- episode hooks ---------------------------------------------------------------------
@@ -242,7 +243,7 @@ class HeavyDutyEnv(HexapodEnv):
     def _apply_action(self, action: np.ndarray) -> None:
         """Joint targets from the action (MuJoCo clamps them to the servo ranges, ctrlrange):
         the mapped action, or the reference gait plus the filtered residual (one compiled
-        call)."""
+        call); with `clock_action`, then the gait clock's advance for the next step."""
         self._before_physics()
         if self.action_mode == "joint":
             self.data.ctrl[self._act_ids] = self.action_map.to_joints(action)
@@ -264,7 +265,8 @@ class HeavyDutyEnv(HexapodEnv):
 
     def _reference_description(self) -> dict:
         """The reference: tripod gait parameters, its table of joint targets per control step
-        of a cycle, steps per cycle and standing steps, residual scale and filter."""
+        of a cycle, steps per cycle and standing steps, residual scale and filter, and whether
+        the action ends with the gait clock's rate (`clock_action`)."""
         return {
             "gait": self.gait.gait,
             "reference_table": self._reference_table.copy(),
@@ -273,6 +275,7 @@ class HeavyDutyEnv(HexapodEnv):
             "residual_scale": self.residual_scale,
             "residual_filter_alpha": self._filter_alpha,
             "walks": self.walks,
+            "clock_action": self.clock_action,
         }
 
     # --- task distribution -----------------------------------------------------------------

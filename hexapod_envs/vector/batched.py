@@ -18,7 +18,7 @@ Each world is an ordinary env instance (its own `MjModel`, `MjData`, task, contr
    observation and info run while later worlds' physics goes on. The time limit and the
    autoreset (any `AutoresetMode`) are Gymnasium's own code; the vector info dict is built
    once after the worlds have stepped (`hexapod_envs.vector.infos.merge_infos`), equal to
-   Gymnasium's world-by-world merge.
+   Gymnasium's world-by-world merge (which the same-step autoreset keeps).
 
 So the results are bit-identical to `SyncVectorEnv` over ``gym.make(id)`` envs with the same
 seeds (tests/hexapod_envs/test_vector_env.py), whatever the thread count: each world runs its
@@ -168,18 +168,24 @@ class BatchedVectorEnv(SyncVectorEnv):
             for i in range(self.num_envs)
             if self.autoreset_mode != AutoresetMode.NEXT_STEP or not self._autoreset_envs[i]
         ]
-        self._collected_infos = []
+        # Each world's info is merged after every world has stepped: its values must not
+        # change once returned (the hexapod envs return fresh ones). With the same-step
+        # autoreset a world resets within the step after giving its final info, which a reset
+        # may change in place: those steps keep Gymnasium's merge, world by world.
+        collect = self.autoreset_mode != AutoresetMode.SAME_STEP
+        self._collected_infos = [] if collect else None
         try:
             with self.physics.step(stepping, list(iterate(self.action_space, actions))):
-                observations, rewards, terminations, truncations, _ = super().step(actions)
+                observations, rewards, terminations, truncations, infos = super().step(actions)
         finally:
             collected, self._collected_infos = self._collected_infos, None
-        infos = merge_infos(collected, self.num_envs, self._add_info)
+        if collect:
+            infos = merge_infos(collected, self.num_envs, self._add_info)
         return observations, rewards, terminations, truncations, infos
 
     def _add_info(self, vector_infos: dict, env_info: dict, env_num: int) -> dict:
-        """In a step, collect each world's info for `merge_infos`; elsewhere (the reset)
-        Gymnasium's merge."""
+        """In a step, collect each world's info for `merge_infos`; elsewhere (the reset, the
+        same-step autoreset) Gymnasium's merge."""
         if self._collected_infos is None:
             return super()._add_info(vector_infos, env_info, env_num)
         self._collected_infos.append((env_info, env_num))

@@ -4,9 +4,9 @@ Gymnasium's vector envs merge each world's info into the vector info as the worl
 (`gymnasium.vector.VectorEnv._add_info`): for every key of every world it looks the key up,
 allocates the batch array and its ``_key`` mask on first sight and assigns one element. With the
 21-32 keys of a hexapod env's info that is a tenth or more of a heavy-duty world's step
-(benchmarks/README.md). `merge_infos` builds the same dict (the same keys in the same order, the same
-dtypes and values, the same masks) from the list of ``(info, world)`` pairs the step collected,
-one batch assignment per key where the worlds' values are alike (a key whose type changes
+(benchmarks/README.md). `merge_infos` builds the same dict (the same keys in the same order, the
+same dtypes and values, the same masks) from the list of ``(info, world)`` pairs the step
+collected, one batch assignment per key where the worlds' values are alike (a key whose type changes
 between worlds is assigned world by world, as Gymnasium does). Where the infos leave what that
 reproduces (a dict beside other values under one key, a world listed twice for one key, a key
 beginning with ``_``), it merges them pair by pair with Gymnasium's own code.
@@ -71,8 +71,8 @@ def _merge_columns(keys, columns, worlds: list[int], num_envs: int) -> Info:
     mask = np.zeros(num_envs, dtype=np.bool_)
     mask[where] = True
     for key, column in zip(keys, columns, strict=True):
-        if key.startswith("_"):
-            raise _Irregular  # it could collide with another key's mask
+        if not isinstance(key, str) or key.startswith("_"):
+            raise _Irregular  # "_<key>" could collide with another key's mask
         if key == "final_obs":
             array = _objects(column, where, num_envs)
         elif isinstance(column[0], dict):
@@ -96,8 +96,8 @@ def _batch(column: Sequence, where: slice | np.ndarray, num_envs: int) -> np.nda
     if kind in _SCALARS or issubclass(kind, np.number):
         array = np.zeros(num_envs, dtype=kind)
         # One cast of the lot equals casting each value when they share the first's type, or
-        # are all floats (float64 holds every one, then one rounding to the dtype); other
-        # mixes go one by one rather than through NumPy's type promotion.
+        # are all floats (NumPy promotes them to the widest, which holds every one, then rounds
+        # once to the dtype); other mixes go one by one rather than through NumPy's promotion.
         alike = len(kinds) == 1 or all(issubclass(other, float | np.floating) for other in kinds)
     elif isinstance(first, np.ndarray):
         array = np.zeros((num_envs, *first.shape), dtype=first.dtype)

@@ -158,7 +158,31 @@ def test_an_error_in_a_world_s_physics_reaches_the_caller():
     assert not any("_simulate" in w.__dict__ or "_apply_action" in w.__dict__ for w in envs.worlds)
     with pytest.raises(RuntimeError, match="call reset"):  # worlds 0 and 2 ran physics alone
         envs.step(np.zeros((3, 18), dtype=np.float32))
-    envs.reset(seed=1)  # the threads serve the next steps
-    observations = envs.step(np.zeros((3, 18), dtype=np.float32))[0]
-    assert observations.shape == (3, *envs.single_observation_space.shape)
+    sync = gym.make_vec("HexapodCliffWalk-v1", 3, vectorization_mode="sync")
+    zeros = np.zeros((3, 18), dtype=np.float32)
+    # the threads serve the next steps, and the vector info is merged again
+    assert_same(envs.reset(seed=1), sync.reset(seed=1), "reset after the error")
+    assert_same(envs.step(zeros), sync.step(zeros), "step after the error")
+    envs.close()
+    sync.close()
+
+
+def test_an_error_applying_an_action_leaves_no_physics_running():
+    """World 2's action fails after worlds 0 and 1 have their physics queued."""
+    envs = gym.make_vec(
+        "HexapodCliffWalk-v1", 3, vectorization_mode="vector_entry_point", nthread=2
+    )
+    envs.reset(seed=0)
+
+    def broken(action):
+        raise FloatingPointError("servo command failed")
+
+    envs.worlds[2]._apply_action = broken
+    with pytest.raises(FloatingPointError, match="servo command failed"):
+        envs.step(np.zeros((3, 18), dtype=np.float32))
+    assert not envs.physics._running
+    assert all(w._needs_reset for w in envs.worlds)
+    assert "_apply_action" not in envs.worlds[2].__dict__  # the step's replacements are gone
+    envs.reset(seed=1)
+    envs.step(np.zeros((3, 18), dtype=np.float32))
     envs.close()

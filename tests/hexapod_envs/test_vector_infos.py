@@ -63,15 +63,34 @@ CASES = {
         ({"r": 0.0, "task": {"d": 0.7}}, 1),
         ({"r": 0.5, "task": {"d": 0.1}}, 2),
     ],
+    "same-step autoreset of world 1 while world 0 goes on": [
+        ({"r": 0.5, "task": {"d": 0.1}}, 0),
+        ({"final_obs": np.ones(2), "final_info": {"r": 1.0, "task": {"d": 0.3}}}, 1),
+        ({"r": 0.0, "task": {"d": 0.7}}, 1),
+    ],
+    "keys that are not strings": [({0: 1.0, "a": {1: "x"}}, 0), ({0: 2.0, "a": {1: "y"}}, 1)],
     "a world given twice under one key": [({"a": 1.0}, 0), ({"a": 2.0}, 0)],
     "a key beginning with an underscore": [({"a": 1.0, "_b": 2.0}, 0), ({"b": 3.0}, 1)],
 }
+
+
+def _masks(info: dict) -> list[np.ndarray]:
+    """Every ``_key`` mask of a vector info, nested ones included."""
+    out = []
+    for key, value in info.items():
+        if isinstance(value, dict):
+            out += _masks(value)
+        elif isinstance(key, str) and key.startswith("_"):
+            out.append(value)
+    return out
 
 
 @pytest.mark.parametrize("name", CASES)
 def test_merge_equals_gymnasium_s(name):
     got, expected = _both(CASES[name])
     assert_same(got, expected, name)
+    masks = _masks(got)
+    assert len({id(mask) for mask in masks}) == len(masks)  # each key its own mask, as there
 
 
 def test_a_value_gymnasium_cannot_cast_fails_as_there():

@@ -516,6 +516,22 @@ def test_a_run_is_evaluated_with_the_observation_it_was_trained_on(monkeypatch):
     }
 
 
+def test_a_run_is_evaluated_with_the_actions_it_was_trained_on(monkeypatch):
+    """clock_action adds an action: a run trained with it is evaluated with it."""
+    from agents.pipeline.evaluation import policy_env_kwargs
+    from agents.run_files import artifacts
+
+    class Run:
+        def training_config(self):
+            return {"env": {"kwargs": {"residual_scale": 0.1, "clock_action": True}}}
+
+    monkeypatch.setattr(artifacts, "find_model", lambda path: Run())
+    kwargs = policy_env_kwargs("ppo:x", "HexapodCliffWalk-v1")
+    assert kwargs == {"residual_scale": 0.1, "clock_action": True}
+    with gym.make("HexapodCliffWalk-v1", **kwargs) as env:
+        assert env.action_space.shape == (19,)
+
+
 def test_reward_exclude_takes_the_named_terms_out_of_the_reward():
     """env.reward_exclude: the learner's reward is the env's minus those info terms; a term the
     env does not report is an error at the first step."""
