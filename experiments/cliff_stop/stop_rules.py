@@ -36,8 +36,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))  # run as a script 
 import hexapod_envs  # noqa: E402, F401  (registers the ids)
 from agents.policy import ObservationReader  # noqa: E402
 from agents.registry import ANALYTICAL_ENV_KWARGS, analytical_factory  # noqa: E402
+from agents.tripod_gait import TripodGaitPolicy  # noqa: E402
 from hexapod_envs.robots.heavy_duty import LEG_NAMES  # noqa: E402
-from hexapod_envs.robots.heavy_duty.gait import INITIAL_PHASE  # noqa: E402
 
 ENV_ID = "HexapodCliffWalk-v1"
 POLICIES = ("analytical", "hold", "sensed_hold")
@@ -54,7 +54,7 @@ class HoldAtTipping:
         base = env.unwrapped
         self.read = ObservationReader(base.task_description.observation_structure)
         self.threshold = base.tipping_threshold_deg
-        self.duty = base.gait.gait.duty_factor
+        self.reference = TripodGaitPolicy(env)  # reads the gait clock's phase
         self.sensed = sensed
         self.action = np.zeros(env.action_space.shape, dtype=np.float32)
         self.held = False
@@ -64,20 +64,22 @@ class HoldAtTipping:
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:
         o = self.read(observation)
-        sin, cos, walking = o["gait_phase"]
-        tipping = walking > 0.5 and o["fasm_margin_deg"][0] < self.threshold
+        walking = o["gait_phase"][2] > 0.5
+        tipping = walking and o["fasm_margin_deg"][0] < self.threshold
         if self.sensed:
-            self.held = walking > 0.5 and (tipping or self._unloaded_stance_leg(sin, cos, o))
+            self.held = walking and (tipping or self._unloaded_stance_leg(observation, o))
         else:
             self.held = self.held or tipping
         self.action[-1] = -1.0 if self.held else 0.0
         return self.action.copy()
 
-    def _unloaded_stance_leg(self, sin: float, cos: float, o: dict) -> bool:
-        phase = (np.arctan2(sin, cos) / (2 * np.pi)) % 1.0
+    def _unloaded_stance_leg(self, observation: np.ndarray, o: dict) -> bool:
+        gait = self.reference.gait
+        phase = self.reference.phase(observation)
+        duty = gait.gait.duty_factor
         for k, leg in enumerate(LEG_NAMES):
-            leg_phase = (phase + INITIAL_PHASE[leg] - INITIAL_PHASE["LM"]) % 1.0
-            if STANCE_MARGIN < leg_phase < self.duty - STANCE_MARGIN and o["foot_contact"][k] < 0.5:
+            leg_phase = gait.leg_phase_at(leg, phase)
+            if STANCE_MARGIN < leg_phase < duty - STANCE_MARGIN and o["foot_contact"][k] < 0.5:
                 return True
         return False
 

@@ -84,6 +84,10 @@ class TripodGait:
         """The gait clock: phase of tripod {LM, RF, RR} (0 at the start of walking)."""
         return self.leg_phase("LM", t)
 
+    def leg_phase_at(self, leg: str, phase: float) -> float:
+        """Phase of `leg` in [0, 1) when the gait clock (tripod {LM, RF, RR}) reads `phase`."""
+        return (phase + INITIAL_PHASE[leg] - INITIAL_PHASE["LM"]) % 1.0
+
     def in_stance(self, leg: str, phase_of_leg: float) -> bool:
         return phase_of_leg < self.gait.duty_factor
 
@@ -103,8 +107,7 @@ class TripodGait:
         """Body-frame foot targets when the gait clock (tripod {LM,RF,RR}) reads `phase`."""
         out = {}
         for leg in LEG_NAMES:
-            leg_phase = (phase + INITIAL_PHASE[leg] - INITIAL_PHASE["LM"]) % 1.0
-            out[leg] = self._neutral[leg] + self.foot_offset(leg_phase)
+            out[leg] = self._neutral[leg] + self.foot_offset(self.leg_phase_at(leg, phase))
         return out
 
     def joints_at_phase(self, phase: float) -> np.ndarray:
