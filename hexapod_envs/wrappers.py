@@ -217,7 +217,11 @@ class StabilityRulePenalty(gym.Wrapper):
       not, since on a platform tilted to 40° every stance is below ξ after the recovery, and
       there the term stays 0);
     - ``reward_rule_tilt`` = -`weight` on every step whose tilt exceeds the success rule's bound
-      (``success_max_tilt_deg``): from then on the episode can no longer succeed.
+      (``success_max_tilt_deg``): from then on the episode can no longer succeed;
+    - ``reward_rule_early_landing`` = -`weight` on every step from a lifted foot's landing before
+      the robot first tipped (``info["early_landing"]``), where the rule keeps the lifted tripod
+      in swing until then (``swing_until_tipping``, the Stewart tilt's): standing on all six feet
+      from the start would otherwise earn the most return and fail every task.
 
     Choose `weight` against the env's alive term (what an upright step earns) so that a tipping
     step costs a visible share of it. A ValueError names the problem for an env without the
@@ -236,11 +240,19 @@ class StabilityRulePenalty(gym.Wrapper):
             )
         self.weight, self.tilt_bound_deg = float(weight), float(bound)
         self.bounds_tipping = _rule_setting(env, "success_max_tipping_share") is not None
+        self.bounds_swing = bool(_rule_setting(env, "swing_until_tipping"))
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         obs, reward, terminated, truncated, info = self.env.step(action)
         is_tipping = self.bounds_tipping and bool(info.get(keys.IS_TIPPING, False))
         tipping = -self.weight * float(is_tipping)
         tilt = -self.weight * float(info.get(keys.TILT_DEG, 0.0) > self.tilt_bound_deg)
-        info = {**info, "reward_rule_tipping": tipping, "reward_rule_tilt": tilt}
-        return obs, float(reward) + tipping + tilt, terminated, truncated, info
+        early = self.bounds_swing and bool(info.get("early_landing", False))
+        landing = -self.weight * float(early)
+        info = {
+            **info,
+            "reward_rule_tipping": tipping,
+            "reward_rule_tilt": tilt,
+            "reward_rule_early_landing": landing,
+        }
+        return obs, float(reward) + tipping + tilt + landing, terminated, truncated, info

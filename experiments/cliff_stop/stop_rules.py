@@ -22,8 +22,6 @@ asks for a stop at the edge, and a per-step policy with the clock action can exp
 
 from __future__ import annotations
 
-import argparse
-import json
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -37,6 +35,7 @@ import hexapod_envs  # noqa: E402, F401  (registers the ids)
 from agents.policy import ObservationReader  # noqa: E402
 from agents.registry import ANALYTICAL_ENV_KWARGS, analytical_factory  # noqa: E402
 from agents.tripod_gait import TripodGaitPolicy  # noqa: E402
+from experiments import rule_studies  # noqa: E402
 from hexapod_envs.robots.heavy_duty import LEG_NAMES  # noqa: E402
 
 ENV_ID = "HexapodCliffWalk-v1"
@@ -97,49 +96,32 @@ def make(policy: str, distribution: str) -> tuple[gym.Env, Callable]:
 
 def run(policy: str, distribution: str, seeds: range) -> list[dict]:
     """Each task's outcome: success, tip-over, largest tilt, share below ξ_f, distance [m]."""
-    env, act = make(policy, distribution)
-    rows = []
-    for seed in seeds:
-        obs, info = env.reset(seed=seed)
-        act.reset()
-        done = False
-        while not done:
-            obs, _, terminated, truncated, info = env.step(act(obs))
-            done = terminated or truncated
-        rows.append(
-            {
-                "seed": seed,
-                "success": bool(info["is_success"]),
-                "tipped_over": bool(info["is_tipped_over"]),
-                "max_tilt_deg": float(info["max_tilt_deg"]),
-                "tipping_share": float(info["tipping_share"]),
-                "distance_m": float(info["distance"]),
-                "cliff_x": float(info["task"]["cliff_x"]),
-            }
-        )
-    env.close()
-    return rows
+    return rule_studies.play(*make(policy, distribution), seeds, _row)
+
+
+def _row(seed: int, info: dict) -> dict:
+    return {
+        "seed": seed,
+        "success": bool(info["is_success"]),
+        "tipped_over": bool(info["is_tipped_over"]),
+        "max_tilt_deg": float(info["max_tilt_deg"]),
+        "tipping_share": float(info["tipping_share"]),
+        "distance_m": float(info["distance"]),
+        "cliff_x": float(info["task"]["cliff_x"]),
+    }
+
+
+def _summary(rows: list[dict]) -> str:
+    return (
+        f"{sum(r['success'] for r in rows)} of {len(rows)} successes, "
+        f"{sum(r['tipped_over'] for r in rows)} tip-overs; distances "
+        + " ".join(f"{r['distance_m']:.2f}" for r in rows)
+    )
 
 
 def main(argv: list[str] | None = None) -> dict[str, list[dict]]:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--distribution", default="train", choices=("train", "test"))
-    parser.add_argument("--seeds", nargs=2, type=int, default=(1000, 1020), metavar=("A", "B"))
-    parser.add_argument("--policies", nargs="+", default=list(POLICIES), choices=POLICIES)
-    parser.add_argument("--json", type=Path, help="write every task's outcome here")
-    args = parser.parse_args(argv)
-    out = {}
-    for policy in args.policies:
-        rows = out[policy] = run(policy, args.distribution, range(*args.seeds))
-        print(
-            f"{policy}: {sum(r['success'] for r in rows)} of {len(rows)} successes, "
-            f"{sum(r['tipped_over'] for r in rows)} tip-overs; distances "
-            + " ".join(f"{r['distance_m']:.2f}" for r in rows),
-            flush=True,
-        )
-    if args.json:
-        args.json.write_text(json.dumps(out, indent=1) + "\n")
-    return out
+    description = __doc__.split("\n\n")[0]
+    return rule_studies.main(description, POLICIES, run, _summary, (1000, 1020), "train", argv)
 
 
 if __name__ == "__main__":

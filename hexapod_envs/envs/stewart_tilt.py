@@ -30,6 +30,10 @@ foothold of the paper's own reach model (eqs. 10-12) at the paper's height.
 ## Action Space
 18 values in [-1, 1]: ``"residual"`` (default) offsets the hold posture by residual_scale x half
 range (default 2, so any joint target is reachable), ``"joint"`` gives targets directly.
+With ``landing_action=True`` (residual mode) a 19th value lowers the lifted tripod: the
+reference moves from the hold posture toward the landed posture (the lifted feet straight down
+by `SWING_LIFT`, onto the plane of the stance feet) by clip(a, 0, 1), low-pass filtered like the
+residual; 0 or below keeps the hold posture, 1 sets the lifted feet down where they are.
 
 ## Observation Space
 As HexapodCliffWalk-v0 without the gait phase: joint_pos, joint_vel, foot_force, foot_contact,
@@ -74,6 +78,7 @@ import math
 
 import mujoco
 import numpy as np
+from gymnasium import spaces
 
 from ..robots.heavy_duty import LEG_NAMES, TRIPODS, joints_for_foot, within_limits
 from ..terrain._compiled import stewart_actuator_lengths
@@ -218,6 +223,11 @@ class StewartTiltSettings(HeavyDutySettings):
     """The lifted tripod is in swing, so a success also needs every lifted foot off the
     platform until the robot first tips (FASM below ξ): landing a leg is a recovery, not a
     posture to take before the need (True in -v1; `info["early_landing"]`)."""
+    landing_action: bool = choice(False, (False, True))
+    """Residual mode: add the lifted tripod's landing as a 19th action (see the module
+    docstring). Landing is the one motion the recovery needs, and in 18 per-joint residuals it
+    is nine joints moved together at the right moment, which per-step exploration does not
+    find (docs/results.md, "Pure PPO on the Stewart tilt")."""
     train_ranges: TiltTaskRanges = option(TILT_TRAIN, kind=TiltTaskRanges, optional=False)
     test_ranges: TiltTaskRanges = option(TILT_TEST, kind=TiltTaskRanges, optional=False)
 
@@ -249,8 +259,18 @@ class StewartTiltEnv(HeavyDutyEnv):
         self._platform_centre = self.platform.neutral_position  # read-only: never moves
         self._platform_centre.flags.writeable = False
         self.task_ranges = {"train": s.train_ranges, "test": s.test_ranges}
+        if s.landing_action and s.action_mode != "residual":
+            raise ValueError(
+                "landing_action=True adds the lifted tripod's landing to the residual action; got "
+                f"action_mode={s.action_mode!r}"
+            )
+        self.landing_action = s.landing_action
         super()._setup()
+        if self.landing_action:
+            self.action_space = spaces.Box(-1.0, 1.0, shape=(19,), dtype=np.float32)
         self._hold = self._hold_posture(STANCES[self.stance_name])  # set per episode at reset
+        if self.landing_action:
+            self._landed = self._hold_posture(STANCES[self.stance_name], lift=0.0)
         # Validate the fixed scenarios' whole motion up front: a pose the actuators cannot reach
         # is refused here, not discovered mid-episode.
         if self.scenario != "random":
@@ -280,19 +300,23 @@ class StewartTiltEnv(HeavyDutyEnv):
         else:
             self.max_tilt = np.radians(40.0)
         self._hold = self._hold_posture(stance)
+        if self.landing_action:
+            self._landed = self._hold_posture(stance, lift=0.0)
 
     def _check_reachable(self) -> None:
         for tilt in np.linspace(0.0, self.max_tilt, 25):
             self.platform.check_pose(self.platform.neutral_position, self._rpy(tilt))
 
-    def _hold_posture(self, stance: tuple[str, ...]) -> np.ndarray:
+    def _hold_posture(self, stance: tuple[str, ...], lift: float = SWING_LIFT) -> np.ndarray:
+        """(18,) joint targets with the `stance` feet at the hold's footholds and the other feet
+        `lift` [m] above theirs."""
         joints = []
         for leg in LEG_NAMES:
             side = 1.0 if leg[0] == "L" else -1.0
             foot = self.robot.hip_offsets[leg] + np.array([0.0, 0.0, -self.hold_depth])
             foot[1] = side * self.hold_foot_y
             if leg not in stance:
-                foot[2] += SWING_LIFT
+                foot[2] += lift
             unreachable = (
                 f"hold_depth={self.hold_depth} m, hold_foot_y={self.hold_foot_y} m: leg {leg} "
                 "cannot reach its foothold"
@@ -362,12 +386,36 @@ class StewartTiltEnv(HeavyDutyEnv):
         return self.platform.neutral_height + self.hold_depth + 0.005
 
     def reference_joints(self) -> np.ndarray:
+        """The hold posture; with `landing_action`, moved toward the landed posture by the
+        filtered landing action."""
+        if self.landing_action:
+            return self._hold + self._landing * (self._landed - self._hold)
         return self._hold
+
+    def _start_episode(self) -> None:
+        super()._start_episode()
+        self._landing = 0.0
+        """With `landing_action`: the low-pass filtered landing fraction in [0, 1]."""
+
+    def _apply_action(self, action: np.ndarray) -> None:
+        """With `landing_action`, first the landing fraction (filtered like the residual), then
+        the heavy-duty residual on the reference it gives."""
+        if self.landing_action:
+            target = min(max(float(action[18]), 0.0), 1.0)
+            self._landing += self._filter_alpha * (target - self._landing)
+        super()._apply_action(action)
 
     def _reference_description(self) -> dict:
         """As the heavy-duty envs', plus ``hold_posture``: the episode's (18,) joint targets of
-        the hold posture, the zero residual action (the held tripod depends on the task)."""
-        return {**super()._reference_description(), "hold_posture": self._hold.copy()}
+        the hold posture, the zero residual action (the held tripod depends on the task); with
+        `landing_action` also ``landed_posture``, the targets of landing fraction 1."""
+        landed = {"landed_posture": self._landed.copy()} if self.landing_action else {}
+        return {
+            **super()._reference_description(),
+            "hold_posture": self._hold.copy(),
+            "landing_action": self.landing_action,
+            **landed,
+        }
 
     def _initial_joints(self) -> np.ndarray:
         return self._hold

@@ -30,6 +30,7 @@ def test_the_terms_count_the_tipping_steps_and_the_reward_carries_them():
         tipping_steps += bool(plain_info["is_tipping"])
         assert info["reward_rule_tipping"] == -2.5 * bool(plain_info["is_tipping"])
         assert info["reward_rule_tilt"] == -2.5 * (plain_info["tilt_deg"] > 25.0)
+        assert info["reward_rule_early_landing"] == 0.0  # the rule has no swing phase here
         expected = plain_reward + info["reward_rule_tipping"] + info["reward_rule_tilt"]
         assert reward == pytest.approx(expected, abs=1e-9)
     assert tipping_steps > 0  # the zero action sags onto the blocks: the term is exercised
@@ -71,6 +72,24 @@ def test_tipping_costs_nothing_where_the_rule_does_not_bound_it():
     assert [env.step(np.zeros(1))[1] for _ in range(2)] == [1.0, 0.0]
     stewart = StabilityRulePenalty(gym.make("HexapodStewartTilt-v1"), 1.0)
     assert not stewart.bounds_tipping and stewart.tilt_bound_deg == 2.5
+
+
+def test_an_early_landing_costs_every_step_from_the_landing_where_the_rule_keeps_the_swing():
+    """The Stewart tilt's rule keeps the lifted tripod up until the robot first tips: a policy
+    standing on six feet from the start pays on every step from its landing."""
+    kwargs = {"landing_action": True, "residual_scale": 0.05}
+    wrapped = StabilityRulePenalty(gym.make("HexapodStewartTilt-v1", **kwargs), 3.0)
+    assert wrapped.bounds_swing
+    wrapped.reset(seed=0)
+    action = np.r_[np.zeros(18), 1.0].astype(np.float32)
+    terms = []
+    for _ in range(100):
+        info = wrapped.step(action)[4]
+        terms.append(info["reward_rule_early_landing"])
+        assert terms[-1] == -3.0 * info["early_landing"]
+    assert terms[0] == 0.0 and terms[-1] == -3.0
+    scripted = StabilityRulePenalty(_Scripted([(False, 0.0)]), 1.0)
+    assert not scripted.bounds_swing
 
 
 def test_bad_uses_are_named():

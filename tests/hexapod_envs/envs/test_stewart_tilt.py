@@ -107,3 +107,43 @@ def test_info_names_the_episodes_case_on_a_task_distribution():
         assert info["scenario"] == info["task"]["scenario"]
         scenarios.add(info["scenario"])
     assert len(scenarios) > 1  # not the setting's "random" every time
+
+
+def _hold_then_land(env, landing, steps, seed=1000):
+    """Step `env` (landing_action) with zero residuals and landing action `landing(step)`."""
+    env.reset(seed=seed)
+    action = np.zeros(19, dtype=np.float32)
+    infos = []
+    for k in range(steps):
+        action[18] = landing(k)
+        infos.append(env.step(action)[4])
+    return infos
+
+
+def test_landing_action_at_or_below_zero_holds_the_posture_bit_for_bit():
+    kwargs = {"task_distribution": "train", "residual_scale": 0.05}
+    plain = gym.make("HexapodStewartTilt-v1", **kwargs)
+    landing = gym.make("HexapodStewartTilt-v1", landing_action=True, **kwargs)
+    assert landing.action_space.shape == (19,)
+    plain.reset(seed=1000)
+    expected = [plain.step(np.zeros(18, dtype=np.float32))[4] for _ in range(120)]
+    got = _hold_then_land(landing, lambda k: -1.0 if k % 2 else 0.0, 120)
+    np.testing.assert_array_equal([i["cog"] for i in got], [i["cog"] for i in expected])
+    reference = landing.unwrapped.task_description.reference
+    assert reference["landing_action"]
+    changed = np.flatnonzero(reference["landed_posture"] != reference["hold_posture"])
+    swing = landing.unwrapped._swing_ids
+    assert {int(j) // 3 for j in changed} == set(swing)  # only the lifted legs move
+
+
+def test_landing_action_one_sets_the_lifted_feet_down_and_keeps_the_robot_up():
+    env = gym.make("HexapodStewartTilt-v1", landing_action=True, residual_scale=0.05)
+    infos = _hold_then_land(env, lambda k: 1.0, 100, seed=0)
+    assert set(infos[-1]["stance_legs"]) == set(env.unwrapped.swing) | set(env.unwrapped.stance)
+    assert infos[-1]["early_landing"]  # before any tipping: the v1 rule's early landing
+    assert not infos[-1]["is_success"]
+
+
+def test_landing_action_needs_the_residual_mode():
+    with pytest.raises(ValueError, match="landing_action.*residual action"):
+        gym.make("HexapodStewartTilt-v1", landing_action=True, action_mode="joint")

@@ -1,0 +1,57 @@
+"""What the rule studies share (`cliff_stop`, `stewart_landing`): play scripted policies on the
+tasks of a distribution, one row of outcomes per task, and a command line that prints each
+policy's summary and writes the rows as JSON."""
+
+from __future__ import annotations
+
+import argparse
+import json
+from collections.abc import Callable, Sequence
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+
+Rows = list[dict]
+
+
+def play(env: gym.Env, act: Callable, seeds: range, row: Callable[[int, dict], dict]) -> Rows:
+    """One episode per seed with policy `act` (its ``reset()`` called first); `row(seed, info)`
+    of each episode's last info."""
+    rows = []
+    for seed in seeds:
+        obs, info = env.reset(seed=seed)
+        act.reset()
+        done = False
+        while not done:
+            obs, _, terminated, truncated, info = env.step(act(np.asarray(obs)))
+            done = terminated or truncated
+        rows.append(row(seed, info))
+    env.close()
+    return rows
+
+
+def main(
+    description: str,
+    policies: Sequence[str],
+    run: Callable[[str, str, range], Rows],
+    summary: Callable[[Rows], str],
+    default_seeds: tuple[int, int],
+    default_distribution: str,
+    argv: list[str] | None = None,
+) -> dict[str, Rows]:
+    """The command line of a rule study: ``--distribution``, ``--seeds A B``, ``--policies``
+    and ``--json``; prints ``<policy>: <summary(rows)>`` per policy."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--distribution", default=default_distribution, choices=("train", "test"))
+    parser.add_argument("--seeds", nargs=2, type=int, default=default_seeds, metavar=("A", "B"))
+    parser.add_argument("--policies", nargs="+", default=list(policies), choices=policies)
+    parser.add_argument("--json", type=Path, help="write every task's outcome here")
+    args = parser.parse_args(argv)
+    out = {}
+    for policy in args.policies:
+        rows = out[policy] = run(policy, args.distribution, range(*args.seeds))
+        print(f"{policy}: {summary(rows)}", flush=True)
+    if args.json:
+        args.json.write_text(json.dumps(out, indent=1) + "\n")
+    return out
