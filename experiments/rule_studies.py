@@ -19,15 +19,17 @@ def play(env: gym.Env, act: Callable, seeds: range, row: Callable[[int, dict], d
     """One episode per seed with policy `act` (its ``reset()`` called first); `row(seed, info)`
     of each episode's last info."""
     rows = []
-    for seed in seeds:
-        obs, info = env.reset(seed=seed)
-        act.reset()
-        done = False
-        while not done:
-            obs, _, terminated, truncated, info = env.step(act(np.asarray(obs)))
-            done = terminated or truncated
-        rows.append(row(seed, info))
-    env.close()
+    try:
+        for seed in seeds:
+            obs, info = env.reset(seed=seed)
+            act.reset()
+            done = False
+            while not done:
+                obs, _, terminated, truncated, info = env.step(act(np.asarray(obs)))
+                done = terminated or truncated
+            rows.append(row(seed, info))
+    finally:
+        env.close()
     return rows
 
 

@@ -209,7 +209,7 @@ class StabilityRulePenalty(gym.Wrapper):
     The ``-v1`` success rules bound the share of the episode spent tipping (the FASM below the
     robot's ξ) and the episode's largest tilt, but the envs' rewards pay neither: a residual
     policy that lifts ATHENA's torso off the blocks earns more return while it leans past the
-    25° bound and tips for a third of the episode, failing every task. Two terms, each in
+    25° bound and tips for a third of the episode, failing every task. Three terms, each in
     ``info`` beside the env's own, close that gap:
 
     - ``reward_rule_tipping`` = -`weight` on every step with ``info["is_tipping"]``, where the

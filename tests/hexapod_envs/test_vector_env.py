@@ -71,16 +71,19 @@ def test_the_ditch_crossing_batches_too(env_id):
     assert sum(_run_both(batched, sync, 70, seed=3)) > 0  # episodes ended and reset
 
 
-def test_batched_equals_single_envs_on_tip_overs():
+@pytest.mark.parametrize("landing_action", [False, True])
+def test_batched_equals_single_envs_on_tip_overs(landing_action):
     """On a platform that starts tilting at once, the held robot tips over: terminations and
-    their autoresets."""
+    their autoresets (with the landing action too: a 19th action, state carried per world)."""
     batched, sync = _pair(
         "HexapodStewartTilt-v1",
         2,
         task_distribution="train",
         tilt_start_time=0.2,
         max_episode_steps=400,
+        landing_action=landing_action,
     )
+    assert batched.single_action_space.shape == (19 if landing_action else 18,)
     terminated, _ = _run_both(batched, sync, 300, seed=1)
     assert terminated > 0
 
