@@ -37,7 +37,7 @@ from experiments import rule_studies  # noqa: E402
 
 ENV_ID = "HexapodStewartTilt-v1"
 POLICIES = ("analytical", "zero", "land", "sensed_land")
-RESIDUAL_SCALE = 0.05
+RESIDUAL_SCALE = 0.01
 """The residual scale of the landing env (the training config's; the residuals stay 0 here)."""
 
 
