@@ -268,9 +268,7 @@ class StewartTiltEnv(HeavyDutyEnv):
         super()._setup()
         if self.landing_action:
             self.action_space = spaces.Box(-1.0, 1.0, shape=(19,), dtype=np.float32)
-        self._hold = self._hold_posture(STANCES[self.stance_name])  # set per episode at reset
-        if self.landing_action:
-            self._landed = self._hold_posture(STANCES[self.stance_name], lift=0.0)
+        self._set_postures(STANCES[self.stance_name])  # set per episode at reset
         # Validate the fixed scenarios' whole motion up front: a pose the actuators cannot reach
         # is refused here, not discovered mid-episode.
         if self.scenario != "random":
@@ -299,6 +297,10 @@ class StewartTiltEnv(HeavyDutyEnv):
             self.max_tilt = np.radians(DEFAULT_MAX_TILT_DEG[scenario])
         else:
             self.max_tilt = np.radians(40.0)
+        self._set_postures(stance)
+
+    def _set_postures(self, stance: tuple[str, ...]) -> None:
+        """The hold posture for `stance` and, with `landing_action`, the landed one."""
         self._hold = self._hold_posture(stance)
         if self.landing_action:
             self._landed = self._hold_posture(stance, lift=0.0)
