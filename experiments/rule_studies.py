@@ -33,6 +33,23 @@ def play(env: gym.Env, act: Callable, seeds: range, row: Callable[[int, dict], d
     return rows
 
 
+def outcome(seed: int, info: dict) -> dict:
+    """The outcome every rule study records of an episode's last info: success, tip-over and the
+    largest tilt [deg]; a study adds its own keys."""
+    return {
+        "seed": seed,
+        "success": bool(info["is_success"]),
+        "tipped_over": bool(info["is_tipped_over"]),
+        "max_tilt_deg": float(info["max_tilt_deg"]),
+    }
+
+
+def counts(rows: Rows) -> str:
+    """``"<s> of <n> successes, <t> tip-overs"``, the start of every study's summary line."""
+    successes = sum(r["success"] for r in rows)
+    return f"{successes} of {len(rows)} successes, {sum(r['tipped_over'] for r in rows)} tip-overs"
+
+
 def main(
     description: str,
     policies: Sequence[str],

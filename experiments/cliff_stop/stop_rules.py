@@ -101,10 +101,7 @@ def run(policy: str, distribution: str, seeds: range) -> list[dict]:
 
 def _row(seed: int, info: dict) -> dict:
     return {
-        "seed": seed,
-        "success": bool(info["is_success"]),
-        "tipped_over": bool(info["is_tipped_over"]),
-        "max_tilt_deg": float(info["max_tilt_deg"]),
+        **rule_studies.outcome(seed, info),
         "tipping_share": float(info["tipping_share"]),
         "distance_m": float(info["distance"]),
         "cliff_x": float(info["task"]["cliff_x"]),
@@ -112,11 +109,8 @@ def _row(seed: int, info: dict) -> dict:
 
 
 def _summary(rows: list[dict]) -> str:
-    return (
-        f"{sum(r['success'] for r in rows)} of {len(rows)} successes, "
-        f"{sum(r['tipped_over'] for r in rows)} tip-overs; distances "
-        + " ".join(f"{r['distance_m']:.2f}" for r in rows)
-    )
+    distances = " ".join(f"{r['distance_m']:.2f}" for r in rows)
+    return f"{rule_studies.counts(rows)}; distances {distances}"
 
 
 def main(argv: list[str] | None = None) -> dict[str, list[dict]]:

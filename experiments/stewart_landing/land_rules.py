@@ -89,22 +89,16 @@ def run(policy: str, distribution: str, seeds: range) -> list[dict]:
 
 def _row(seed: int, info: dict) -> dict:
     return {
-        "seed": seed,
-        "success": bool(info["is_success"]),
-        "tipped_over": bool(info["is_tipped_over"]),
+        **rule_studies.outcome(seed, info),
         "early_landing": bool(info["early_landing"]),
-        "max_tilt_deg": float(info["max_tilt_deg"]),
         "scenario": str(info["task"]["scenario"]),
         "tilt_rate_deg": float(info["task"]["tilt_rate_deg"]),
     }
 
 
 def _summary(rows: list[dict]) -> str:
-    return (
-        f"{sum(r['success'] for r in rows)} of {len(rows)} successes, "
-        f"{sum(r['tipped_over'] for r in rows)} tip-overs, "
-        f"{sum(r['early_landing'] for r in rows)} early landings"
-    )
+    landings = sum(r["early_landing"] for r in rows)
+    return f"{rule_studies.counts(rows)}, {landings} early landings"
 
 
 def main(argv: list[str] | None = None) -> dict[str, list[dict]]:
