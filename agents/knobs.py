@@ -86,7 +86,8 @@ class KnobSettings:
             step is checked for the controller's judgment (its own FASM, from its body model,
             may differ a little).
         reward: training only: "success" (1 when the episode meets the env's success rule, else
-            0), "stable_success" (a success graded by its largest tilt, -v1 ids:
+            0), "stable_success" (a success graded by its largest tilt, -v1 ids),
+            "margin_success" (graded by its smallest static margin, the ditch crossing;
             `hexapod_envs.wrappers.episode_reward`) or "return" (the env's reward summed from
             the event (recovery knobs) or the start (planner knobs) to the episode's end).
     """

@@ -96,13 +96,17 @@ def _play(env: gym.Env, action: Any, done: Callable[[int], bool]) -> tuple[tuple
             return result, total, steps
 
 
-EpisodeReward = Literal["success", "stable_success", "return"]
+EpisodeReward = Literal["success", "stable_success", "margin_success", "return"]
 """The rewards of a decision that spans an episode (`episode_reward`)."""
 EPISODE_REWARDS: tuple[str, ...] = get_args(EpisodeReward)
 
 
 def episode_reward(
-    kind: str, info: dict[str, Any], episode_return: float, tilt_bound_deg: float | None = None
+    kind: str,
+    info: dict[str, Any],
+    episode_return: float,
+    tilt_bound_deg: float | None = None,
+    margin_scale_m: float | None = None,
 ) -> float:
     """The reward of a decision whose consequence is a whole episode.
 
@@ -112,10 +116,16 @@ def episode_reward(
       rule's bound: ``1 - info["max_tilt_deg"] / tilt_bound_deg`` for a success (in [0, 1]; the
       rule holds the tilt within the bound), 0.0 for a failure. Among settings that all
       succeed, it prefers the steadier one, which the 0/1 success cannot tell apart.
+    - ``"margin_success"``: a success graded by how close the episode came to tipping on the
+      robot's own stability criterion, the static margin (the ditch crossing):
+      ``1 + clip(info["min_static_margin_m"] / margin_scale_m, 0, 1)`` for a success (in
+      [1, 2]), 0.0 for a failure. A success outweighs any margin; among successes it prefers
+      the one whose smallest margin was larger.
     - ``"return"``: `episode_return`, the env's rewards summed over what it decided.
 
-    `tilt_bound_deg` is the env's ``success_max_tilt_deg`` (`tilt_bound`), needed by
-    "stable_success" only.
+    `tilt_bound_deg` is the env's ``success_max_tilt_deg`` and `margin_scale_m` the env's
+    support inradius (`episode_reward_of` reads both), needed by "stable_success" and
+    "margin_success" only.
     """
     _check_episode_reward(kind)
     if kind == "return":
@@ -123,15 +133,24 @@ def episode_reward(
     success = float(bool(info.get("is_success", False)))
     if kind == "success" or not success:
         return success
+    if kind == "margin_success":
+        if margin_scale_m is None:
+            raise ValueError('episode reward "margin_success" needs the margin scale [m]')
+        return 1.0 + min(max(info["min_static_margin_m"] / margin_scale_m, 0.0), 1.0)
     if tilt_bound_deg is None:
         raise ValueError('episode reward "stable_success" needs the success rule\'s tilt bound')
     return max(1.0 - info["max_tilt_deg"] / tilt_bound_deg, 0.0)
 
 
 def episode_reward_of(env: gym.Env, kind: str) -> Callable[[dict[str, Any], float], float]:
-    """`episode_reward` of kind `kind` on `env`, checked once (`tilt_bound`'s errors):
-    ``rule(info, episode_return)``."""
-    return partial(episode_reward, kind, tilt_bound_deg=tilt_bound(env, kind))
+    """`episode_reward` of kind `kind` on `env`, checked once (`tilt_bound`'s and
+    `margin_scale`'s errors): ``rule(info, episode_return)``."""
+    return partial(
+        episode_reward,
+        kind,
+        tilt_bound_deg=tilt_bound(env, kind),
+        margin_scale_m=margin_scale(env, kind),
+    )
 
 
 def _check_episode_reward(kind: str) -> None:
@@ -154,6 +173,24 @@ def tilt_bound(env: gym.Env, kind: str) -> float | None:
             '(the -v1 ids have one); use "success" or "return"'
         )
     return float(bound)
+
+
+def margin_scale(env: gym.Env, kind: str) -> float | None:
+    """The scale [m] of "margin_success" on `env`: the inradius of its support polygon (the
+    scale of the env's own stability reward term); a ValueError where `kind` is
+    "margin_success" and `env` has no static margin (only the ditch crossing's robot is judged
+    by one)."""
+    _check_episode_reward(kind)
+    if kind != "margin_success":
+        return None
+    scale = getattr(env.unwrapped, "inradius", None)
+    if scale is None:
+        raise ValueError(
+            'the episode reward "margin_success" grades a success by the smallest static margin '
+            f"(info['min_static_margin_m']), and {_env_name(env)} has none "
+            '(the ditch crossing has); use "success", "stable_success" or "return"'
+        )
+    return float(scale)
 
 
 def _rule_setting(env: gym.Env, name: str) -> Any:

@@ -82,8 +82,9 @@ class EnvConfig:
     rewarded as ``episode_reward`` says)."""
     episode_reward: EpisodeReward = "success"
     """With ``decision: episode``: the learner's reward per episode, "success" (1 when it meets
-    the env's success rule, else 0), "stable_success" (a success graded by its largest tilt,
-    `hexapod_envs.wrappers.episode_reward`; -v1 ids) or "return" (the env's rewards summed)."""
+    the env's success rule, else 0), "stable_success" (a success graded by its largest tilt;
+    -v1 ids), "margin_success" (graded by its smallest static margin; the ditch crossing;
+    `hexapod_envs.wrappers.episode_reward`) or "return" (the env's rewards summed)."""
     stability_penalty: float = 0.0
     """A per-step penalty of this weight while the robot tips and while its tilt is past the
     success rule's bound (`hexapod_envs.wrappers.StabilityRulePenalty`, terms ``rule_tipping``

@@ -82,8 +82,9 @@ The episode ends (terminated) when the robot tips over (body tilt > tip_over_ang
 succeeds: every foot past the far edge of the ditch (the finish line on flat ground), all six
 feet loaded, not tipped. `info`: the reward terms, fasm_margin_deg, static_margin_m,
 stance_legs, is_tipping (static_margin_m <= 0: the CoG projection is not inside the loaded
-feet's polygon), is_tipped_over, is_success, sim_unstable, distance (CoG advance [m]), tilt_deg,
-planner_status, planner_reason, ditch (start_x, width, depth [m]; None on flat ground),
+feet's polygon), min_static_margin_m (the smallest static_margin_m since reset [m]: how close
+the crossing came to tipping), is_tipped_over, is_success, sim_unstable, distance (CoG advance
+[m]), tilt_deg, planner_status, planner_reason, ditch (start_x, width, depth [m]; None on flat ground),
 finish_x [m], gait_step and gait_phase (the reference's plan step and phase), time, cog.
 
 ## Arguments
@@ -528,6 +529,7 @@ class DitchCrossingEnv(HexapodEnv):
 
     def _start_episode(self) -> None:
         self._residual = np.zeros(len(COMMAND_NAMES))
+        self._min_static_margin = np.inf
         self._episode_info = {  # info entries fixed for the episode
             "planner_status": self.plan.status,
             "planner_reason": self.plan.reason,
@@ -579,6 +581,7 @@ class DitchCrossingEnv(HexapodEnv):
         self._power = power
         # Same computation as stability.static_stability_margin, gravity along -z.
         self._static_margin = static
+        self._min_static_margin = min(self._min_static_margin, static)
         return Measurement(forces, loaded, margin, (i, j) if status == _stability.OK else None, cog)
 
     def _is_success(self) -> bool:
@@ -645,6 +648,7 @@ class DitchCrossingEnv(HexapodEnv):
         step, phase = self.schedule.phase(self._step_count)
         return {
             "static_margin_m": self._static_margin,
+            "min_static_margin_m": self._min_static_margin,
             "actuator_power_w": self._power,
             **self._episode_info,
             "ditch": self._ditch_info,  # a new dict every step (callers may keep infos)

@@ -154,6 +154,18 @@ def test_the_stable_success_reward_grades_the_crossing_by_its_largest_tilt():
     assert reward == pytest.approx(1.0 - info["max_tilt_deg"] / 2.0, rel=0, abs=1e-12)
 
 
+def test_the_margin_success_reward_grades_the_crossing_by_its_smallest_static_margin():
+    rewards = {}
+    for margin in (0.0, 0.5):  # the env's 10 mm, then 20 mm (min_margin's range: 0-30 mm)
+        env = PlanKnobsPerEpisode(_ditch(), KnobSettings(names=NAMES, reward="margin_success"))
+        env.reset(seed=3)
+        _, reward, *_, info = env.step(np.array([0.0, margin], dtype=np.float32))
+        assert info["is_success"] and not info["planner_fallback"]
+        assert reward == pytest.approx(1.0 + info["min_static_margin_m"] / 0.1, rel=0, abs=1e-12)
+        rewards[margin] = reward
+    assert rewards[0.5] > rewards[0.0] + 0.03  # the planned margin is the crossing's (+5 mm)
+
+
 def test_the_policy_asks_once_with_the_course_and_matches_the_training_env():
     action = [-0.25, 0.5]  # exact in float32
     env = PlanKnobsPerEpisode(_ditch(), KnobSettings(names=NAMES, reward="return"))

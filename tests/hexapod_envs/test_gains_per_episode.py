@@ -7,7 +7,7 @@ import pytest
 from helpers.paths import REPO
 
 import hexapod_envs  # noqa: F401  (registers the env ids)
-from hexapod_envs.wrappers import GainsPerEpisode, episode_reward, tilt_bound
+from hexapod_envs.wrappers import GainsPerEpisode, episode_reward, margin_scale, tilt_bound
 
 ENV_ID = "HexapodIrregularTerrain-v1"
 GAINS = {
@@ -56,13 +56,35 @@ def test_stable_success_grades_a_success_by_how_far_its_tilt_stayed_from_the_bou
         episode_reward("stable_success", success, 7.0)
 
 
+def test_margin_success_grades_a_success_by_its_smallest_static_margin():
+    success = {"is_success": True, "min_static_margin_m": 0.02}
+    assert episode_reward("margin_success", success, 7.0, margin_scale_m=0.1) == 1.2
+    low = {**success, "min_static_margin_m": -0.01}
+    assert episode_reward("margin_success", low, 7.0, margin_scale_m=0.1) == 1.0
+    high = {**success, "min_static_margin_m": 0.3}
+    assert episode_reward("margin_success", high, 7.0, margin_scale_m=0.1) == 2.0
+    failure = {**success, "is_success": False}
+    assert episode_reward("margin_success", failure, 7.0, margin_scale_m=0.1) == 0.0
+    with pytest.raises(ValueError, match="margin scale"):
+        episode_reward("margin_success", success, 7.0)
+
+
+def test_margin_success_needs_an_env_judged_by_a_static_margin():
+    assert margin_scale(gym.make("HexapodDitchCrossing-v1"), "margin_success") == 0.1
+    assert margin_scale(gym.make(ENV_ID), "success") is None
+    with pytest.raises(ValueError, match="HexapodIrregularTerrain-v1 has none"):
+        margin_scale(gym.make(ENV_ID), "margin_success")
+
+
 def test_stable_success_needs_an_env_whose_success_rule_bounds_the_tilt():
     assert tilt_bound(gym.make(ENV_ID), "stable_success") == 25.0  # the -v1 blocks' bound
     assert tilt_bound(gym.make("HexapodDitchCrossing-v1"), "stable_success") == 2.0
     assert tilt_bound(gym.make(ENV_ID), "success") is None
     with pytest.raises(ValueError, match="HexapodIrregularTerrain-v0 has none"):
         tilt_bound(gym.make("HexapodIrregularTerrain-v0"), "stable_success")
-    with pytest.raises(ValueError, match=r"one of \('success', 'stable_success', 'return'\)"):
+    with pytest.raises(
+        ValueError, match=r"one of \('success', 'stable_success', 'margin_success', 'return'\)"
+    ):
         tilt_bound(gym.make(ENV_ID), "stable")
 
 
@@ -70,7 +92,8 @@ def test_other_modes_and_rewards_are_refused_by_name():
     with pytest.raises(ValueError, match="GainsPerEpisode needs action_mode='gains'"):
         GainsPerEpisode(gym.make(ENV_ID))
     with pytest.raises(
-        ValueError, match=r"reward must be one of \('success', 'stable_success', 'return'\)"
+        ValueError,
+        match=r"reward must be one of \('success', 'stable_success', 'margin_success', 'return'\)",
     ):
         GainsPerEpisode(gym.make(ENV_ID, **GAINS), reward="returns")
 

@@ -86,10 +86,14 @@ def test_observation_layout_and_reset_state():
 
 def test_static_margin_is_the_support_polygon_margin_of_the_loaded_feet():
     env = DitchCrossingEnv()
-    env.reset(seed=3)
+    _, info = env.reset(seed=3)
+    smallest = info["static_margin_m"]
+    assert info["min_static_margin_m"] == smallest
     seen = set()
     for _ in range(60):  # through the first lift-off: six, then three loaded feet
         _, _, _, _, info = env.step(ZERO)
+        smallest = min(smallest, info["static_margin_m"])
+        assert info["min_static_margin_m"] == smallest  # the episode's smallest so far
         loaded = env._loaded
         seen.add(int(loaded.sum()))
         if loaded.sum() >= 3:
@@ -102,6 +106,7 @@ def test_static_margin_is_the_support_polygon_margin_of_the_loaded_feet():
             leg for leg, on in zip(LEG_NAMES, loaded, strict=True) if on
         )
     assert {3, 6} <= seen
+    assert smallest < env.reset(seed=3)[1]["min_static_margin_m"]  # a new episode starts afresh
     # Random actions soon leave two feet loaded (no polygon: margin 0), where the robot tips.
     env.reset(seed=0)
     env.action_space.seed(0)
