@@ -84,8 +84,8 @@ feet loaded, not tipped. `info`: the reward terms, fasm_margin_deg, static_margi
 stance_legs, is_tipping (static_margin_m <= 0: the CoG projection is not inside the loaded
 feet's polygon), min_static_margin_m (the smallest static_margin_m since reset [m]: how close
 the crossing came to tipping), is_tipped_over, is_success, sim_unstable, distance (CoG advance
-[m]), tilt_deg, planner_status, planner_reason, ditch (start_x, width, depth [m]; None on flat ground),
-finish_x [m], gait_step and gait_phase (the reference's plan step and phase), time, cog.
+[m]), tilt_deg, planner_status, planner_reason, ditch (start_x, width, depth [m]; None on flat
+ground), finish_x [m], gait_step and gait_phase (the reference's plan step and phase), time, cog.
 
 ## Arguments
 `DitchCrossingSettings` (``gym.make(id, **kwargs)``).
