@@ -168,10 +168,15 @@ def _learned_part(config: dict[str, Any]) -> str:
         spans = ", ".join(
             f"{n} {PLANNER_KNOB_RANGES[n][0]}..{PLANNER_KNOB_RANGES[n][1]} m" for n in names
         )
+        seen = (
+            "the course (the ditch's distance ahead, width and depth [m])"
+            if knobs.get("course", True)
+            else "three zeros (knobs.course: false, one setting for every ditch)"
+        )
         notes.append(
-            f"planner knobs model: the input is the course (the ditch's distance ahead, width "
-            f"and depth [m]), the action {len(names)} values in [-1, 1] that set the ditch "
-            f"planner's settings (0: the env's own, +-1: the ends of the ranges {spans}; "
+            f"planner knobs model: the input is {seen}, the action {len(names)} values in "
+            "[-1, 1] that set the ditch planner's settings (0: the env's own, +-1: the ends of "
+            f"the ranges {spans}; "
             "agents.plan_knobs), chosen once per episode; the planner (agents.upu_gait) plans "
             "and walks with them, with its own settings where they give no plan"
         )

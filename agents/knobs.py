@@ -90,11 +90,17 @@ class KnobSettings:
             "margin_success" (graded by its smallest static margin, the ditch crossing;
             `hexapod_envs.wrappers.episode_reward`) or "return" (the env's reward summed from
             the event (recovery knobs) or the start (planner knobs) to the episode's end).
+        course: planner knobs only: the policy sees the course it plans (the ditch's distance,
+            width and depth, `agents.plan_knobs.COURSE_FEATURES`); False: it sees zeros, so it
+            learns one setting for every ditch, which cannot carry a trend over the training
+            ditches past them (the -v1 test ditches are wider, deeper and farther than any
+            training ditch).
     """
 
     names: tuple[str, ...] = ("rho", "kappa", "t_min")
     event_margin_deg: float = 5.0
     reward: EpisodeReward = "success"
+    course: bool = True
 
     def __post_init__(self):
         self.names = names = tuple(self.names)
@@ -111,6 +117,13 @@ class KnobSettings:
             )
         if self.reward not in REWARDS:
             raise ValueError(f"knobs.reward must be one of {REWARDS}, got {self.reward!r}")
+        if not isinstance(self.course, bool):
+            raise ValueError(f"knobs.course must be true or false, got {self.course!r}")
+        if not self.course and self.controller != "planner":
+            raise ValueError(
+                "knobs.course: false is for the ditch planner's knobs (set once per episode from "
+                "the course); the recovery's knobs see the robot's state at the tipping event"
+            )
 
     @property
     def action_space(self) -> gym.spaces.Box:

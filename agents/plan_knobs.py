@@ -57,6 +57,14 @@ def course_space() -> gym.spaces.Box:
     return gym.spaces.Box(-np.inf, np.inf, shape=(len(COURSE_FEATURES),), dtype=np.float32)
 
 
+def observed_course(env: gym.Env, settings: KnobSettings) -> np.ndarray:
+    """What a planner-knob policy sees of `env`'s episode: `course_features`, or zeros where
+    ``settings.course`` is False (one setting for every ditch)."""
+    if settings.course:
+        return course_features(env)
+    return np.zeros(len(COURSE_FEATURES), dtype=np.float32)
+
+
 def course_features(env: gym.Env) -> np.ndarray:
     """`COURSE_FEATURES` of `env`'s episode, from its task description (read after reset)."""
     task = env.unwrapped.task_description
@@ -169,7 +177,7 @@ class PlanKnobsPerEpisode(gym.Wrapper):
         obs, info = self.env.reset(**kwargs)
         self.core.reset()
         self._obs = obs
-        return course_features(self.env), info
+        return observed_course(self.env, self.core.settings), info
 
     def step(self, action: np.ndarray):
         if self._obs is None:
@@ -191,7 +199,7 @@ class PlanKnobsPerEpisode(gym.Wrapper):
             "env_terminated": terminated,
             "env_truncated": truncated,
         }
-        return course_features(self.env), learner_reward, True, False, info
+        return observed_course(self.env, self.core.settings), learner_reward, True, False, info
 
 
 class PlanKnobPolicy(LearnedWithController):
@@ -209,6 +217,6 @@ class PlanKnobPolicy(LearnedWithController):
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:
         if not self._decided:  # the course is sampled at env.reset(), before the first call
-            self.core.set_knobs(self.learned(course_features(self.core.env)))
+            self.core.set_knobs(self.learned(observed_course(self.core.env, self.core.settings)))
             self._decided = True
         return self.core(observation)

@@ -166,6 +166,23 @@ def test_the_margin_success_reward_grades_the_crossing_by_its_smallest_static_ma
     assert rewards[0.5] > rewards[0.0] + 0.03  # the planned margin is the crossing's (+5 mm)
 
 
+def test_a_course_blind_policy_sees_zeros_in_training_and_on_the_plain_env():
+    settings = KnobSettings(names=NAMES, course=False)
+    env = PlanKnobsPerEpisode(_ditch(), settings)
+    features, _ = env.reset(seed=6)
+    np.testing.assert_array_equal(features, np.zeros(3, dtype=np.float32))
+    np.testing.assert_array_equal(env.step(np.zeros(2, dtype=np.float32))[0], features)
+    raw = _ditch()
+    learned = _Constant([0.25, 0.5])
+    policy = PlanKnobPolicy(learned, raw, settings)
+    _episode(raw, policy, seed=6)
+    assert len(learned.seen) == 1 and not learned.seen[0].any()
+    with pytest.raises(ValueError, match="knobs.course: false is for the ditch planner"):
+        KnobSettings(course=False)  # the recovery's knobs
+    with pytest.raises(ValueError, match="knobs.course must be true or false"):
+        KnobSettings(names=NAMES, course="no")
+
+
 def test_the_policy_asks_once_with_the_course_and_matches_the_training_env():
     action = [-0.25, 0.5]  # exact in float32
     env = PlanKnobsPerEpisode(_ditch(), KnobSettings(names=NAMES, reward="return"))
