@@ -331,7 +331,11 @@ def model_card(
     structure = getattr(unwrapped, "observation_structure", None) or {}
     observation_space = actor_input_space(config, env)
     if _planner_knobs(config):
-        structure = {name: slice(i, i + 1) for i, name in enumerate(COURSE_FEATURES)}
+        blind = not (config.get("knobs") or {}).get("course", True)
+        structure = {
+            f"{name} (zero: knobs.course false)" if blind else name: slice(i, i + 1)
+            for i, name in enumerate(COURSE_FEATURES)
+        }
     folded = []
     if stats is not None and stats.norm_obs:
         folded.append(

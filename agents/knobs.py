@@ -87,7 +87,7 @@ class KnobSettings:
             may differ a little).
         reward: training only: "success" (1 when the episode meets the env's success rule, else
             0), "stable_success" (a success graded by its largest tilt, -v1 ids),
-            "margin_success" (graded by its smallest static margin, the ditch crossing;
+            "margin_success" (planner knobs: graded by its smallest static margin;
             `hexapod_envs.wrappers.episode_reward`) or "return" (the env's reward summed from
             the event (recovery knobs) or the start (planner knobs) to the episode's end).
         course: planner knobs only: the policy sees the course it plans (the ditch's distance,
@@ -117,6 +117,12 @@ class KnobSettings:
             )
         if self.reward not in REWARDS:
             raise ValueError(f"knobs.reward must be one of {REWARDS}, got {self.reward!r}")
+        if self.reward == "margin_success" and self.controller != "planner":
+            raise ValueError(
+                'knobs.reward: "margin_success" grades a success by the ditch crossing\'s static '
+                "margin, for the ditch planner's knobs; the recovery's knobs take "
+                '"success", "stable_success" or "return"'
+            )
         if not isinstance(self.course, bool):
             raise ValueError(f"knobs.course must be true or false, got {self.course!r}")
         if not self.course and self.controller != "planner":

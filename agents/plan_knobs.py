@@ -20,8 +20,8 @@ Settings with which the planner finds no plan fall back to the env's own
 Two ways to run it, sharing `PlanKnobCore`:
 
 - `PlanKnobsPerEpisode`: the env a learner trains on. One learner step per episode: reset
-  returns the course; step plans with the chosen settings and walks the plan to the episode's
-  end. The reward is the episode's ``info["is_success"]`` (the benchmark's rule), that success
+  returns the course (zeros with ``course=False``); step plans with the chosen settings and
+  walks the plan to the episode's end. The reward is the episode's ``info["is_success"]`` (the benchmark's rule), that success
   graded by its largest tilt ("stable_success") or by its smallest static margin
   ("margin_success"), or its return.
 - `PlanKnobPolicy`: a trained policy as a per-step `Policy` on the plain env (`evaluate.py`).
@@ -156,7 +156,8 @@ class PlanKnobCore(EnvBound):
 class PlanKnobsPerEpisode(gym.Wrapper):
     """The env seen by a learner of planner knobs: one step per episode.
 
-    ``reset`` resets the env and returns the course (`COURSE_FEATURES`). ``step(a)`` plans with
+    ``reset`` resets the env and returns what the policy sees (`observed_course`: the course,
+    `COURSE_FEATURES`, or zeros with ``course=False``). ``step(a)`` plans with
     the settings of ``a`` and walks the plan to the episode's end. Its reward is
     `KnobSettings.reward`, and it ends the learner's episode as terminated: nothing follows the
     outcome (the env's own flags are ``info["env_terminated"]`` and ``info["env_truncated"]``).
@@ -204,7 +205,8 @@ class PlanKnobsPerEpisode(gym.Wrapper):
 
 class PlanKnobPolicy(LearnedWithController):
     """A trained planner-knob policy with the env's planner, as a per-step `Policy`: asked once
-    per episode with the course at its first step, the planner acts every step."""
+    per episode at its first step with what it saw in training (`observed_course`), the planner
+    acts every step."""
 
     def __init__(self, learned: Policy, env: gym.Env, settings: KnobSettings):
         self.learned = learned

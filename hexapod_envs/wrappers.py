@@ -187,8 +187,8 @@ def margin_scale(env: gym.Env, kind: str) -> float | None:
     if scale is None:
         raise ValueError(
             'the episode reward "margin_success" grades a success by the smallest static margin '
-            f"(info['min_static_margin_m']), and {_env_name(env)} has none "
-            '(the ditch crossing has); use "success", "stable_success" or "return"'
+            f"(info['min_static_margin_m']), and {_env_name(env)} has none (the ditch "
+            'crossing has); use "success" or "return"'
         )
     return float(scale)
 

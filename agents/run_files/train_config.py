@@ -82,9 +82,9 @@ class EnvConfig:
     rewarded as ``episode_reward`` says)."""
     episode_reward: EpisodeReward = "success"
     """With ``decision: episode``: the learner's reward per episode, "success" (1 when it meets
-    the env's success rule, else 0), "stable_success" (a success graded by its largest tilt;
-    -v1 ids), "margin_success" (graded by its smallest static margin; the ditch crossing;
-    `hexapod_envs.wrappers.episode_reward`) or "return" (the env's rewards summed)."""
+    the env's success rule, else 0), "stable_success" (a success graded by its largest tilt,
+    `hexapod_envs.wrappers.episode_reward`; -v1 ids) or "return" (the env's rewards summed).
+    ("margin_success" is for the ditch planner's knobs, ``knobs.reward``.)"""
     stability_penalty: float = 0.0
     """A per-step penalty of this weight while the robot tips and while its tilt is past the
     success rule's bound (`hexapod_envs.wrappers.StabilityRulePenalty`, terms ``rule_tipping``
@@ -352,7 +352,7 @@ class HybridConfig(HybridSettings):
 class KnobConfig(KnobSettings):
     """``knobs:`` section: train a policy that sets the tipping recovery's knobs once per tipping
     event, or the ditch planner's once per episode (`agents.knobs`, `agents.plan_knobs`: names,
-    event_margin_deg, reward). Absent (null): no knobs."""
+    event_margin_deg, reward, course). Absent (null): no knobs."""
 
     zero_init_action_net: bool = True
     """Zero the action mean's last layer so that training starts from the controller's own
@@ -430,6 +430,13 @@ class TrainConfig:
                 "episode's outcome; "
                 "it needs no hybrid section, env.decision: step, env.vectorization: vec_env and "
                 "no env.reward_exclude"
+            )
+        if self.env.decision == "episode" and self.env.episode_reward == "margin_success":
+            raise ValueError(
+                'env.episode_reward: "margin_success" grades a success by the static margin of '
+                "the ditch crossing, whose planner's settings a knobs section learns "
+                '(knobs.reward); with env.decision: episode use "success", "stable_success" or '
+                '"return"'
             )
         planner_knobs = self.knobs is not None and self.knobs.controller == "planner"
         if planner_knobs and self.policy.critic_privileged:

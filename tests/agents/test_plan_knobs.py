@@ -183,6 +183,22 @@ def test_a_course_blind_policy_sees_zeros_in_training_and_on_the_plain_env():
         KnobSettings(names=NAMES, course="no")
 
 
+def test_margin_success_is_refused_where_no_static_margin_grades_the_outcome():
+    with pytest.raises(ValueError, match="the recovery's knobs take"):
+        KnobSettings(reward="margin_success")
+    with pytest.raises(ValueError, match=r"env.episode_reward: \"margin_success\""):
+        load_train_config(
+            data={
+                "env": {
+                    "id": "HexapodIrregularTerrain-v1",
+                    "kwargs": {"action_mode": "gains"},
+                    "decision": "episode",
+                    "episode_reward": "margin_success",
+                }
+            }
+        )
+
+
 def test_the_policy_asks_once_with_the_course_and_matches_the_training_env():
     action = [-0.25, 0.5]  # exact in float32
     env = PlanKnobsPerEpisode(_ditch(), KnobSettings(names=NAMES, reward="return"))
