@@ -21,9 +21,9 @@ Two ways to run it, sharing `PlanKnobCore`:
 
 - `PlanKnobsPerEpisode`: the env a learner trains on. One learner step per episode: reset
   returns the course (zeros with ``course=False``); step plans with the chosen settings and
-  walks the plan to the episode's end. The reward is the episode's ``info["is_success"]`` (the benchmark's rule), that success
-  graded by its largest tilt ("stable_success") or by its smallest static margin
-  ("margin_success"), or its return.
+  walks the plan to the episode's end. The reward is the episode's ``info["is_success"]``
+  (the benchmark's rule), that success graded by its largest tilt ("stable_success") or by its
+  smallest static margin ("margin_success"), or its return.
 - `PlanKnobPolicy`: a trained policy as a per-step `Policy` on the plain env (`evaluate.py`).
 
 A training config's ``knobs:`` section with the planner's knob names builds both
