@@ -116,6 +116,7 @@ def test_every_shipped_agent_records_the_env_it_was_trained_on_and_the_code_stil
         "HexapodIrregularTerrain-v1/ppo",
         "HexapodCliffWalk-v1/ppo",
         "HexapodStewartTilt-v1/ppo",
+        "HexapodDitchCrossing-v1/knobs",
         "HexapodIrregularTerrain-v0/ppo",
         "HexapodIrregularTerrain-v0/gains",
     }
