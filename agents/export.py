@@ -169,9 +169,9 @@ def _learned_part(config: dict[str, Any]) -> str:
             f"{n} {PLANNER_KNOB_RANGES[n][0]}..{PLANNER_KNOB_RANGES[n][1]} m" for n in names
         )
         seen = (
-            "the course (the ditch's distance ahead, width and depth [m])"
-            if knobs.get("course", True)
-            else "three zeros (knobs.course: false, one setting for every ditch)"
+            "three zeros (knobs.course: false, one setting for every ditch)"
+            if _course_blind(config)
+            else "the course (the ditch's distance ahead, width and depth [m])"
         )
         notes.append(
             f"planner knobs model: the input is {seen}, the action {len(names)} values in "
@@ -306,6 +306,11 @@ def _planner_knobs(config: dict[str, Any]) -> bool:
     return knobs is not None and knobs.controller == "planner"
 
 
+def _course_blind(config: dict[str, Any]) -> bool:
+    """Whether the run's planner knobs see zeros instead of the course (``knobs.course``)."""
+    return not settings_from_config(config.get("knobs")).course
+
+
 def actor_input_space(config: dict[str, Any], env: Any) -> Any:
     """What the exported actor reads: the env's observation, or for a planner-knobs model the
     course (`COURSE_FEATURES`)."""
@@ -331,7 +336,7 @@ def model_card(
     structure = getattr(unwrapped, "observation_structure", None) or {}
     observation_space = actor_input_space(config, env)
     if _planner_knobs(config):
-        blind = not (config.get("knobs") or {}).get("course", True)
+        blind = _course_blind(config)
         structure = {
             f"{name} (zero: knobs.course false)" if blind else name: slice(i, i + 1)
             for i, name in enumerate(COURSE_FEATURES)
