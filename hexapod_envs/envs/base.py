@@ -262,10 +262,10 @@ class HexapodEnv(SafetyFigures, gym.Env):
             self.task = self.paper_task()
         else:
             self.task = self.sample_task(self.np_random, self.task_distribution)
+        self._apply_task(self.task)  # may draw the rest of a paper task (added to self.task)
         spans = self.task_difficulty_spans()
         if spans:
             self.task["difficulty"] = task_difficulty(self.task, spans)
-        self._apply_task(self.task)
         mujoco.mj_resetData(self.model, self.data)
         self._set_initial_state()
         mujoco.mj_forward(self.model, self.data)

@@ -45,6 +45,25 @@ def test_difficulty_is_a_weighted_mean_of_clipped_positions():
         DifficultySpan(1.0, 1.0)
 
 
+@pytest.mark.parametrize(
+    "env_id, kwargs",
+    [
+        ("HexapodStewartTilt-v1", {}),  # the "random" paper scenario draws rate, axis, stance
+        ("HexapodDitchCrossing-v0", {"ditch_width_range": (0.25, 0.4)}),
+    ],
+)
+def test_the_difficulty_rates_the_task_drawn_at_reset(env_id, kwargs):
+    """Paper tasks whose values are drawn while the task is applied are rated from those draws."""
+    env = gym.make(env_id, **kwargs)
+    base = env.unwrapped
+    for seed in range(3):
+        task = env.reset(seed=seed)[1]["task"]
+        drawn = {k: v for k, v in task.items() if k != "difficulty"}
+        assert task["difficulty"] == task_difficulty(drawn, base.task_difficulty_spans())
+    assert len({env.reset(seed=s)[1]["task"]["difficulty"] for s in range(3)}) == 3
+    env.close()
+
+
 @pytest.mark.parametrize("env_id", V1_IDS)
 def test_test_tasks_are_at_least_as_hard_as_training_on_average(env_id):
     means = {}
