@@ -102,6 +102,7 @@ ground), finish_x [m], gait_step and gait_phase (the reference's plan step and p
 from __future__ import annotations
 
 import dataclasses
+import warnings
 
 import mujoco
 import numpy as np
@@ -246,7 +247,8 @@ class DitchCrossingSettings(EnvSettings):
     """Time constant of the residual's first-order filter [s] (0: no filter)."""
     horizon_steps: int = number(1500, strict=True, integer=True)
     """The episode's step budget (the registered time limit) whose remaining steps the
-    success bonus pays for."""
+    success bonus pays for; set it to the time limit when ``max_episode_steps`` raises that
+    (the env warns when an episode runs past it)."""
     friction: float = number(1.0, strict=True)
     gait_timing: GaitTiming | None = option(None, kind=GaitTiming)
     gait_settings: GaitSettings | None = option(None, kind=GaitSettings)
@@ -635,6 +637,14 @@ class DitchCrossingEnv(HexapodEnv):
         # Crossing ends the episode: the bonus pays what the remaining steps could at most have
         # earned, so that standing still on the near side never returns more than crossing.
         remaining = max(self.horizon_steps - self._step_count, 0)
+        if self._step_count == self.horizon_steps + 1:
+            warnings.warn(
+                f"{type(self).__name__}: the episode ran past horizon_steps="
+                f"{self.horizon_steps}, the step budget whose remaining steps the success bonus "
+                "pays for; a crossing now earns no bonus. Set horizon_steps to the time limit "
+                "(max_episode_steps) when you raise it.",
+                stacklevel=2,
+            )
         return {
             "forward": w["forward"] * min(max(speed, -FORWARD_CLIP_M_S), FORWARD_CLIP_M_S),
             "stability": w["stability"] * margin,

@@ -1,5 +1,7 @@
 """HexapodDitchCrossing-v0: keyword arguments, observation layout, measurements, randomisation."""
 
+import warnings
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -261,3 +263,17 @@ def test_a_crossing_ends_the_episode_once_and_pays_its_bonus_once():
     for _ in range(5):
         _, _, terminated, _, info = env.step(ZERO)
         assert terminated and info["is_success"] and info["reward_success"] == 0.0
+
+
+def test_an_episode_past_the_bonus_horizon_warns_once():
+    """A time limit raised above horizon_steps would let a late crossing earn no bonus: the
+    env says so on the first step past it, once."""
+    env = DitchCrossingEnv(horizon_steps=3)
+    env.reset(seed=0)
+    for _ in range(3):
+        env.step(ZERO)
+    with pytest.warns(UserWarning, match="ran past horizon_steps=3"):
+        env.step(ZERO)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        env.step(ZERO)
