@@ -164,7 +164,7 @@ def _learned_part(config: dict[str, Any]) -> str:
         )
     knobs = config.get("knobs")
     if _planner_knobs(config):
-        names = knobs["names"]
+        names = settings_from_config(knobs).names
         spans = ", ".join(
             f"{n} {PLANNER_KNOB_RANGES[n][0]}..{PLANNER_KNOB_RANGES[n][1]} m" for n in names
         )
@@ -181,7 +181,7 @@ def _learned_part(config: dict[str, Any]) -> str:
             "and walks with them, with its own settings where they give no plan"
         )
     elif knobs is not None:
-        names = knobs.get("names")
+        names = settings_from_config(knobs).names
         spans = ", ".join(f"{n} {KNOB_RANGES[n][0]}..{KNOB_RANGES[n][1]}" for n in names)
         notes.append(
             f"knobs model: the action is {len(names)} values in [-1, 1] that set the tipping "
@@ -227,9 +227,11 @@ def _space(space: Any) -> dict[str, Any]:
     }
 
 
-def training_evaluations(model_dir: Path) -> dict[str, Any] | None:
+def training_evaluations(model_dir: Path, select: str = "reward") -> dict[str, Any] | None:
     """The model directory's EvalCallback log (``evaluations.npz``): the number of evaluations,
-    and the last one and the one with the best mean return (mean return, success rate)."""
+    the last one and the best one (mean return, success rate), best by the training run's
+    ``eval.select`` rule, the one that chose its ``best/`` checkpoint: the mean return
+    ("reward"), or the success rate and then the mean return ("success")."""
     path = Path(model_dir) / EVALUATIONS_FILE
     if not path.is_file():
         return None
@@ -249,7 +251,12 @@ def training_evaluations(model_dir: Path) -> dict[str, Any] | None:
             out["success_rate"] = float(np.mean(successes[i]))
         return out
 
-    best = int(np.argmax(results.mean(axis=1)))
+    returns = results.mean(axis=1)
+    if select == "success" and successes is not None and successes.size:
+        rates = successes.mean(axis=1)
+        best = max(range(len(steps)), key=lambda i: (rates[i], returns[i]))
+    else:
+        best = int(np.argmax(returns))
     return {"evaluations": int(len(steps)), "last": row(len(steps) - 1), "best": row(best)}
 
 
@@ -389,7 +396,9 @@ def model_card(
             "eval_mean_reward": meta.get("eval_mean_reward"),
         },
         "source": {"model": str(files.model), "config": str(files.config)},
-        "training_evaluations": training_evaluations(files.directory),
+        "training_evaluations": training_evaluations(
+            files.directory, (config.get("eval") or {}).get("select", "reward")
+        ),
         "benchmark": report_scores(report, files.directory) if report is not None else None,
     }
 

@@ -11,7 +11,13 @@ from helpers.paths import REPO
 from helpers.stewart_hybrid_runs import train
 
 import hexapod_envs  # noqa: F401  (registers the envs)
-from agents.export import _learned_part, card_paths, export_main, export_model
+from agents.export import (
+    _learned_part,
+    card_paths,
+    export_main,
+    export_model,
+    training_evaluations,
+)
 from agents.hybrid import HybridPolicy
 from agents.ppo import PPOPolicy
 
@@ -132,3 +138,23 @@ def test_a_gains_cards_learned_part_names_the_height_knob_when_the_env_has_it():
     env["decision"] = "episode"
     held = "chosen once per episode at its first observation and held"
     assert _learned_part({"env": env}).endswith(held)
+
+
+def test_a_knobs_section_without_names_gets_the_default_knobs_on_the_card():
+    part = _learned_part({"knobs": {"reward": "success"}})
+    assert part.startswith("knobs model: the action is 3 values") and "rho 0.4..1.0" in part
+
+
+def test_the_cards_best_evaluation_follows_the_runs_select_rule(tmp_path):
+    """With ``eval.select: success`` the run's best/ is the most successful evaluation (then the
+    higher return), not the highest return: the card names the same one."""
+    np.savez(
+        tmp_path / "evaluations.npz",
+        timesteps=np.array([0, 100, 200]),
+        results=np.array([[10.0, 10.0], [50.0, 30.0], [20.0, 20.0]]),
+        successes=np.array([[0, 0], [0, 1], [1, 1]], dtype=bool),
+        ep_lengths=np.ones((3, 2)),
+    )
+    assert training_evaluations(tmp_path)["best"]["timesteps"] == 100
+    best = training_evaluations(tmp_path, "success")["best"]
+    assert best["timesteps"] == 200 and best["success_rate"] == 1.0
