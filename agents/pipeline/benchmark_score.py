@@ -36,6 +36,22 @@ def normalised(rate: float, scale: tuple[float, float]) -> float:
     return 100.0 * (rate - low) / (high - low)
 
 
+def env_scores(
+    successes: Mapping[str, Mapping[str, list[bool]]],
+) -> dict[str, dict[str, float]]:
+    """``{policy: {env: normalised success rate}}`` for every policy on every env with a scale
+    on which it ran, including policies that did not run on every env (which get no IQM).
+    `successes` is ``{env: {policy: [success per episode]}}``."""
+    out: dict[str, dict[str, float]] = {}
+    for env, by_policy in successes.items():
+        scale = env_scale({p: float(np.mean(v)) for p, v in by_policy.items()})
+        if scale is None:
+            continue
+        for policy, episodes in by_policy.items():
+            out.setdefault(policy, {})[env] = normalised(float(np.mean(episodes)), scale)
+    return dict(sorted(out.items()))
+
+
 def score_matrices(
     successes: Mapping[str, Mapping[str, list[bool]]],
 ) -> tuple[dict[str, np.ndarray], list[str]]:

@@ -441,12 +441,14 @@ def benchmark_section(result: SuiteResult) -> tuple[Table | None, str]:
     else:
         note = ""
     table = Table(["policy", *envs, "IQM [95 % CI]"])
-    for policy, matrix in matrices.items():
-        cells = [f"{x:.0f}" for x in matrix.mean(axis=0)]
+    partial = False
+    for policy, by_env in benchmark_score.env_scores(successes).items():
+        cells = [f"{by_env[env]:.0f}" if env in by_env else "-" for env in envs]
         if policy in intervals:
             iqm, low, high = intervals[policy]
             cells.append(f"{iqm:.0f} [{low:.0f}, {high:.0f}]")
         else:
+            partial = partial or policy not in matrices
             cells.append("n/a")
         table.rows.append([f"`{policy}`", *cells])
     text = (
@@ -454,6 +456,11 @@ def benchmark_section(result: SuiteResult) -> tuple[Table | None, str]:
         "controller, on the same tasks; the last column is the interquartile mean across envs "
         "with its 95 % stratified-bootstrap interval (episodes resampled within each env)."
     )
+    if partial:
+        text += (
+            " A policy without a score on every env (-), or with unequal episode counts, gets "
+            "no IQM."
+        )
     if left_out:
         text += (
             f" Left out (the analytical controller does not beat random actions there): "

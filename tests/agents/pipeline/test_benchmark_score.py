@@ -6,7 +6,13 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from agents.pipeline.benchmark_score import env_scale, iqm_intervals, normalised, score_matrices
+from agents.pipeline.benchmark_score import (
+    env_scale,
+    env_scores,
+    iqm_intervals,
+    normalised,
+    score_matrices,
+)
 
 
 def test_the_scale_runs_from_random_to_analytical():
@@ -29,6 +35,19 @@ def test_score_matrices_leave_out_envs_without_a_scale():
     assert matrices["ppo"].shape == (4, 1)
     assert matrices["ppo"].mean() == pytest.approx(150.0)  # 3/4 against 2/4 above 0
     assert matrices["analytical"].mean() == pytest.approx(100.0)
+
+
+def test_env_scores_keep_a_policy_that_ran_on_some_envs_only():
+    """A learned agent shipped for some envs gets its score there, though no IQM."""
+    successes = {
+        "A": {"analytical": [1, 1], "random": [0, 0], "knobs": [1, 0]},
+        "B": {"analytical": [1, 0], "random": [0, 0]},
+        "C": {"analytical": [0, 0], "random": [0, 0], "knobs": [1, 1]},  # no scale
+    }
+    scores = env_scores(successes)
+    assert scores["knobs"] == {"A": 50.0}
+    assert scores["analytical"] == {"A": 100.0, "B": 100.0}
+    assert "knobs" not in score_matrices(successes)[0]
 
 
 def test_the_iqm_of_per_env_scores_with_an_interval_that_holds_it():
