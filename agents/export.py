@@ -520,11 +520,12 @@ def export_model(
             raise UserError(
                 f"{', '.join(map(str, existing))} already exist(s); pass --force to overwrite"
             )
+        # The card first: a report that cannot be read stops the export before any file is
+        # written.
+        card = model_card(files, env, policy.stats, out.name, policy.model.action_space, report)
         out.parent.mkdir(parents=True, exist_ok=True)
         module = actor_module(policy.model, policy.stats)
         write_onnx(module, actor_input_space(files.training_config() or {}, env).shape[0], out)
-        space = policy.model.action_space
-        card = model_card(files, env, policy.stats, out.name, space, report)
     finally:
         env.close()
     atomic_write_text(card_json, json.dumps(card, indent=2) + "\n")

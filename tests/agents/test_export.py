@@ -128,6 +128,14 @@ def test_cli_refuses_to_overwrite_without_force(tmp_path, capsys):
     assert "no PPO model" in capsys.readouterr().err
 
 
+def test_an_unreadable_report_stops_the_export_before_any_file_is_written(tmp_path, capsys):
+    out = tmp_path / "a.onnx"
+    argv = [str(REPO / "models" / "HexapodIrregularTerrain-v0" / "ppo"), "--output", str(out)]
+    assert export_main([*argv, "--report", str(tmp_path / "no_report")]) == 2
+    assert "cannot read the report" in capsys.readouterr().err
+    assert not out.exists() and not any(p.exists() for p in card_paths(out))
+
+
 def test_a_gains_cards_learned_part_names_the_height_knob_when_the_env_has_it():
     env = {"decision": "gait_cycle", "kwargs": {"action_mode": "gains"}}
     plain = _learned_part({"env": env})
