@@ -91,8 +91,9 @@ def test_ramp_posture_control_holds_the_torso_higher(ramp):
     strict=True,
     reason=(
         "Not reached with the calibrated servos (kp 6.8 N m/rad): posture control's roll-rate RMS "
-        "is 5.5 % above the simple control's (seeds 0-3; paper -36 %), while the simple control's "
-        "torso drags on the slope, which damps its roll. At kp 8 it was -15 %."
+        "is 5.5 % above the simple control's (seeds 0-3, this test runs 0-1; paper -36 %), while "
+        "the simple control's torso drags on the slope, which damps its roll. At kp 8 it was "
+        "-15 %."
     ),
 )
 def test_ramp_posture_control_lowers_the_roll_rate(ramp):
@@ -122,8 +123,8 @@ def test_blocks_posture_control_cuts_the_torso_contacts(blocks):
     strict=True,
     reason=(
         "Not reached: on the calibrated bed (0.25 m blocks) the posture controller's torso "
-        "still grazes the blocks in some episodes (1 of seeds 0-3, 10 of seeds 0-19; on 0.1 m "
-        "blocks 4 of 4). Its height control holds the torso at the standing height above the one "
+        "still grazes the blocks in some episodes (1 of seeds 0-3, within the 0-2 this test runs; "
+        "10 of seeds 0-19; on 0.1 m blocks 4 of 4). Its height control holds the torso at the standing height above the one "
         "block its infrared sensor sees, and neighbouring blocks up to 0.09 m taller reach the "
         "torso's edges."
     ),

@@ -18,22 +18,26 @@ CONFIG = REPO / "configs" / "irregular_terrain_v1_ppo.yaml"
 
 
 def test_the_terms_count_the_tipping_steps_and_the_reward_carries_them():
-    kwargs = {"task_distribution": "train", "max_episode_steps": 60}
+    # a 3 deg success bound (the env's is 25) that the zero action's 6 deg sag passes
+    kwargs = {"task_distribution": "train", "max_episode_steps": 60, "success_max_tilt_deg": 3.0}
     wrapped = StabilityRulePenalty(gym.make("HexapodIrregularTerrain-v1", **kwargs), 2.5)
     plain = gym.make("HexapodIrregularTerrain-v1", **kwargs)
     wrapped.reset(seed=1000)
     plain.reset(seed=1000)
-    tipping_steps = 0
+    tipping_steps = tilted_steps = 0
     for _ in range(60):
         _, reward, *_, info = wrapped.step(np.zeros(18))
         _, plain_reward, *_, plain_info = plain.step(np.zeros(18))
         tipping_steps += bool(plain_info["is_tipping"])
         assert info["reward_rule_tipping"] == -2.5 * bool(plain_info["is_tipping"])
-        assert info["reward_rule_tilt"] == -2.5 * (plain_info["tilt_deg"] > 25.0)
+        tilted_steps += plain_info["tilt_deg"] > 3.0
+        assert info["reward_rule_tilt"] == -2.5 * (plain_info["tilt_deg"] > 3.0)
         assert info["reward_rule_early_landing"] == 0.0  # the rule has no swing phase here
         expected = plain_reward + info["reward_rule_tipping"] + info["reward_rule_tilt"]
         assert reward == pytest.approx(expected, abs=1e-9)
-    assert tipping_steps > 0  # the zero action sags onto the blocks: the term is exercised
+    assert wrapped.tilt_bound_deg == 3.0
+    # the zero action sags onto the blocks: both terms are exercised
+    assert tipping_steps > 0 and 0 < tilted_steps < 60
 
 
 class _Scripted(gym.Env):

@@ -73,11 +73,6 @@ def test_sweep_file_is_typed_and_checked_against_the_training_config(tmp_path):
 
 def test_shipped_seed_sweeps_load():
     for path in sorted((REPO / "configs").glob("sweep_*_seeds.yaml")):
-        if (
-            "_hybrid_" in path.name
-            and not (REPO / "configs" / yaml.safe_load(path.read_text())["base"]).is_file()
-        ):
-            continue  # the hybrid training configs come with the learned-agents work
         sweep = load_sweep(path)
         assert list(sweep.config.space) == ["train.seed"]
         assert sweep.config.num_trials >= 3 and sweep.base_config.vec_env.n_envs == 1

@@ -2,6 +2,7 @@
 
 import dataclasses
 import math
+import re
 
 import gymnasium as gym
 import mujoco
@@ -39,7 +40,7 @@ def _unnamed(env_id, names, bad):
         try:
             gym.make(env_id, **{name: bad})
         except (ValueError, TypeError) as err:
-            if name not in str(err):
+            if not re.search(rf"(?<!\w){re.escape(name)}(?!\w)", str(err)):  # not a longer name
                 unnamed.append((name, str(err)))
         else:
             unnamed.append((name, "accepted"))
