@@ -124,9 +124,9 @@ def test_blocks_posture_control_cuts_the_torso_contacts(blocks):
     reason=(
         "Not reached: on the calibrated bed (0.25 m blocks) the posture controller's torso "
         "still grazes the blocks in some episodes (1 of seeds 0-3, within the 0-2 this test runs; "
-        "10 of seeds 0-19; on 0.1 m blocks 4 of 4). Its height control holds the torso at the standing height above the one "
-        "block its infrared sensor sees, and neighbouring blocks up to 0.09 m taller reach the "
-        "torso's edges."
+        "10 of seeds 0-19; on 0.1 m blocks 4 of 4). Its height control holds the torso at the "
+        "standing height above the one block its infrared sensor sees, and neighbouring blocks "
+        "up to 0.09 m taller reach the torso's edges."
     ),
 )
 def test_blocks_posture_control_is_collision_free(blocks):
