@@ -65,17 +65,43 @@ class Clone:
             return np.clip(self.net(z)[0].numpy(), -1.0, 1.0)
 
 
-def episode(env, expert, seed: int, clone: Clone | None, pairs: list | None) -> dict:
-    """One episode from ``reset(seed)``: the clone acts (the controller if None); the
-    controller labels every step into `pairs` (if given). The last step's info."""
+def sensors(obs: np.ndarray, info: dict) -> np.ndarray:
+    """The clone's input by default: the sensor observation alone."""
+    return obs
+
+
+def with_ditch_and_time(obs: np.ndarray, info: dict) -> np.ndarray:
+    """The sensor observation plus what the ditch planner reads from the task and its clock:
+    the ditch's near and far edge ahead of the CoG [m], its depth [m] (5, 5, 0 on flat
+    ground) and the episode time [s] / 150 (privileged inputs, from ``info``)."""
+    ditch, cog_x = info["ditch"], float(info["cog"][0])
+    if ditch is None:
+        task = [5.0, 5.0, 0.0]
+    else:
+        near = ditch["start_x"] - cog_x
+        task = [near, near + ditch["width"], ditch["depth"]]
+    return np.concatenate([obs, task, [info["time"] / 150.0]])
+
+
+def episode(
+    env, expert, seed: int, clone: Clone | None, pairs: list | None, inputs=sensors, noise=0.0
+) -> dict:
+    """One episode from ``reset(seed)``: the clone acts (the controller if None, with Gaussian
+    action noise of std `noise` from a generator seeded with `seed`); the controller labels
+    every step into `pairs` (if given) as (`inputs` (obs, info), action). The last info."""
     obs, info = env.reset(seed=seed)
     expert.reset()
+    rng = np.random.default_rng(seed)
     done = False
     while not done:
         label = np.asarray(expert(obs))
+        x = inputs(obs, info)
         if pairs is not None:
-            pairs.append((obs.copy(), np.clip(label, -1.0, 1.0)))
-        action = label if clone is None else clone(obs)
+            pairs.append((x.copy(), np.clip(label, -1.0, 1.0)))
+        if clone is None:
+            action = np.clip(label + noise * rng.normal(size=label.shape), -1.0, 1.0)
+        else:
+            action = clone(x)
         obs, _, terminated, truncated, info = env.step(action)
         done = terminated or truncated
     return info
@@ -90,17 +116,47 @@ def main() -> None:
     parser.add_argument("--noise", type=float, default=0.1)
     parser.add_argument("--tests", type=int, default=10, help="benchmark test tasks")
     parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument(
+        "--action-mode", help="the env's action mode (default: the controller's, e.g. joint)"
+    )
+    parser.add_argument(
+        "--task-inputs",
+        action="store_true",
+        help="HexapodDitchCrossing only: add the ditch's edges and depth and the episode time "
+        "to the clone's input (privileged; `with_ditch_and_time`)",
+    )
+    parser.add_argument(
+        "--controller-noise",
+        type=float,
+        nargs="+",
+        metavar="STD",
+        help="only run the controller with Gaussian action noise of each STD on `episodes` "
+        "training tasks (how precisely a clone must copy it) and stop",
+    )
     args = parser.parse_args()
-    kwargs = ANALYTICAL_ENV_KWARGS.get(args.env_id, {})
+    kwargs = dict(ANALYTICAL_ENV_KWARGS.get(args.env_id, {}))
+    if args.action_mode:
+        kwargs["action_mode"] = args.action_mode
+    inputs = with_ditch_and_time if args.task_inputs else sensors
     make = analytical_factory(args.env_id)
     train = gym.make(args.env_id, task_distribution="train", **kwargs)
     expert = make(train)
-    clone = Clone(train.observation_space.shape[0], train.action_space.shape[0], args.seed)
+    if args.controller_noise:
+        for std in args.controller_noise:
+            infos = [episode(train, expert, k, None, None, noise=std) for k in range(args.episodes)]
+            wins = sum(bool(i[keys.IS_SUCCESS]) for i in infos)
+            tips = sum(bool(i[keys.IS_TIPPED_OVER]) for i in infos)
+            print(f"action noise std {std}: {wins} successes, {tips} tip-overs of {len(infos)}")
+        return
+    obs, info = train.reset(seed=0)
+    n_inputs = inputs(obs, info).shape[0]
+    clone = Clone(n_inputs, train.action_space.shape[0], args.seed)
     pairs: list = []
     start = time.perf_counter()
     for round_ in range(args.rounds + 1):
         for k in range(args.episodes):
-            episode(train, expert, 1000 * round_ + k, clone if round_ else None, pairs)
+            driver = clone if round_ else None
+            episode(train, expert, 1000 * round_ + k, driver, pairs, inputs)
         x, y = (np.array(v) for v in zip(*pairs, strict=True))
         loss = clone.fit(x, y, args.epochs, args.noise)
         print(
@@ -114,7 +170,7 @@ def main() -> None:
     for seed in range(args.tests):
         line = [f"task {seed}"]
         for name, actor in (("clone", clone), ("controller", None)):
-            info = episode(test, test_expert, seed, actor, None)
+            info = episode(test, test_expert, seed, actor, None, inputs)
             wins[name] += bool(info[keys.IS_SUCCESS])
             line.append(
                 f"{name} {bool(info[keys.IS_SUCCESS])} {info.get('distance', np.nan):.2f} m "
