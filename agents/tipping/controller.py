@@ -132,7 +132,8 @@ class RecoveryConfig:
     Attributes:
         threshold_deg: ξ_f [deg] (paper: 20).
         reach_model: foothold reach model, "kinematic" (the leg's real reach) or "paper"
-            (eqs. 10-12 as printed); see :mod:`.foothold`.
+            (eqs. 10-12 as printed, which finds no foothold outside a side tipping edge of the
+            standing robot); see :mod:`.foothold`.
         rho: safety factor ρ of eqs. (11)-(13) (not given in the paper).
         angle_threshold_deg: segment/axis angle threshold of the selection rule [deg].
         kappa, t_min, t_max: eq. (15)'s ϰ and the clamp on t_s [s].
@@ -404,7 +405,7 @@ class TippingRecoveryController:
         p, q = feet[_LEG_INDEX[edge[0]], :2], feet[_LEG_INDEX[edge[1]], :2]
         axis = (q - p) / np.linalg.norm(q - p)
 
-        def outside(leg):  # > 0 right of the counter-clockwise edge, i.e. outside the polygon
+        def outside(leg):  # < 0 right of the counter-clockwise edge, i.e. outside the polygon
             h = self.params.hip_offsets[leg][:2] - p
             return axis[0] * h[1] - axis[1] * h[0]
 

@@ -17,7 +17,9 @@ Two models find R and L along the line:
 - ``"paper"``: eqs. (10)-(12) as printed. R lies on the circle ‖B_iR‖ = L_max (eq. 10) unless
   the angle ∠HB_iR exceeds the swing range, in which case that angle is clamped and ‖HR‖
   recomputed (law of sines); L likewise. This treats the swing angle as the angle at B_i, i.e.
-  it ignores the leg-plane offset L1. ‖HR‖ and ‖HL‖ are then scaled by ρ about H.
+  it ignores the leg-plane offset L1. ‖HR‖ and ‖HL‖ are then scaled by ρ about H. On the
+  heavy robot standing on flat ground this puts R and L of a middle leg at |y| = 1.825 m,
+  inside the stance feet at 1.9 m, so this model finds no foothold outside a side tipping edge.
 - ``"kinematic"`` (default): the exact extremes of the line inside the leg's reachable set of
   eq. (1) (swing angle J_θ in its range, leg length K_z J_z + L2 in its range, J_x = 0): the
   candidates are the line's intersections with the circles ‖B_iP‖ = L_max, L_min and with the

@@ -85,8 +85,11 @@ def effective_support_legs(
     """The two stance legs carrying the largest vertical foot force, larger first.
 
     Args:
-        vertical_forces: vertical (world z) ground reaction force on each foot [N], keyed by leg
-            name; must contain every stance leg (other legs are ignored).
+        vertical_forces: vertical ground reaction force on each foot [N], keyed by leg name;
+            must contain every stance leg (other legs are ignored). The recovery controller
+            passes the component along the body's z axis, the frame in which it also measures
+            the feet and the FASM; on a tilted body this can rank the legs otherwise than the
+            world's z would.
         stance_legs: legs in stance (at least 2).
     """
     stance = _check_legs(stance_legs, "stance_legs")
