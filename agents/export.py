@@ -247,12 +247,14 @@ def training_evaluations(model_dir: Path, select: str = "reward") -> dict[str, A
             "episodes": int(results.shape[1]),
             "mean_return": float(np.mean(results[i])),
         }
-        if successes is not None and successes.size:
+        if successes is not None and i < len(successes) and np.size(successes[i]):
             out["success_rate"] = float(np.mean(successes[i]))
         return out
 
     returns = results.mean(axis=1)
-    if select == "success" and successes is not None and successes.size:
+    # SB3 logs successes only for evaluations whose episodes report is_success
+    by_success = successes is not None and successes.size and len(successes) == len(steps)
+    if select == "success" and by_success:
         rates = successes.mean(axis=1)
         best = max(range(len(steps)), key=lambda i: (rates[i], returns[i]))
     else:

@@ -166,3 +166,12 @@ def test_the_cards_best_evaluation_follows_the_runs_select_rule(tmp_path):
     assert training_evaluations(tmp_path)["best"]["timesteps"] == 100
     best = training_evaluations(tmp_path, "success")["best"]
     assert best["timesteps"] == 200 and best["success_rate"] == 1.0
+    # equal success: the higher return; an exact tie: the earlier evaluation, as best/ keeps it
+    np.savez(
+        tmp_path / "evaluations.npz",
+        timesteps=np.array([0, 100, 200, 300]),
+        results=np.array([[10.0, 10.0], [20.0, 20.0], [30.0, 30.0], [30.0, 30.0]]),
+        successes=np.array([[1, 0], [1, 1], [1, 1], [1, 1]], dtype=bool),
+        ep_lengths=np.ones((4, 2)),
+    )
+    assert training_evaluations(tmp_path, "success")["best"]["timesteps"] == 200

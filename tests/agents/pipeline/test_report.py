@@ -8,8 +8,8 @@ import pytest
 
 from agents.pipeline.cli import evaluate_main
 from agents.pipeline.episode import EpisodeRecord
-from agents.pipeline.evaluation import EnvResult, PolicyRun
-from agents.pipeline.report import verdict_lines, verdict_paragraph
+from agents.pipeline.evaluation import EnvResult, PolicyRun, SuiteResult
+from agents.pipeline.report import benchmark_section, verdict_lines, verdict_paragraph
 from agents.pipeline.summary import aggregate
 
 AGENT_ENVS = ["HexapodStewartTilt-v1", "HexapodIrregularTerrain-v1"]  # with a shipped knobs agent
@@ -306,6 +306,27 @@ def test_benchmark_scores_run_from_random_to_the_analytical_controller(tmp_path)
     metrics = json.loads((out / "metrics.json").read_text())
     episode = metrics["envs"]["HexapodStewartTilt-v1"]["policies"]["analytical"]["episodes"][0]
     assert "difficulty" in json.dumps(episode)
+
+
+def test_a_policy_run_on_some_envs_gets_its_scores_there_and_no_iqm():
+    """A learned agent shipped for one of two envs: its row shows its score there, "-" on the
+    other env and no IQM, and the text says why."""
+    ok, tipped = _record(100, 0.0, 1.0, False), _record(100, 0.0, 1.0, True)
+    envs = []
+    for env_id, agent in (("A-v1", True), ("B-v1", False)):
+        result = EnvResult(env_id, {}, 100, 0.02, [])
+        result.runs = {
+            "analytical": PolicyRun("analytical", "a", [ok, ok, ok, tipped]),
+            "random": PolicyRun("random", "r", [tipped] * 4),
+        }
+        if agent:
+            result.runs["ppo:x"] = PolicyRun("ppo:x", "x", [ok, ok, tipped, tipped])
+        envs.append(result)
+    table, text = benchmark_section(SuiteResult(None, envs, [], 0.0))
+    rows = {row[0]: row[1:] for row in table.rows}
+    assert rows["`ppo:x`"] == ["67", "-", "n/a"]  # 2/4 against 3/4 above 0/4
+    assert rows["`analytical`"][:2] == ["100", "100"] and rows["`analytical`"][2] != "n/a"
+    assert "without a score on every env (-)" in text
 
 
 def test_ppo_policies_get_short_unambiguous_aliases():
