@@ -40,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from .knobs import KNOB_RANGES, PLANNER_KNOB_RANGES, settings_from_config
+from .pipeline.callbacks import evaluation_score
 from .pipeline.cli import _add_trust_pickle_option, _run
 from .plan_knobs import COURSE_FEATURES, course_space
 from .policy import LearnedWithController
@@ -251,14 +252,11 @@ def training_evaluations(model_dir: Path, select: str = "reward") -> dict[str, A
             out["success_rate"] = float(np.mean(successes[i]))
         return out
 
-    returns = results.mean(axis=1)
-    # SB3 logs successes only for evaluations whose episodes report is_success
-    by_success = successes is not None and successes.size and len(successes) == len(steps)
-    if select == "success" and by_success:
-        rates = successes.mean(axis=1)
-        best = max(range(len(steps)), key=lambda i: (rates[i], returns[i]))
+    if select == "success":
+        logged = successes if successes is not None else []
+        best = max(range(len(steps)), key=lambda i: evaluation_score(logged, results, i))
     else:
-        best = int(np.argmax(returns))
+        best = int(np.argmax(results.mean(axis=1)))
     return {"evaluations": int(len(steps)), "last": row(len(steps) - 1), "best": row(best)}
 
 

@@ -36,18 +36,26 @@ def normalised(rate: float, scale: tuple[float, float]) -> float:
     return 100.0 * (rate - low) / (high - low)
 
 
+def env_scales(
+    successes: Mapping[str, Mapping[str, list[bool]]],
+) -> dict[str, tuple[float, float]]:
+    """``{env: (random, analytical) success rates}`` of the envs with a usable scale.
+    `successes` is ``{env: {policy: [success per episode]}}``."""
+    scales = {
+        env: env_scale({p: float(np.mean(v)) for p, v in by_policy.items()})
+        for env, by_policy in successes.items()
+    }
+    return {env: scale for env, scale in scales.items() if scale is not None}
+
+
 def env_scores(
     successes: Mapping[str, Mapping[str, list[bool]]],
 ) -> dict[str, dict[str, float]]:
     """``{policy: {env: normalised success rate}}`` for every policy on every env with a scale
-    on which it ran, including policies that did not run on every env (which get no IQM).
-    `successes` is ``{env: {policy: [success per episode]}}``."""
+    on which it ran, including policies that did not run on every env (which get no IQM)."""
     out: dict[str, dict[str, float]] = {}
-    for env, by_policy in successes.items():
-        scale = env_scale({p: float(np.mean(v)) for p, v in by_policy.items()})
-        if scale is None:
-            continue
-        for policy, episodes in by_policy.items():
+    for env, scale in env_scales(successes).items():
+        for policy, episodes in successes[env].items():
             out.setdefault(policy, {})[env] = normalised(float(np.mean(episodes)), scale)
     return dict(sorted(out.items()))
 
@@ -58,11 +66,8 @@ def score_matrices(
     """``{policy: (episodes x envs) normalised per-episode scores}`` over the envs with a scale
     on which the policy ran the same number of episodes as every other; and those envs.
     `successes` is ``{env: {policy: [success per episode]}}``."""
-    scales = {
-        env: env_scale({p: float(np.mean(v)) for p, v in by_policy.items()})
-        for env, by_policy in successes.items()
-    }
-    envs = [env for env, scale in scales.items() if scale is not None]
+    scales = env_scales(successes)
+    envs = list(scales)
     out = {}
     for policy in sorted({p for env in envs for p in successes[env]}):
         if not all(policy in successes[env] for env in envs):

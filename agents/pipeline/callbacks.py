@@ -121,6 +121,15 @@ class SaveBest(BaseCallback):
         return True
 
 
+def evaluation_score(successes: Any, results: Any, i: int) -> tuple[float, float]:
+    """(success rate, mean return) of evaluation `i` of an EvalCallback log, the key by which
+    ``eval.select: success`` keeps ``best/``; success 0 where the log holds none (SB3 logs
+    successes only for evaluations whose episodes report ``is_success``)."""
+    episodes = successes[i] if i < len(successes) else []
+    rate = float(sum(episodes)) / len(episodes) if len(episodes) else 0.0
+    return rate, float(sum(results[i]) / len(results[i]))
+
+
 class StatsEvalCallback(EvalCallback):
     """EvalCallback that also logs FASM/success statistics of its evaluation episodes."""
 
@@ -185,10 +194,8 @@ class StatsEvalCallback(EvalCallback):
         self.logger.record("eval/return_change_since_start", latest[1] - first[1])
 
     def score(self, i: int) -> tuple[float, float]:
-        """(success rate, mean return) of evaluation `i`; success 0 when the env reports none."""
-        successes = self.evaluations_successes[i] if i < len(self.evaluations_successes) else []
-        rate = float(sum(successes)) / len(successes) if len(successes) else 0.0
-        return rate, float(sum(self.evaluations_results[i]) / len(self.evaluations_results[i]))
+        """(success rate, mean return) of evaluation `i` (`evaluation_score`)."""
+        return evaluation_score(self.evaluations_successes, self.evaluations_results, i)
 
     def _log_success_callback(self, locals_: dict[str, Any], globals_: dict[str, Any]) -> None:
         super()._log_success_callback(locals_, globals_)

@@ -98,10 +98,12 @@ def episode(
         x = inputs(obs, info)
         if pairs is not None:
             pairs.append((x.copy(), np.clip(label, -1.0, 1.0)))
-        if clone is None:
+        if clone is not None:
+            action = clone(x)
+        elif noise:
             action = np.clip(label + noise * rng.normal(size=label.shape), -1.0, 1.0)
         else:
-            action = clone(x)
+            action = label
         obs, _, terminated, truncated, info = env.step(action)
         done = terminated or truncated
     return info
