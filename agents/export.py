@@ -44,7 +44,13 @@ from .pipeline.callbacks import evaluation_score
 from .pipeline.cli import _add_trust_pickle_option, _run
 from .plan_knobs import COURSE_FEATURES, course_space
 from .policy import LearnedWithController
-from .run_files.artifacts import ModelFiles, find_model, learner_step_unit, read_meta
+from .run_files.artifacts import (
+    ModelFiles,
+    find_model,
+    is_run_dir,
+    learner_step_unit,
+    read_meta,
+)
 from .run_files.errors import UserError
 from .run_files.model_files import NormalizationStats, atomic_path, atomic_write_text
 
@@ -232,10 +238,18 @@ def training_evaluations(model_dir: Path, select: str = "reward") -> dict[str, A
     """The model directory's EvalCallback log (``evaluations.npz``): the number of evaluations,
     the last one and the best one (mean return, success rate), best by the training run's
     ``eval.select`` rule, the one that chose its ``best/`` checkpoint: the mean return
-    ("reward"), or the success rate and then the mean return ("success")."""
-    path = Path(model_dir) / EVALUATIONS_FILE
-    if not path.is_file():
+    ("reward"), or the success rate and then the mean return ("success"). A model inside a run
+    directory (``best/``, ``final/``, ``checkpoints/step_N/``) reads its run's log."""
+    model_dir = Path(model_dir)
+    candidates = [model_dir, model_dir.parent, model_dir.parent.parent]
+    found = [
+        d / EVALUATIONS_FILE
+        for d in candidates
+        if (d / EVALUATIONS_FILE).is_file() and (d == model_dir or is_run_dir(d))
+    ]
+    if not found:
         return None
+    path = found[0]
     with np.load(path, allow_pickle=False) as data:
         steps, results = data["timesteps"], data["results"]
         successes = data["successes"] if "successes" in data.files else None

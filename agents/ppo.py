@@ -111,6 +111,18 @@ class PPOPolicy:
     def reset(self) -> None:
         pass
 
+    def seed_episode(self, seed: int) -> None:
+        """Sample the actions of the episode run with `seed` from that seed (``deterministic``
+        False), so that its result does not depend on the episodes run before it; an evaluation
+        calls this before each episode. The sampling draws from torch's global generator."""
+        if self.deterministic:
+            return
+        import torch
+
+        torch.manual_seed(seed)
+        if self.model.use_sde:
+            self.model.policy.reset_noise()
+
     def __call__(self, observation: np.ndarray) -> np.ndarray:
         obs = np.asarray(observation)
         if obs.dtype.kind not in "fiu":

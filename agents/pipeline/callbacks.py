@@ -17,6 +17,7 @@ TensorBoard tags written besides SB3's own (``rollout/``, ``train/``, ``eval/``,
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
@@ -147,6 +148,10 @@ class StatsEvalCallback(EvalCallback):
         return; pass no ``callback_on_new_best`` then)."""
         super().__init__(*args, **kwargs)
         self.task_seed, self.select_saver = task_seed, select_saver
+        self._log_file: str | None = None
+        if self.log_path is not None:  # SB3 rewrites its log in place; write a copy, then swap
+            self._log_file = self.log_path + ".npz"
+            self.log_path = os.path.join(os.path.dirname(self.log_path), ".evaluations.partial")
         self.best_score: tuple[float, float] | None = None
         self._make_accumulators = new_accumulator
         self._accumulators: dict[int, EpisodeAccumulator] = {}
@@ -169,6 +174,8 @@ class StatsEvalCallback(EvalCallback):
             self.eval_env.seed(self.task_seed)
         done_before = len(self.evaluations_timesteps)
         continue_training = super()._on_step()
+        if self._log_file is not None and len(self.evaluations_timesteps) > done_before:
+            os.replace(self.log_path + ".npz", self._log_file)
         if self.task_seed is not None and len(self.evaluations_timesteps) > done_before:
             self._log_change_since_start()
         if self.select_saver is not None and len(self.evaluations_timesteps) > done_before:

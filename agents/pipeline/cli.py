@@ -10,6 +10,7 @@ Ctrl-C during training saves a checkpoint and exits with 130.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import sys
 from collections.abc import Callable, Sequence
@@ -216,7 +217,7 @@ def evaluate_main(argv: Sequence[str] | None = None, prog: str = "evaluate.py") 
         args.config = resolve_shipped(args.config)
 
     def body() -> int:
-        from .eval_config import load_suite
+        from .eval_config import DEFAULT_TITLE, load_suite
         from .evaluation import run_suite
         from .report import write_report
 
@@ -224,7 +225,11 @@ def evaluate_main(argv: Sequence[str] | None = None, prog: str = "evaluate.py") 
         overrides = ["missing_models=error"] if args.policies else []
         overrides += args.overrides
         if args.envs:
-            overrides.append(f"envs={json.dumps(_suite_envs(args.config, args.envs))}")
+            entries, unlisted = _suite_envs(args.config, args.envs)
+            overrides.append(f"envs={json.dumps(entries)}")
+            if unlisted and not any(o.startswith("title=") for o in args.overrides):
+                # an env the suite does not list: its title (say "benchmark v1") may not hold
+                overrides.append(f"title={json.dumps(DEFAULT_TITLE)}")
         for key, value in (
             ("policies", args.policies),
             ("episodes", args.episodes),
@@ -244,17 +249,22 @@ def evaluate_main(argv: Sequence[str] | None = None, prog: str = "evaluate.py") 
         from .study import expand_studies, write_study_section
 
         suite, studies, study_warnings = expand_studies(suite)  # ppo:<sweep dir> -> trials
-        out = _prepare_report_dir(Path(suite.output_dir), args.force or _is_default_report(suite))
-        video_dir = out / "videos" if args.video else None
-        result = run_suite(suite, progress=not args.no_progress, video_dir=video_dir)
-        result.warnings[:0] = study_warnings
-        paths = write_report(result, out)
-        paths += write_study_section(result, studies, out)  # nothing without sweep dirs
+        out = Path(suite.output_dir)
+        force = args.force or _is_default_report(suite)
+        _prepare_report_dir(out, force, check_only=True)  # before the run: refusals cost nothing
+        with _partial_dir(out) as partial:  # an earlier report stays until the new one is done
+            video_dir = partial / "videos" if args.video else None
+            result = run_suite(suite, progress=not args.no_progress, video_dir=video_dir)
+            result.warnings[:0] = study_warnings
+            paths = write_report(result, partial)
+            paths += write_study_section(result, studies, partial)  # none without sweep dirs
+            _prepare_report_dir(out, force).rmdir()
+            partial.rename(out)
         for line in result.warnings:
             print(f"warning: {line}", file=sys.stderr)
         for line in result.notes:
             print(f"note: {line}", file=sys.stderr)
-        print("wrote " + ", ".join(str(p) for p in paths))
+        print("wrote " + ", ".join(str(out / p.relative_to(partial)) for p in paths))
         return 0
 
     return _run(prog, body)
@@ -268,9 +278,10 @@ def hexapod_evaluate() -> int:
     return evaluate_main(prog="hexapod-evaluate")
 
 
-def _suite_envs(config: Path | None, ids: list[str]) -> list[dict]:
+def _suite_envs(config: Path | None, ids: list[str]) -> tuple[list[dict], list[str]]:
     """`--envs` entries with the suite's kwargs and time limit for ids the suite names (so the
-    shipped agents are evaluated in the env they were trained in); other ids bare."""
+    shipped agents are evaluated in the env they were trained in); other ids bare, and those
+    ids (they run with the env's registered defaults: a -v0 id the paper's scenario)."""
     from ..run_files.configtools import load_yaml
 
     listed = load_yaml(config or DEFAULT_SUITE).get("envs") or []
@@ -278,7 +289,8 @@ def _suite_envs(config: Path | None, ids: list[str]) -> list[dict]:
     for item in listed:
         entry = {"id": item} if isinstance(item, str) else dict(item)
         known[entry.get("id")] = entry
-    return [known.get(env_id, {"id": env_id}) for env_id in ids]
+    unlisted = [env_id for env_id in ids if env_id not in known]
+    return [known.get(env_id, {"id": env_id}) for env_id in ids], unlisted
 
 
 def _is_default_report(suite) -> bool:
@@ -292,7 +304,26 @@ def _is_default_report(suite) -> bool:
     return default is not None and out == Path(default) and (out / "metrics.json").is_file()
 
 
-def _prepare_report_dir(path: Path, force: bool) -> Path:
+def _prepare_report_dir(path: Path, force: bool, check_only: bool = False) -> Path:
+    """Empty `path` for a new report (`prepare_new_dir`); `check_only`: only raise where that
+    would be refused."""
     from ..run_files.artifacts import prepare_new_dir
 
-    return prepare_new_dir(path, force, "report directory")
+    return prepare_new_dir(
+        path, force, "report directory", ("metrics.json", "report.md"), check_only=check_only
+    )
+
+
+@contextlib.contextmanager
+def _partial_dir(out: Path):
+    """A new directory beside `out` that the report is written to, removed if the run fails or
+    is interrupted (a finished report is renamed to `out` inside the block)."""
+    import shutil
+
+    partial = out.parent / f".{out.name}.partial"
+    shutil.rmtree(partial, ignore_errors=True)  # left by a killed run
+    partial.mkdir(parents=True)
+    try:
+        yield partial
+    finally:
+        shutil.rmtree(partial, ignore_errors=True)

@@ -41,6 +41,14 @@ def _parse_envs(value: Any, where: str) -> list[SuiteEnv]:
         if isinstance(item, str):
             item = {"id": item}
         envs.append(from_mapping(SuiteEnv, item, f"{where}[{i}]"))
+    ids = [env.id for env in envs]
+    repeated = sorted({env_id for env_id in ids if ids.count(env_id) > 1})
+    if repeated:
+        raise ConfigError(
+            f"{where}: {repeated} listed more than once; a report has one section per env id "
+            "(its results, figures and scores are keyed by it): evaluate other settings of the "
+            "same env, such as another task_distribution, in a suite of their own"
+        )
     return envs
 
 
@@ -70,6 +78,10 @@ def _parse_references(value: Any, where: str) -> list[str] | None:
     return None if value is None else _parse_policies(value, where)
 
 
+DEFAULT_TITLE = "Hexapod policy evaluation"
+"""A report's title where the suite gives none."""
+
+
 @dataclass
 class EvaluationSuite:
     envs: list[SuiteEnv] = field(metadata={"parse": _parse_envs})
@@ -96,7 +108,7 @@ class EvaluationSuite:
     frame_size: list[int] = field(default_factory=lambda: [320, 240])
     xi_f_deg: float = 20.0
     gym_packages: list[str] = field(default_factory=lambda: list(DEFAULT_GYM_PACKAGES))
-    title: str = "Hexapod policy evaluation"
+    title: str = DEFAULT_TITLE
 
     def __post_init__(self):
         if self.episodes < 1:

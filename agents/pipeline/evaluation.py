@@ -65,11 +65,13 @@ class EnvResult:
     criterion: str = ""  # the robot's stability criterion, in words
     unranked: tuple[str, ...] = ()  # standard metrics without a verdict here (see `prepare`)
     aliases: dict[str, str] = field(default_factory=dict)  # policy name -> short name
+    rules: dict[str, float | None] = field(default_factory=dict)
+    """The env's episode-end and success bounds (`episode_rules`); empty for other envs."""
 
     def label(self, name: str) -> str:
         """What a reader of this env sees: the policy's short alias (`policy_aliases`), else
         its name with ``{env_id}`` expanded."""
-        return self.aliases.get(name) or name.replace("{env_id}", self.env_id)
+        return (self.aliases.get(name) or name).replace("{env_id}", self.env_id)
 
 
 _RUN_PARTS = {"best", "final", "model.zip", "checkpoints"}
@@ -79,16 +81,40 @@ _RUN_PARTS = {"best", "final", "model.zip", "checkpoints"}
 def policy_aliases(names: list[str]) -> dict[str, str]:
     """Short names for the ``ppo:<path>`` policies of a suite: the path's last component that
     names the model (``ppo:models/{env_id}/hybrid`` -> ``hybrid``; ``runs/<run>/best`` ->
-    ``<run>``). A policy whose alias would be ambiguous (another policy's alias or name) keeps
+    ``<run>``; ``ppo:mine/{env_id}`` -> ``mine``; `EnvResult.label` expands a ``{env_id}``
+    left in it). A policy whose alias would be ambiguous (another policy's alias or name) keeps
     its full name; the report's sources list every path."""
     short = {}
     for name in names:
         if name.startswith(PPO_PREFIX):
-            parts = [p for p in Path(name[len(PPO_PREFIX) :]).parts if p not in _RUN_PARTS]
+            parts = [
+                p
+                for p in Path(name[len(PPO_PREFIX) :]).parts
+                if p not in _RUN_PARTS and p != "{env_id}"
+            ]
             if parts:
                 short[name] = parts[-1]
     taken = [*short.values(), *(n for n in names if n not in short)]
     return {name: alias for name, alias in short.items() if taken.count(alias) == 1}
+
+
+RULE_SETTINGS = (
+    "tip_over_angle_deg",
+    "tip_over_margin_time",
+    "success_max_tilt_deg",
+    "success_max_tipping_share",
+)
+"""A hexapod env's settings that end an episode (tip-over: a tilt [deg], or the FASM at or
+below 0 for a time [s]) and bound a success (its largest tilt [deg], its share of time
+tipping [-]); None: not bounded."""
+
+
+def episode_rules(env: gym.Env) -> dict[str, float | None]:
+    """`RULE_SETTINGS` of the env's settings (none for an env without them)."""
+    settings = getattr(env.unwrapped, "settings", None)
+    if settings is None or not all(hasattr(settings, name) for name in RULE_SETTINGS):
+        return {}
+    return {name: getattr(settings, name) for name in RULE_SETTINGS}
 
 
 def stability_threshold(env: gym.Env, default_deg: float) -> tuple[float | None, str]:
@@ -321,6 +347,7 @@ def prepare(
             aliases=policy_aliases(suite.policies),
         )
         result.xi_deg, result.criterion = stability_threshold(env, suite.xi_f_deg)
+        result.rules = episode_rules(env)
         if not getattr(env.unwrapped, "walks", True):  # a standing task (the Stewart tilt):
             result.unranked = ("speed_m_s",)  # distance is drift or a fall, not progress
         policies = {}

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import io
+import warnings
 from collections.abc import Sequence
 
 import matplotlib
@@ -190,14 +191,18 @@ def learning_curves(result: EnvResult) -> bytes | None:
     """Evaluation success rate and mean return against learner steps (env steps; gait cycles, in
     a row of their own, for a run that acts once per cycle) for every PPO policy whose
     run directory holds an ``evaluations.npz`` (shipped model directories do not)."""
-    from .learning_curve import load_learning_curve
+    from ..run_files.errors import UserError
+    from .learning_curve import EVALUATIONS_FILE, load_learning_curve
 
     curves = {}
     for name, run in result.runs.items():
         directory = getattr(run, "model_dir", None)
         for candidate in (directory, getattr(directory, "parent", None)):
-            if candidate is not None and (candidate / "evaluations.npz").is_file():
-                curves[result.label(name)] = load_learning_curve(candidate)
+            if candidate is not None and (candidate / EVALUATIONS_FILE).is_file():
+                try:
+                    curves[result.label(name)] = load_learning_curve(candidate)
+                except UserError as exc:
+                    warnings.warn(f"{exc}; no learning curve for {name}", stacklevel=2)
                 break
     if not curves:
         return None

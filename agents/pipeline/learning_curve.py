@@ -57,7 +57,10 @@ class LearningCurve:
 
 
 def load_learning_curve(run_dir: str | Path) -> LearningCurve:
-    """The evaluation log of `run_dir`; UserError if it has none (eval.freq 0, or too early)."""
+    """The evaluation log of `run_dir`; UserError if it has none (eval.freq 0, or too early) or
+    if it is damaged (unreadable, an array missing, rows of different lengths). SB3 logs
+    successes only for evaluations whose episodes report ``is_success``; a successes array that
+    does not have a row per evaluation is left out (``successes`` None)."""
     path = Path(run_dir) / EVALUATIONS_FILE
     if not path.is_file():
         raise UserError(
@@ -66,12 +69,20 @@ def load_learning_curve(run_dir: str | Path) -> LearningCurve:
         )
     config = Path(run_dir) / "config.yaml"
     unit = learner_step_unit(yaml.safe_load(config.read_text()) if config.is_file() else None)
-    with np.load(path) as data:
-        successes = data["successes"] if "successes" in data and data["successes"].size else None
-        return LearningCurve(
-            timesteps=np.asarray(data["timesteps"], dtype=np.int64),
-            returns=np.asarray(data["results"], dtype=float),
-            lengths=np.asarray(data["ep_lengths"], dtype=np.int64),
-            successes=None if successes is None else np.asarray(successes, dtype=float),
-            unit=unit,
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            timesteps = np.asarray(data["timesteps"], dtype=np.int64).reshape(-1)
+            returns = np.asarray(data["results"], dtype=float)
+            lengths = np.asarray(data["ep_lengths"], dtype=np.int64)
+            successes = np.asarray(data["successes"], dtype=float) if "successes" in data else None
+    except (OSError, ValueError, KeyError, EOFError) as exc:
+        raise UserError(f"the evaluation log {path} is damaged ({exc})") from None
+    n = len(timesteps)
+    if returns.ndim != 2 or len(returns) != n or lengths.shape != returns.shape:
+        raise UserError(
+            f"the evaluation log {path} is damaged: {n} evaluations, but returns of shape "
+            f"{returns.shape} and lengths of shape {lengths.shape}"
         )
+    if successes is not None and successes.shape != returns.shape:
+        successes = None
+    return LearningCurve(timesteps, returns, lengths, successes, unit=unit)

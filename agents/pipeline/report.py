@@ -24,7 +24,14 @@ from . import benchmark_score, figures
 from .episode import POWER_KEY
 from .eval_config import DEFAULT_REFERENCES, PPO_PREFIX
 from .evaluation import EnvResult, SuiteResult
-from .summary import STANDARD_METRICS, Verdict, aggregate, compare, paired_difference_interval
+from .summary import (
+    STANDARD_METRICS,
+    TIE_TOLERANCE,
+    Verdict,
+    aggregate,
+    compare,
+    paired_difference_interval,
+)
 
 
 # --- tables --------------------------------------------------------------------------------
@@ -234,7 +241,7 @@ def verdict_paragraph(result: EnvResult, aggs: dict[str, dict]) -> str:
     parts = [f"**Verdict:** {head}"]
     with_fasm = [n for n in leaders if math.isfinite(_median_min_fasm(aggs[n]))]
     medians = [_median_min_fasm(aggs[n]) for n in with_fasm]
-    if len(with_fasm) > 1 and medians[0] != medians[-1]:
+    if len(with_fasm) > 1 and not _tied(medians[0], medians[-1]):
         most, least = with_fasm[0], with_fasm[-1]
         parts.append(
             f"Among them the stability cost differs: median minimum FASM "
@@ -282,6 +289,26 @@ def _success_lead(result: EnvResult, leader: str, runner_up: str) -> str:
     return (
         f"The lead in successes over `{runner_up}` is {word} (paired difference [{low}, {high}])."
     )
+
+
+def _rule_cells(rules: dict) -> list[str]:
+    """The tip-over, success-tilt and success-tipping cells of an env's rules ("-": none)."""
+    if not rules:
+        return ["-", "-", "-"]
+    tip = f"tilt > {rules['tip_over_angle_deg']:g}°"
+    if rules["tip_over_margin_time"] is not None:
+        tip += f", or FASM <= 0 for {rules['tip_over_margin_time']:g} s"
+    tilt, share = rules["success_max_tilt_deg"], rules["success_max_tipping_share"]
+    return [
+        tip,
+        "-" if tilt is None else f"<= {tilt:g}°",
+        "-" if share is None else f"<= {share * 100:g} % of the episode",
+    ]
+
+
+def _tied(a: float, b: float) -> bool:
+    """Within `TIE_TOLERANCE` of the larger magnitude: the verdicts' rule for a tie."""
+    return abs(a - b) <= TIE_TOLERANCE * max(abs(a), abs(b))
 
 
 def _median_min_fasm(a: dict) -> float:
@@ -383,7 +410,8 @@ HOW_TO_READ = [
     "switch or in the air) or the force points at a tipping edge; **negative** values mean the "
     "net force points outside the polygon: the robot is rotating about an edge. A short negative "
     "spike while a foot lands is not a tip-over; a tip-over is the body tilting past the env's "
-    "tip-over angle, counted in the tip-over column.",
+    "tip-over angle or, where the env sets a time, the FASM at or below 0 for that long (the "
+    "table below), counted in the tip-over column.",
     "- **ξ** is the robot's FASM threshold (below it the robot is judged to be tipping); it "
     "differs per robot and is listed per env below. Where the paper judges a robot by another "
     "criterion (the 3-UPU robot: the static margin > 0), its FASM is shown for comparison and "
@@ -393,8 +421,9 @@ HOW_TO_READ = [
     "Stewart tilt: standing to the time limit; the irregular terrain: no torso contact and at "
     "least half the distance the gait's nominal speed covers; the ditch crossing: every foot "
     "past the far edge and loaded. The `-v1` envs also require the episode's largest tilt "
-    "(`max_tilt_deg`) and share of time tipping (`tipping_share`) within the env's bounds, and "
-    "on the Stewart tilt the lifted tripod kept up until the robot first tips (docs/benchmark.md).",
+    "(`max_tilt_deg`) and, where the env bounds it, its share of time tipping (`tipping_share`) "
+    "within the bounds in the table below, and on the Stewart tilt the lifted tripod kept up "
+    "until the robot first tips (docs/benchmark.md).",
     "- **Benchmark scores** put each policy's success rate on a scale from 0 (random actions) to "
     "100 (the analytical controller) per env, on the same tasks, and aggregate them across envs "
     "with the interquartile mean and its 95 % stratified-bootstrap interval (rliable).",
@@ -454,18 +483,24 @@ def benchmark_section(result: SuiteResult) -> tuple[Table | None, str]:
     text = (
         "Normalised success score per env: 0 = random actions, 100 = the analytical "
         "controller, on the same tasks; the last column is the interquartile mean across envs "
-        "with its 95 % stratified-bootstrap interval (episodes resampled within each env)."
+        "with its 95 % stratified-bootstrap interval (episodes resampled within each env). "
+        "The scale is fixed by these episodes, so even the references' intervals are wide: "
+        "a resample of the analytical controller's episodes succeeds more or less often than "
+        "the episodes that set 100."
     )
     if partial:
         text += (
             " A policy without a score on every env (-), or with unequal episode counts, gets "
             "no IQM."
         )
-    if left_out:
-        text += (
-            f" Left out (the analytical controller does not beat random actions there): "
-            f"{', '.join(f'`{e}`' for e in left_out)}."
-        )
+    unbeaten = [e for e in left_out if {"analytical", "random"} <= set(successes[e])]
+    unreferenced = [e for e in left_out if e not in unbeaten]
+    for envs_out, why in (
+        (unbeaten, "the analytical controller does not beat random actions there"),
+        (unreferenced, "`analytical` or `random` did not run there"),
+    ):
+        if envs_out:
+            text += f" Left out ({why}): {', '.join(f'`{e}`' for e in envs_out)}."
     return table, text + note
 
 
@@ -514,6 +549,7 @@ def build_metrics(result: SuiteResult) -> dict[str, Any]:
         envs[r.env_id] = {
             "kwargs": r.kwargs,
             "xi_deg": r.xi_deg,
+            "rules": r.rules,
             "stability_criterion": r.criterion,
             "max_episode_steps": r.max_episode_steps,
             "dt_s": r.dt,
@@ -681,10 +717,19 @@ def _write_overview(doc: _Document, result: SuiteResult) -> None:
     )
     doc.heading("How to read this report", 2)
     doc.bullets(HOW_TO_READ)
-    thresholds = Table(["env", "stability criterion", "ξ [deg]"])
+    thresholds = Table(
+        [
+            "env",
+            "stability criterion",
+            "ξ [deg]",
+            "tip-over",
+            "success: largest tilt",
+            "success: time tipping",
+        ]
+    )
     for r in result.envs:
         xi = "none (FASM for comparison)" if r.xi_deg is None else f"{r.xi_deg:g}"
-        thresholds.rows.append([r.env_id, r.criterion, xi])
+        thresholds.rows.append([r.env_id, r.criterion, xi, *_rule_cells(r.rules)])
     doc.table(thresholds)
     if result.warnings:
         doc.heading("Warnings", 2)
@@ -737,11 +782,21 @@ def _env_setup_text(r: EnvResult) -> str:
         for n, run in r.runs.items()
     )
     xi = "no ξ" if r.xi_deg is None else f"ξ = {r.xi_deg:g}°"
+    tasks = [e.task for run in r.runs.values() for e in run.episodes]
+    same_task = len(tasks) > len(r.runs) and bool(tasks[0]) and all(t == tasks[0] for t in tasks)
     return (
         f"Env kwargs: `{r.kwargs or {}}`; time limit {r.max_episode_steps} steps"
         + (f" × {r.dt:g} s" if r.dt else "")
         + f"; stability criterion: {r.criterion} ({xi})"
         + (f". Sources: {sources}." if sources else ". No policy ran on this env.")
+        + (
+            " Every episode ran the same task (the env's `task_distribution`: the paper's "
+            "scenario), so the seeds differ only in the reset noise and the paired intervals "
+            "show that noise, not a spread of tasks; `kwargs: {task_distribution: test}` "
+            "samples held-out tasks."
+            if same_task
+            else ""
+        )
     )
 
 

@@ -267,7 +267,9 @@ def run_sweep(
         _check_reachable(address)
     stem = sweep.config.name or (sweep.path.stem if sweep.path else "sweep")
     name = name or f"{stem}__{time.strftime('%Y%m%d-%H%M%S')}"
-    sweep_dir = prepare_new_dir(Path(output_dir) / name, force, "sweep directory").resolve()
+    sweep_dir = prepare_new_dir(
+        Path(output_dir) / name, force, "sweep directory", (SWEEP_FILE,)
+    ).resolve()
     command = command or command_line()
     resolved = to_mapping(sweep.config)
     resolved["base"] = BASE_FILE  # self-contained: the sweep directory holds its base config

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import csv
 import json
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -17,6 +18,8 @@ import numpy as np
 
 from ..run_files.artifacts import CONFIG_FILE, latest_model_dir, read_meta
 from ..run_files.configtools import load_yaml
+from ..run_files.errors import UserError
+from .learning_curve import EVALUATIONS_FILE, load_learning_curve
 from .sweep_config import SWEEP_FILE, LoadedSweep
 
 TRIAL_FILE = "trial.json"
@@ -29,24 +32,26 @@ def trial_name(trial_id: str) -> str:
 
 
 def eval_rows(run_dir: Path) -> list[dict[str, float]]:
-    """EvalCallback's log as rows {timesteps, eval_mean_reward, eval_success_rate}."""
-    path = Path(run_dir) / "evaluations.npz"
-    if not path.is_file():
+    """EvalCallback's log as rows {timesteps, eval_mean_reward, eval_success_rate} (NaN where
+    the log has no successes); none for a run without a log, or with a damaged one (said on
+    stderr)."""
+    if not (Path(run_dir) / EVALUATIONS_FILE).is_file():
         return []
-    with np.load(path) as data:
-        steps, results = data["timesteps"], data["results"]
-        successes = data.get("successes")
-        rows = []
-        for i, step in enumerate(steps):
-            rate = float(np.mean(successes[i])) if successes is not None else float("nan")
-            rows.append(
-                {
-                    "timesteps": int(step),
-                    "eval_mean_reward": float(np.mean(results[i])),
-                    "eval_success_rate": rate,
-                }
-            )
-    return rows
+    try:
+        curve = load_learning_curve(run_dir)
+    except UserError as exc:
+        print(f"warning: {exc}; the run's evaluations are left out", file=sys.stderr)
+        return []
+    return [
+        {
+            "timesteps": row["timesteps"],
+            "eval_mean_reward": row["mean_return"],
+            "eval_success_rate": (
+                float("nan") if row["success_rate"] is None else row["success_rate"]
+            ),
+        }
+        for row in curve.rows()
+    ]
 
 
 def is_sweep_dir(path: str | Path) -> bool:

@@ -55,6 +55,7 @@ from ..run_files.model_files import (
 from ..run_files.train_config import TrainConfig, load_train_config
 from .envs import EnvSpec, env_time_step, make_vec_env
 from .episode import XI_F_DEG, EpisodeAccumulator, metric_specs
+from .learning_curve import EVALUATIONS_FILE
 
 EVAL_SEED_OFFSET = 10_000
 """Evaluation envs are seeded apart from the training envs."""
@@ -250,7 +251,7 @@ def start_training(
     spec = env_spec(config)
     new_accumulator, settings = _probe(spec)
     name = name or run_name(config.env.id, config.train.seed)
-    run_dir = prepare_new_dir(Path(output_dir) / name, force, "run directory")
+    run_dir = prepare_new_dir(Path(output_dir) / name, force, "run directory", (CONFIG_FILE,))
     try:
         command = command or command_line()
         atomic_write_text(run_dir / CONFIG_FILE, dump_yaml(config))
@@ -277,7 +278,8 @@ def resume_training(
 
     Overrides may change the budget, PPO hyperparameters, evaluation/checkpoint frequencies,
     the number of envs and how they run (``env.vectorization``), but not the env, the policy
-    network or the normalisation. A damaged
+    network or the normalisation, nor the evaluation episodes of a run with an evaluation log
+    (``eval.n_episodes``, ``eval.same_tasks``: its learning curve). A damaged
     newest checkpoint is reported and the next newest is used; no file of the run is written
     before a checkpoint has loaded.
     """
@@ -292,7 +294,9 @@ def resume_training(
                 f"cannot change {section!r} when resuming ({text!r}); the sections "
                 f"{list(RESUME_FIXED_SECTIONS)} are fixed by the saved model"
             )
+    saved = load_train_config(data=load_yaml(run_dir / CONFIG_FILE))
     config = load_train_config(data=load_yaml(run_dir / CONFIG_FILE), overrides=overrides)
+    _check_eval_tasks_kept(run_dir, saved, config)
     candidates = saved_model_dirs(run_dir)
     if not candidates:
         raise UserError(f"{run_dir} holds no checkpoint to resume from")
@@ -327,6 +331,23 @@ def resume_training(
     return _learn(
         model, config, run_dir, command, eval_env, new_accumulator, True, after_eval, settings
     )
+
+
+def _check_eval_tasks_kept(run_dir: Path, before: Any, after: Any) -> None:
+    """UserError if the overrides change the evaluation episodes of a run with an evaluation
+    log: its rows hold ``eval.n_episodes`` episodes each (on the same tasks at every
+    evaluation with ``eval.same_tasks``), the learning curve compares them, and rows of two
+    widths cannot share the log."""
+    if not (run_dir / EVALUATIONS_FILE).is_file():
+        return
+    for key in ("n_episodes", "same_tasks"):
+        old, new = getattr(before.eval, key), getattr(after.eval, key)
+        if old != new:
+            raise UserError(
+                f"cannot change eval.{key} when resuming ({old} -> {new}): the run's "
+                f"{EVALUATIONS_FILE} holds its learning curve on the earlier evaluation "
+                "episodes; start a new run to evaluate otherwise"
+            )
 
 
 def _warn_if_settings_changed(run_dir: Path, settings: dict[str, Any] | None) -> None:
@@ -644,7 +665,7 @@ def _restore_eval_history(eval_cb: Any, run_dir: Path, done: int) -> None:
     best = read_meta(run_dir / BEST)
     if "eval_mean_reward" in best:
         eval_cb.best_mean_reward = float(best["eval_mean_reward"])
-    log = run_dir / "evaluations.npz"
+    log = run_dir / EVALUATIONS_FILE
     if not log.is_file():
         return
     try:

@@ -67,18 +67,50 @@ def run_name(env_id: str, seed: int, now: float | None = None) -> str:
     return f"{env_id}__ppo__{seed}__{stamp}"
 
 
-def prepare_new_dir(path: Path, force: bool, what: str) -> Path:
-    """Create `path`; an existing non-empty directory is an error unless `force` (then emptied)."""
+def prepare_new_dir(
+    path: Path, force: bool, what: str, markers: tuple[str, ...] = (), check_only: bool = False
+) -> Path:
+    """Create `path`; an existing non-empty directory is an error unless `force` (then emptied).
+    `check_only`: raise where that would be refused, and change nothing.
+
+    `markers`: file names of which this tool's own output holds at least one (a run's
+    ``config.yaml``, a report's ``metrics.json``). With markers given, `force` empties only a
+    directory that holds one of them, and never the working directory, the home directory or
+    a directory above either: a mistyped ``--output-dir`` must not delete someone's files.
+    """
     path = Path(path)
     if path.exists() and (not path.is_dir() or any(path.iterdir())):
         if not force:
             raise UserError(f"{what} {path} already exists; pass --force to overwrite it")
+        if path.is_dir() and markers:
+            _check_replaceable(path, what, markers)
+        if check_only:
+            return path
         if path.is_dir():
             shutil.rmtree(path)
         else:
             path.unlink()
-    path.mkdir(parents=True, exist_ok=True)
+    if not check_only:
+        path.mkdir(parents=True, exist_ok=True)
     return path
+
+
+def _check_replaceable(path: Path, what: str, markers: tuple[str, ...]) -> None:
+    """UserError unless `path` looks like an earlier `what` (holds a marker file) and is
+    neither the working nor the home directory nor above one of them."""
+    resolved = path.resolve()
+    for protected in (Path.cwd().resolve(), Path.home().resolve()):
+        if resolved == protected or resolved in protected.parents:
+            raise UserError(
+                f"--force would delete {path}, which is or contains {protected}; "
+                f"choose a new directory for the {what}"
+            )
+    if not any((path / name).exists() for name in markers):
+        raise UserError(
+            f"{path} exists and is not an earlier {what} (it has none of {list(markers)}); "
+            "--force only replaces the tool's own output: choose another directory or empty "
+            "it yourself"
+        )
 
 
 def save_model_dir(

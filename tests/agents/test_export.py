@@ -175,3 +175,22 @@ def test_the_cards_best_evaluation_follows_the_runs_select_rule(tmp_path):
         ep_lengths=np.ones((4, 2)),
     )
     assert training_evaluations(tmp_path, "success")["best"]["timesteps"] == 200
+
+
+def test_a_model_inside_a_run_reads_the_runs_evaluation_log(tmp_path):
+    """Training writes evaluations.npz to the run directory, not into best/ or a checkpoint: the
+    card of such a model reads the run's log; a directory that is no run gives none."""
+    run = tmp_path / "run"
+    for sub in ("best", "final", "checkpoints/step_000000000100"):
+        (run / sub).mkdir(parents=True)
+    np.savez(
+        run / "evaluations.npz",
+        timesteps=np.array([0, 100]),
+        results=np.array([[1.0], [2.0]]),
+        ep_lengths=np.ones((2, 1)),
+    )
+    for sub in ("best", "final", "checkpoints/step_000000000100"):
+        assert training_evaluations(run / sub)["evaluations"] == 2
+    (tmp_path / "loose" / "model").mkdir(parents=True)
+    np.savez(tmp_path / "loose" / "evaluations.npz", timesteps=np.array([0]))
+    assert training_evaluations(tmp_path / "loose" / "model") is None

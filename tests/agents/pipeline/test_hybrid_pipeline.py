@@ -133,10 +133,40 @@ def test_missing_learning_curve_is_a_clear_error(tmp_path):
         load_learning_curve(tmp_path)
 
 
+def test_a_damaged_learning_curve_is_a_clear_error_and_short_successes_are_left_out(tmp_path):
+    """SB3 logs successes only where the episodes report them: a successes array without a
+    row per evaluation is left out; rows of different lengths or a missing array are a
+    damaged log, said as such (the report and the sweep summary then leave the run out)."""
+    log = tmp_path / "evaluations.npz"
+    np.savez(
+        log,
+        timesteps=[0, 1, 2],
+        results=np.ones((3, 2)),
+        ep_lengths=np.ones((3, 2)),
+        successes=np.ones((2, 2)),
+    )
+    curve = load_learning_curve(tmp_path)
+    assert curve.successes is None and [r["success_rate"] for r in curve.rows()] == [None] * 3
+    np.savez(log, timesteps=[0, 1, 2], results=np.ones((2, 2)), ep_lengths=np.ones((2, 2)))
+    with pytest.raises(ValueError, match="is damaged: 3 evaluations, but returns of shape"):
+        load_learning_curve(tmp_path)
+    np.savez(log, timesteps=[0])
+    with pytest.raises(ValueError, match="evaluations.npz is damaged"):
+        load_learning_curve(tmp_path)
+
+
 def test_resume_keeps_the_hybrid_and_refuses_to_change_it(tmp_path, capsys):
     run = train(tmp_path, "resumed", "checkpoint.freq=128")
     assert train_main(["--resume", str(run), "--set", "hybrid.scale=0.2"]) == 2
     assert "cannot change 'hybrid' when resuming" in capsys.readouterr().err
+    # The evaluation log's rows hold eval.n_episodes episodes each: kept, log untouched.
+    log = (run / "evaluations.npz").read_bytes()
+    same_tasks = yaml.safe_load((run / "config.yaml").read_text())["eval"]["same_tasks"]
+    for override in ("eval.n_episodes=3", f"eval.same_tasks={str(not same_tasks).lower()}"):
+        argv = ["--resume", str(run), "--set", override, "--set", "train.total_timesteps=384"]
+        assert train_main(argv) == 2
+        assert "when resuming" in capsys.readouterr().err
+    assert (run / "evaluations.npz").read_bytes() == log
     assert train_main(["--resume", str(run), "--set", "train.total_timesteps=384"]) == 0
     config = yaml.safe_load((run / "final" / "config.yaml").read_text())
     assert config["hybrid"]["scale"] == 0.05

@@ -204,6 +204,24 @@ def test_identical_seeds_give_identical_episodes_across_policies(tmp_path):
         assert a["distance_m"] == pytest.approx(z["distance_m"], abs=1e-4)
 
 
+def test_a_sampling_ppo_policy_repeats_an_episode_whatever_ran_before(run):
+    """With deterministic=False an episode's actions come from its own seed (`seed_episode`,
+    which the evaluation calls before each episode), not from the episodes run before it."""
+    from agents.pipeline.episode import EpisodeAccumulator
+    from agents.pipeline.evaluation import run_episode
+
+    env = gym.make("HexapodCliffWalk-v0", max_episode_steps=30)
+    policy = PPOPolicy.load(run[0] / "final", env, deterministic=False)
+
+    def episode_return(seed: int) -> float:
+        return run_episode(env, policy, seed, EpisodeAccumulator(None)).episode_return
+
+    first = episode_return(1)
+    episode_return(0)
+    assert episode_return(1) == first
+    assert episode_return(2) != first
+
+
 def test_run_records_every_setting_of_its_training_env(run):
     """Defaults included: a later change of a default must be visible against the record."""
     run_dir, _ = run
@@ -320,6 +338,9 @@ def test_the_default_report_is_replaced_on_a_second_run_other_reports_need_force
     for _ in range(2):
         assert evaluate_main(argv) == 0
     assert (tmp_path / "reports" / "default" / "metrics.json").is_file()
+    # a -v0 id is no part of the default suite (the v1 benchmark): the title says no more
+    title = (tmp_path / "reports" / "default" / "report.md").read_text().splitlines()[0]
+    assert title.startswith("# Hexapod policy evaluation") and "v1" not in title
     assert evaluate_main([*argv, "--output-dir", "reports/default"]) == 0  # the same directory
     assert evaluate_main([*argv, "--output-dir", "mine"]) == 0
     capsys.readouterr()
@@ -331,6 +352,44 @@ def test_the_default_report_is_replaced_on_a_second_run_other_reports_need_force
     (tmp_path / "reports" / "default" / "notes.txt").write_text("not a report")
     assert evaluate_main(argv) == 2
     assert (tmp_path / "reports" / "default" / "notes.txt").is_file()
+
+
+def test_an_interrupted_evaluation_keeps_the_earlier_report(tmp_path, monkeypatch):
+    """The report is written beside the output directory and swapped in when it is complete:
+    a run stopped half-way (Ctrl-C) leaves the earlier report as it was, and no partial one."""
+    from agents.pipeline import evaluation
+
+    argv = ["--envs", "HexapodCliffWalk-v0", "--policies", "zero", "--episodes", "1"]
+    argv += ["--max-episode-steps", "5", "--no-progress", "--output-dir", str(tmp_path / "rep")]
+    assert evaluate_main(argv) == 0
+    before = (tmp_path / "rep" / "metrics.json").read_bytes()
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(evaluation, "run_episode", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        evaluate_main([*argv, "--force"])
+    assert (tmp_path / "rep" / "metrics.json").read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["rep"]
+
+
+def test_force_replaces_only_an_earlier_report_never_other_files(tmp_path, monkeypatch, capsys):
+    """--force empties a directory only if it holds an earlier report, and never the working
+    directory or one above it: a mistyped --output-dir must not delete a user's files."""
+    monkeypatch.chdir(tmp_path)
+    argv = ["--envs", "HexapodCliffWalk-v0", "--policies", "zero", "--episodes", "1"]
+    argv += ["--max-episode-steps", "5", "--no-progress", "--force"]
+    precious = tmp_path / "precious"
+    (precious / "sub").mkdir(parents=True)
+    (precious / "sub" / "data.csv").write_text("1,2")
+    assert evaluate_main([*argv, "--output-dir", "precious"]) == 2
+    assert "is not an earlier report directory" in capsys.readouterr().err
+    assert (precious / "sub" / "data.csv").is_file()
+    for parent in (".", ".."):
+        assert evaluate_main([*argv, "--output-dir", parent]) == 2
+        assert "choose a new directory for the report directory" in capsys.readouterr().err
+    assert (precious / "sub" / "data.csv").is_file()
 
 
 def test_missing_shipped_model_is_skipped_with_a_warning_in_the_report(tmp_path):

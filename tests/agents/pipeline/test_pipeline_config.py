@@ -192,6 +192,17 @@ def test_suite_policy_names_are_checked():
         from_mapping(EvaluationSuite, {"envs": ["HexapodCliffWalk-v0"], "policies": ["ppo"]})
 
 
+def test_a_suite_lists_each_env_id_once():
+    """The report keys results, figures and scores by env id: a second entry of the same id
+    (say with another task distribution) would replace the first's results."""
+    envs = [
+        {"id": "HexapodCliffWalk-v1", "kwargs": {"task_distribution": "train"}},
+        {"id": "HexapodCliffWalk-v1", "kwargs": {"task_distribution": "test"}},
+    ]
+    with pytest.raises(ConfigError, match=r"\['HexapodCliffWalk-v1'\] listed more than once"):
+        from_mapping(EvaluationSuite, {"envs": envs})
+
+
 @pytest.mark.parametrize(
     ("key", "value", "match"),
     [

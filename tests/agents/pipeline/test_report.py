@@ -46,6 +46,11 @@ def test_report_has_no_placeholder_a_verdict_per_env_and_the_reading_guide(repor
     metrics = json.loads((report / "metrics.json").read_text())
     assert metrics["envs"]["HexapodStewartTilt-v1"]["xi_deg"] == 20.0
     assert metrics["envs"]["HexapodDitchCrossing-v0"]["xi_deg"] == 0.0
+    # each env's episode-end and success bounds, as its settings set them
+    rules = metrics["envs"]["HexapodStewartTilt-v1"]["rules"]
+    assert rules["success_max_tilt_deg"] == 2.5 and rules["success_max_tipping_share"] is None
+    assert "| HexapodStewartTilt-v1 | FASM >= ξ_f = 20 deg" in md
+    assert "| 20 | tilt > 10° | <= 2.5° | - |" in md
 
 
 def _record(length, time_below, distance, tipped, dt=0.02, fasm_min=None):
@@ -96,6 +101,10 @@ def test_the_verdict_compares_the_leaders_stability_only_where_it_differs():
     paragraph = verdict_paragraph(result, aggs)
     assert "Their median minimum FASM is the same, 30°." in paragraph
     assert "differs" not in paragraph
+    nearly = [_record(100, 0.5, 1.0, False, fasm_min=30.0 - 1e-6)] * 3  # prints the same
+    result.runs["ppo:x"] = PolicyRun("ppo:x", "x", nearly)
+    aggs = {n: aggregate(r.episodes) for n, r in result.runs.items()}
+    assert "differs" not in verdict_paragraph(result, aggs)
     lower = [_record(100, 0.5, 1.0, False, fasm_min=20.0)] * 3
     result.runs["ppo:x"] = PolicyRun("ppo:x", "x", lower)
     aggs = {n: aggregate(r.episodes) for n, r in result.runs.items()}
@@ -329,6 +338,42 @@ def test_a_policy_run_on_some_envs_gets_its_scores_there_and_no_iqm():
     assert "without a score on every env (-)" in text
 
 
+def test_envs_left_out_of_the_scores_are_said_why():
+    """An env where random actions match the controller and one where no reference ran are left
+    out for different reasons."""
+    ok, tipped = _record(100, 0.0, 1.0, False), _record(100, 0.0, 1.0, True)
+    runs = {
+        "A-v1": {"analytical": [ok, tipped], "random": [tipped, tipped]},
+        "B-v1": {"analytical": [tipped, tipped], "random": [tipped, tipped]},
+        "C-v1": {"zero": [ok, ok]},
+    }
+    envs = []
+    for env_id, by_policy in runs.items():
+        result = EnvResult(env_id, {}, 100, 0.02, [])
+        result.runs = {n: PolicyRun(n, n, episodes) for n, episodes in by_policy.items()}
+        envs.append(result)
+    _, text = benchmark_section(SuiteResult(None, envs, [], 0.0))
+    assert "(the analytical controller does not beat random actions there): `B-v1`." in text
+    assert "(`analytical` or `random` did not run there): `C-v1`." in text
+
+
+def test_an_env_whose_episodes_all_ran_one_task_says_so():
+    """A -v0 id evaluated on its default (the paper's scenario): the seeds change only the reset
+    noise, which the setup text says; sampled tasks get no such sentence."""
+    from dataclasses import replace
+
+    from agents.pipeline.report import _env_setup_text
+
+    paper = {"cliff_x": 2.8, "difficulty": 0.47}
+    result = EnvResult("HexapodCliffWalk-v0", {}, 100, 0.02, [])
+    same = [replace(_record(100, 0.0, 1.0, False), task=dict(paper)) for _ in range(3)]
+    result.runs = {"zero": PolicyRun("zero", "z", same)}
+    assert "Every episode ran the same task" in _env_setup_text(result)
+    other = replace(same[0], task={**paper, "cliff_x": 3.1})
+    result.runs = {"zero": PolicyRun("zero", "z", [*same[:2], other])}
+    assert "Every episode ran the same task" not in _env_setup_text(result)
+
+
 def test_ppo_policies_get_short_unambiguous_aliases():
     from agents.pipeline.evaluation import policy_aliases
 
@@ -342,3 +387,9 @@ def test_ppo_policies_get_short_unambiguous_aliases():
     assert "ppo:runs/gains/final" not in aliases and "ppo:other/gains" not in aliases
     assert "analytical" not in aliases
     assert policy_aliases(["ppo:models/x/analytical", "analytical"]) == {}
+    # a template component is no name of its own; what is left of one is expanded per env
+    from agents.pipeline.evaluation import EnvResult
+
+    names = ["ppo:mine/{env_id}", "ppo:runs/{env_id}_seed0/best"]
+    result = EnvResult("HexapodCliffWalk-v1", {}, None, None, [], aliases=policy_aliases(names))
+    assert [result.label(n) for n in names] == ["mine", "HexapodCliffWalk-v1_seed0"]
