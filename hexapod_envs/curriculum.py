@@ -17,6 +17,8 @@ on tall block beds, so that its episodes carry a signal.
 
 from __future__ import annotations
 
+import warnings
+
 import gymnasium as gym
 
 from .checks import check_number
@@ -62,7 +64,9 @@ class DifficultyCurriculum(gym.Wrapper):
         self._results: list[bool] = []
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        obs, info = _draw(self.env, seed, options, self.max_draws, lambda d: d <= self.level)
+        obs, info = _draw(
+            self, seed, options, self.max_draws, lambda d: d <= self.level, f"<= {self.level:g}"
+        )
         return obs, {**info, "curriculum_level": self.level}
 
     def step(self, action):
@@ -97,7 +101,9 @@ class MinimumDifficulty(gym.Wrapper):
         self.max_draws = int(max_draws)
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
-        return _draw(self.env, seed, options, self.max_draws, lambda d: d >= self.minimum)
+        return _draw(
+            self, seed, options, self.max_draws, lambda d: d >= self.minimum, f">= {self.minimum:g}"
+        )
 
 
 def _require_sampled(env: gym.Env, wrapper: str) -> None:
@@ -108,12 +114,24 @@ def _require_sampled(env: gym.Env, wrapper: str) -> None:
         )
 
 
-def _draw(env: gym.Env, seed, options, max_draws: int, accept) -> tuple:
+def _draw(wrapper: gym.Wrapper, seed, options, max_draws: int, accept, wanted: str) -> tuple:
     """Reset `env` (with `seed`, then from its ``np_random``) until ``accept(difficulty)`` or
-    `max_draws` resets; the last reset's result with ``info["task_draws"]``."""
+    `max_draws` resets; the last reset's result with ``info["task_draws"]``, and
+    ``info["task_accepted"]`` False (with a warning, once per wrapper) when no draw passed."""
+    env = wrapper.env
     obs, info = env.reset(seed=seed, options=options)
     draws = 1
     while draws < max_draws and not accept(info["task"]["difficulty"]):
         obs, info = env.reset(options=options)  # the next task from np_random
         draws += 1
-    return obs, {**info, "task_draws": draws}
+    accepted = bool(accept(info["task"]["difficulty"]))
+    if not accepted and not getattr(wrapper, "_warned", False):
+        wrapper._warned = True
+        warnings.warn(
+            f"{type(wrapper).__name__}: none of {draws} tasks drawn had a difficulty {wanted}; "
+            f"the reset keeps the last (difficulty {info['task']['difficulty']:.2f}, "
+            'info["task_accepted"] False). Raise max_draws, or the cap, if the ranges hold '
+            "few such tasks (said once)",
+            stacklevel=3,
+        )
+    return obs, {**info, "task_draws": draws, "task_accepted": accepted}

@@ -31,8 +31,28 @@ def _action_modes(env: gym.Env) -> tuple[str, ...]:
     return (env.unwrapped.action_mode,)
 
 
+def _layouts(env_id: str) -> dict[str, tuple]:
+    """Action mode -> (observation structure, action shape, low, high) of `env_id`."""
+    probe = gym.make(env_id)
+    modes = _action_modes(probe)
+    probe.close()
+    found = {}
+    for mode in modes:
+        env = gym.make(env_id, action_mode=mode)
+        space = env.action_space
+        found[mode] = (
+            dict(env.unwrapped.observation_structure),
+            space.shape,
+            float(space.low.min()),
+            float(space.high.max()),
+        )
+        env.close()
+    return found
+
+
 def render() -> str:
-    """The whole page (default kwargs of each env, every action mode)."""
+    """The whole page (default kwargs of each env, every action mode; a ``-v1`` id with the
+    same layouts as its ``-v0`` id is named in the ``-v0`` section, else gets its own)."""
     import hexapod_envs  # noqa: F401  (registers the ids)
 
     lines = [
@@ -46,27 +66,28 @@ def render() -> str:
         "",
     ]
     for env_id in ENV_IDS:
-        probe = gym.make(env_id)
-        modes = _action_modes(probe)
-        probe.close()
-        lines += [f"## {env_id}", ""]
-        for mode in modes:
-            env = gym.make(env_id, action_mode=mode)
-            structure = env.unwrapped.observation_structure
-            size = env.observation_space.shape[0]
-            low, high = env.action_space.low.min(), env.action_space.high.max()
-            lines += [
-                f'### action_mode="{mode}": observation size {size}, '
-                f"action shape {env.action_space.shape} in [{low:g}, {high:g}]",
-                "",
-                "| piece | indices | size |",
-                "|---|---|---|",
-            ]
-            for name, piece in structure.items():
-                n = piece.stop - piece.start
-                lines.append(f"| `{name}` | {piece.start}–{piece.stop - 1} | {n} |")
-            lines.append("")
-            env.close()
+        layouts = _layouts(env_id)
+        v1 = env_id.removesuffix("-v0") + "-v1"
+        v1_layouts = _layouts(v1) if v1 in gym.registry else None
+        if v1_layouts == layouts:
+            sections = [(f"{env_id} and {v1}", layouts)]
+        else:
+            sections = [(env_id, layouts)] + ([(v1, v1_layouts)] if v1_layouts else [])
+        for title, found in sections:
+            lines += [f"## {title}", ""]
+            for mode, (structure, shape, low, high) in found.items():
+                size = max(piece.stop for piece in structure.values())
+                lines += [
+                    f'### action_mode="{mode}": observation size {size}, '
+                    f"action shape {shape} in [{low:g}, {high:g}]",
+                    "",
+                    "| piece | indices | size |",
+                    "|---|---|---|",
+                ]
+                for name, piece in structure.items():
+                    n = piece.stop - piece.start
+                    lines.append(f"| `{name}` | {piece.start}–{piece.stop - 1} | {n} |")
+                lines.append("")
     return "\n".join(lines)
 
 

@@ -545,7 +545,16 @@ class HexapodEnv(SafetyFigures, gym.Env):
             self._renderer = make_renderer(
                 self.model, self.data, self._camera_name, self._render_size
             )
-        return self._renderer.render(self.render_mode)
+        try:
+            return self._renderer.render(self.render_mode)
+        except mujoco.FatalError as error:
+            if "OpenGL" not in str(error):
+                raise
+            raise RuntimeError(
+                f"rendering needs an OpenGL context, and MuJoCo found none ({error}). Without "
+                "a display, set MUJOCO_GL=egl (or osmesa) in the environment before Python "
+                "starts: MUJOCO_GL=egl python your_script.py"
+            ) from error
 
     def close(self):
         if self._renderer is not None:

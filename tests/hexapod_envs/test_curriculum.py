@@ -32,6 +32,23 @@ def test_resets_draw_tasks_under_the_level_reproducibly():
     assert max(spread) > 0.4  # without it the same env draws harder tasks
 
 
+def test_a_reset_that_finds_no_task_under_the_level_says_so_once():
+    """The ranges may hold few tasks that easy: after max_draws the last task is kept, flagged
+    in info and warned about once."""
+    env = _env(level=0.0, max_draws=2)
+    with pytest.warns(UserWarning, match=r"none of 2 tasks drawn had a difficulty <= 0;"):
+        _, info = env.reset(seed=0)
+    assert info["task_draws"] == 2 and info["task_accepted"] is False
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        _, info = env.reset()
+    assert info["task_accepted"] is False
+    _, info = _env(level=1.0).reset(seed=0)
+    assert info["task_draws"] == 1 and info["task_accepted"] is True
+
+
 def test_the_level_rises_after_a_successful_window_and_falls_after_a_failing_one():
     env = _env(level=0.3, step=0.1, window=2, promote_at=1.0, demote_at=0.5)
     for success in (True, True):

@@ -126,6 +126,28 @@ def test_rgb_render_headless(env_id):
     assert frame.shape == (64, 96, 3) and frame.std() > 0
 
 
+def test_rendering_without_an_opengl_context_says_to_set_mujoco_gl():
+    """Without MUJOCO_GL and a display MuJoCo finds no OpenGL context: render() says what to
+    set instead of MuJoCo's bare FatalError."""
+    import os
+    import subprocess
+    import sys
+
+    env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "DISPLAY")}
+    code = (
+        "import gymnasium as gym, hexapod_envs\n"
+        "env = gym.make('HexapodCliffWalk-v1', render_mode='rgb_array', width=32, height=24)\n"
+        "env.reset(seed=0)\n"
+        "env.render()\n"
+        "print('rendered')\n"
+    )
+    run = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    if "rendered" in run.stdout:
+        pytest.skip("this machine renders without MUJOCO_GL and a display")
+    assert "RuntimeError: rendering needs an OpenGL context" in run.stderr, run.stderr[-2000:]
+    assert "MUJOCO_GL=egl" in run.stderr
+
+
 @pytest.mark.parametrize("env_id", ENV_IDS)
 def test_docstring_tables_name_every_observation_piece_and_reward_term(env_id):
     """The user-facing docstring (module + class) must describe what the env really returns."""
