@@ -37,7 +37,7 @@ CLIFF_TRAIN_V1 = CliffTaskRanges(
     payload_mass=(0.0, 800.0),
     payload_offset=0.25,
 )
-"""Training cliffs, easy to hard: the edge 0.15-2.35 m ahead of the front feet, cutting
+"""Training cliffs, easy to hard: the edge 0.33-2.53 m ahead of the front feet, cutting
 0.6-1.2 m into the outer feet's path, 1-5 m deep; friction 0.6-1.2; payload up to 800 kg."""
 CLIFF_TEST_V1 = CliffTaskRanges(
     cliff_x=(2.8, 5.0),
@@ -67,7 +67,8 @@ BLOCKS_TEST_V1 = TerrainTaskRanges(
     servo_kp_scale=((0.7, 0.85), (1.15, 1.3)),
 )
 """Test block beds: the taller half of training's blocks, smaller, more slippery, servos far
-from nominal: harder than training on average."""
+from nominal (the soft ones rated harder, the stiff ones as nominal): harder than training on
+average."""
 
 DITCH_TEST_V1 = DitchTaskRanges(
     start_x=(0.9, 1.1), width=(0.40, 0.55), depth=(0.12, 0.15), friction=(0.5, 0.8)

@@ -6,8 +6,9 @@ step sees 39 actions without consequence for each one that counts, and a per-ste
 effect shows up over the whole cycle. The wrapper makes one wrapped step of each gait cycle: the
 action is held until the env reads the next one, and the rewards of the cycle's steps are
 summed. It is the semi-MDP of "one decision per gait cycle" (the paper's gains are per cycle too).
-The env reads the gains at the first control step of a cycle; a wait for the stance feet to touch
-the ground at the cycle start (ground search) belongs to the cycle before.
+The env reads the gains at the first control step of a cycle; when the cycle starts with waits
+for the stance feet to touch the ground (ground search), the gains are read on the first wait,
+the search already runs with them, and the waits belong to that cycle's wrapped step.
 
 With ``baseline_action`` the wrapper also plays each cycle a second time, on a copy of the env
 taken at the cycle start, with that action held (e.g. the zero residual: the paper's gains), and
@@ -48,8 +49,8 @@ class GainsPerCycle(gym.Wrapper):
 
     ``step`` returns the last control step's observation, termination, truncation and info, with
     the reward summed over the cycle's control steps; ``info["cycle_steps"]`` is how many control
-    steps it ran (a cycle's, plus the ground-search waits before the next one; fewer when the
-    episode ended inside the cycle).
+    steps it ran (a cycle's, with the ground-search waits at its start; fewer when the episode
+    ended inside the cycle).
 
     With ``baseline_action`` (an action of the wrapped env) the reward is that sum minus the sum
     over as many control steps (fewer if it ends first) of a copy of the wrapped env taken before
@@ -216,12 +217,27 @@ class GainsPerEpisode(gym.Wrapper):
         super().__init__(env)
         self._reward = episode_reward_of(env, reward)
         _require_gains_mode(env, type(self).__name__)
+        if not _has_time_limit(env):
+            raise ValueError(
+                "GainsPerEpisode plays each episode to its end, so the env needs a time limit: "
+                "make it with gym.make (the registered limit, or max_episode_steps=N) or wrap it "
+                "in gymnasium.wrappers.TimeLimit"
+            )
         self.reward = reward
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         (obs, _, _, truncated, info), total, steps = _play(self.env, action, lambda _: False)
         info.update(episode_steps=steps, episode_truncated=truncated)
         return obs, self._reward(info, total), True, False, info
+
+
+def _has_time_limit(env: gym.Env) -> bool:
+    """A `gymnasium.wrappers.TimeLimit` among `env`'s wrappers."""
+    while isinstance(env, gym.Wrapper):
+        if isinstance(env, gym.wrappers.TimeLimit):
+            return True
+        env = env.env
+    return False
 
 
 def _require_gains_mode(env: gym.Env, wrapper: str) -> None:

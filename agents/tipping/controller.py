@@ -203,6 +203,19 @@ class RecoveryConfig:
             )
         for name in ("touchdown_speed", "max_search_depth", "rate_window", "accel_filter_time"):
             check_number(name, getattr(self, name), strict=True)
+        # Checked here, not first at the episode's first tipping judgment that uses them:
+        check_number("threshold_deg", self.threshold_deg, low=-90.0, high=90.0)
+        check_number("angle_threshold_deg", self.angle_threshold_deg, high=180.0)
+        check_number("rho", self.rho, strict=True, high=1.0)
+        check_number("swing_clearance", self.swing_clearance)
+        check_number("arm_after", self.arm_after)
+        if not 0.0 < check_number("kappa", self.kappa, strict=True) < 1.0:
+            raise ValueError(f"kappa must lie in (0, 1), got {self.kappa}")
+        if not 0.0 < check_number("t_min", self.t_min, strict=True) <= self.t_max:
+            raise ValueError(f"need 0 < t_min <= t_max, got t_min={self.t_min}, t_max={self.t_max}")
+        ratios = np.asarray(self.cone_ratios, dtype=float)
+        if ratios.ndim != 1 or not ratios.size or not np.all((ratios > 0.0) & (ratios < 1.0)):
+            raise ValueError(f"cone_ratios must be values in (0, 1), got {self.cone_ratios!r}")
 
 
 @dataclass
@@ -634,10 +647,12 @@ class TippingRecoveryPolicy(EnvBound):
 
     Works in either action mode: the joint targets of :class:`TippingRecoveryController` become
     normalised targets ("joint") or offsets from the env's reference posture ("residual"; the
-    Stewart env's default residual_scale 2 reaches every target). Everything comes from the
-    env's declared task description (robot, action mapping, timing, and the reference: the
-    Stewart env's ``hold_posture`` of the episode, or the walking envs' gait table at the
-    observed ``gait_phase``, the definition of the residual action) and from the observation.
+    Stewart env's default residual_scale 2 reaches every target). An action beyond the 18
+    joints (``landing_action``, ``clock_action``) is 0: no landing, the gait's own pace.
+    Everything comes from the env's declared task description (robot, action mapping, timing,
+    and the reference: the Stewart env's ``hold_posture`` of the episode, or the walking envs'
+    gait table at the observed ``gait_phase``, the definition of the residual action) and from
+    the observation.
     The description is read again on the first call after `reset` (the held tripod is drawn
     at the env's reset, which may come before or after the policy's).
 
@@ -664,6 +679,9 @@ class TippingRecoveryPolicy(EnvBound):
         if self.action_mode == "residual":
             self._gain = task.reference["residual_scale"] * self.action_map.half
         self._dtype = env.action_space.dtype
+        # An env's actions beyond the 18 joints (the Stewart tilt's landing_action, the cliff
+        # walk's clock_action) get 0, their neutral value: no landing, the gait's own pace.
+        self._extra = np.zeros(int(env.action_space.shape[0]) - 18, dtype=self._dtype)
         self._reference_gait = TripodGaitReference(task)
         self._hold: np.ndarray | None = None
         self.controller = TippingRecoveryController(task.robot, self.config, self.control_dt)
@@ -701,7 +719,8 @@ class TippingRecoveryPolicy(EnvBound):
             action = np.minimum(np.maximum(raw, -1.0), 1.0)
         else:
             action = self.action_map.to_action(joints)
-        return action.astype(self._dtype)
+        action = action.astype(self._dtype)
+        return np.concatenate([action, self._extra]) if self._extra.size else action
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:
         if self._steps == 0:  # the episode's reference (the env has been reset by now)

@@ -30,12 +30,12 @@ clock rate, 1 + min(a, 0), so that a policy can slow or hold the gait.
 | Reward term (info key) | meaning |
 |---|---|
 | reward_forward | forward_weight x clip(CoG speed along x / gait speed, -1, forward_cap) |
-| reward_stability | stability_weight x clip(FASM, -20, 45) / 45 |
+| reward_stability | stability_weight x clip(FASM, -ξ, 45) / 45 (ξ = tipping_threshold_deg, 20) |
 | reward_alive | the largest cost of a step, paid while the robot is up (see below) |
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
 | reward_effort | -effort_weight x min(sum of |joint power| / (weight x gait speed), 20) |
 
-Every term is bounded and the alive term (forward_weight + stability_weight x 20/45 +
+Every term is bounded and the alive term (forward_weight + stability_weight x ξ/45 +
 effort_weight x 20) makes an upright step's reward >= 0, so an episode that ends by tipping over
 returns less than staying up, however badly the robot moves.
 
@@ -61,7 +61,7 @@ error that lists the valid ones).
 
 ## Version History
 - v1: termination at 15° or 1 s at FASM <= 0; success bounded in tilt (8°) and time below ξ_f
-  (10 %); cliffs 0.15-2.35 m ahead of the front feet (`hexapod_envs.benchmark`).
+  (10 %); cliffs 0.33-2.53 m ahead of the front feet (`hexapod_envs.benchmark`).
 - v0: the papers' reproduction.
 """
 
@@ -72,6 +72,7 @@ import dataclasses
 import mujoco
 import numpy as np
 
+from ..robots.heavy_duty.gait import TripodGait
 from ..terrain.cliff import CLIFF_SIDES, add_cliff
 from ..terrain.flat import add_flat
 from .difficulty import DifficultySpan
@@ -86,8 +87,16 @@ from .settings import bounded, choice, number, option
 
 TERRAINS = ("cliff", "flat")
 
-FRONT_FEET_X = 2.4 + 0.25
-"""x of the farthest foot at the start (hip x + half the stroke) [m]."""
+
+def _front_foot_x() -> float:
+    """x of the farthest foot at the start with the default robot and gait [m]: the body starts
+    at x = 0 and the gait clock at 0, where RF's stroke has it 0.07 m ahead of its neutral
+    foothold (the stroke lies mostly behind it, see `TripodGaitParams.stance_offset`)."""
+    return max(float(foot[0]) for foot in TripodGait().feet_at_phase(0.0).values())
+
+
+FRONT_FEET_X = round(_front_foot_x(), 3)
+"""x of the farthest foot at the start (RF, 2.471 m) [m]: a cliff must lie ahead of it."""
 
 
 @dataclasses.dataclass(frozen=True)

@@ -376,6 +376,15 @@ class IrregularTerrainSettings(EnvSettings):
                 f"ramp_start_x={self.ramp_start_x} m puts the foot of the slope under the robot; "
                 "use <= -0.3 (start on the slope) or >= 0.3 (start on the flat approach)"
             )
+        low = self.block_height_range[0]
+        for name in ("train_ranges", "test_ranges"):
+            drawn = getattr(self, name).block_height_max
+            if drawn[0] < low:
+                raise ValueError(
+                    f"{name}.block_height_max starts at {drawn[0]} m, below block_height_range's "
+                    f"lowest block {low} m: the bed could not have blocks that low; raise it to "
+                    f">= {low} m or lower block_height_range"
+                )
 
 
 class IrregularTerrainEnv(HexapodEnv):
@@ -601,7 +610,8 @@ class IrregularTerrainEnv(HexapodEnv):
 
     def task_difficulty_spans(self) -> dict[str, DifficultySpan]:
         """What makes a terrain task hard: on the blocks tall and small blocks, on the ramp a
-        steep slope; on both a slippery ground and servos far from their nominal stiffness."""
+        steep slope; on both a slippery ground and soft servos (down to 70 % of the nominal
+        stiffness; stiffer servos rate as nominal: they hold the posture at least as well)."""
         kp = self.settings.servo_kp
         spans = {
             "friction": DifficultySpan(easy=1.1, hard=0.5),

@@ -215,3 +215,12 @@ def test_a_per_episode_run_trains_and_evaluates_per_episode_and_plays_its_first_
     policy.reset()  # a new episode: asked again, on its own first observation
     obs, _ = env.reset(seed=1)
     assert policy(obs).shape == (4,)
+
+
+def test_an_env_without_a_time_limit_is_refused():
+    """Each step plays an episode to its end: without a time limit a robot that never falls
+    would never return."""
+    unlimited = gym.make(ENV_ID, **GAINS).unwrapped
+    with pytest.raises(ValueError, match="the env needs a time limit"):
+        GainsPerEpisode(gym.wrappers.OrderEnforcing(unlimited))
+    GainsPerEpisode(gym.wrappers.TimeLimit(unlimited, 10))

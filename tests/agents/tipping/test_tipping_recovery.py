@@ -136,6 +136,17 @@ def test_config_errors_name_the_choices():
     for bad in ((0.004, 0.004), 0.004, (0.004, -0.001, 0.004)):
         with pytest.raises(ValueError, match="max_offset must be 3 finite limits"):
             RecoveryConfig(max_offset=bad)
+    # settings first used at a tipping judgment are checked when the config is made
+    for kwargs, match in (
+        ({"kappa": 1.5}, "kappa must lie in"),
+        ({"rho": 1.5}, "rho must be a finite number"),
+        ({"t_min": 5.0}, "need 0 < t_min <= t_max"),
+        ({"threshold_deg": float("nan")}, "threshold_deg must be a finite number"),
+        ({"cone_ratios": (0.65, 1.2)}, "cone_ratios must be values in"),
+        ({"swing_clearance": -0.1}, "swing_clearance"),
+    ):
+        with pytest.raises(ValueError, match=match):
+            RecoveryConfig(**kwargs)
     env = gym.make("HexapodStewartTilt-v0", scenario="climb")
     with pytest.raises(ValueError, match="valid:.*reach_model"):
         TippingRecoveryPolicy(env, reach_mode="paper")

@@ -120,3 +120,32 @@ def test_support_feet_in_a_line_skip_the_force_distribution_instead_of_crashing(
         if terminated or truncated:
             break
     assert "degenerate_geometry" in statuses
+
+
+@pytest.mark.parametrize(
+    ("env_id", "policy_class", "option"),
+    [
+        ("HexapodStewartTilt-v1", TippingRecoveryPolicy, {"landing_action": True}),
+        ("HexapodCliffWalk-v1", GaitWithRecoveryPolicy, {"clock_action": True}),
+    ],
+)
+def test_an_extra_action_gets_its_neutral_zero_and_changes_nothing(env_id, policy_class, option):
+    """With a 19th action (the landing fraction, the gait clock's rate) the recovery policies
+    send 0 for it and act as on the 18-action env: the same joint actions step for step."""
+    runs = []
+    for kwargs in ({}, option):
+        env = gym.make(env_id, task_distribution="test", **kwargs)
+        policy = policy_class(env)
+        obs, _ = env.reset(seed=1)
+        policy.reset()
+        actions = []
+        for _ in range(400):  # past the Stewart tilt's first tipping judgment (step 230 here)
+            action = policy(obs)
+            actions.append(action)
+            obs, _, terminated, truncated, _ = env.step(action)
+            if terminated or truncated:
+                break
+        runs.append(np.array(actions))
+    plain, extra = runs
+    assert extra.shape[1] == 19 and np.all(extra[:, 18] == 0.0)
+    np.testing.assert_array_equal(extra[:, :18], plain)

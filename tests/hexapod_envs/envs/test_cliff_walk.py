@@ -98,6 +98,16 @@ def test_cliff_behind_the_robot_is_refused():
         gym.make("HexapodCliffWalk-v0", cliff_x=-3.0)
 
 
+def test_a_cliff_just_ahead_of_the_front_foot_is_accepted():
+    """The bound is the front foot's x at the start, measured in the built robot."""
+    env = gym.make("HexapodCliffWalk-v0", reset_noise_scale=0.0, cliff_x=2.5)
+    env.reset(seed=0)
+    front = env.unwrapped.sensors.foot_positions()[:, 0].max()
+    assert front == pytest.approx(2.471, abs=1e-3) and front < 2.5
+    with pytest.raises(ValueError, match="behind"):
+        gym.make("HexapodCliffWalk-v0", cliff_x=2.47)
+
+
 @pytest.mark.parametrize(
     ("kwargs", "match"),
     [
