@@ -32,6 +32,7 @@ import argparse
 import json
 import os
 import warnings
+import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,21 +43,15 @@ import numpy as np
 from .knobs import KNOB_RANGES, PLANNER_KNOB_RANGES, settings_from_config
 from .pipeline.callbacks import evaluation_score
 from .pipeline.cli import _add_trust_pickle_option, _run
+from .pipeline.learning_curve import evaluation_log
 from .plan_knobs import COURSE_FEATURES, course_space
 from .policy import LearnedWithController
-from .run_files.artifacts import (
-    ModelFiles,
-    find_model,
-    is_run_dir,
-    learner_step_unit,
-    read_meta,
-)
+from .run_files.artifacts import ModelFiles, find_model, learner_step_unit, read_meta
 from .run_files.errors import UserError
 from .run_files.model_files import NormalizationStats, atomic_path, atomic_write_text
 
 OPSET = 17
 INPUT, OUTPUT = "observation", "action"
-EVALUATIONS_FILE = "evaluations.npz"
 
 
 @dataclass
@@ -239,20 +234,18 @@ def training_evaluations(model_dir: Path, select: str = "reward") -> dict[str, A
     the last one and the best one (mean return, success rate), best by the training run's
     ``eval.select`` rule, the one that chose its ``best/`` checkpoint: the mean return
     ("reward"), or the success rate and then the mean return ("success"). A model inside a run
-    directory (``best/``, ``final/``, ``checkpoints/step_N/``) reads its run's log."""
-    model_dir = Path(model_dir)
-    candidates = [model_dir, model_dir.parent, model_dir.parent.parent]
-    found = [
-        d / EVALUATIONS_FILE
-        for d in candidates
-        if (d / EVALUATIONS_FILE).is_file() and (d == model_dir or is_run_dir(d))
-    ]
-    if not found:
+    directory (``best/``, ``final/``, ``checkpoints/step_N/``) reads its run's log
+    (`evaluation_log`). The successes are read as logged, as the callback scored them (SB3 logs
+    them only for evaluations whose episodes report ``is_success``)."""
+    path = evaluation_log(model_dir)
+    if path is None:
         return None
-    path = found[0]
-    with np.load(path, allow_pickle=False) as data:
-        steps, results = data["timesteps"], data["results"]
-        successes = data["successes"] if "successes" in data.files else None
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            steps, results = data["timesteps"], np.asarray(data["results"], dtype=float)
+            successes = data["successes"] if "successes" in data.files else None
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
+        raise UserError(f"the evaluation log {path} is damaged ({exc})") from None
     if len(steps) == 0:
         return None
 

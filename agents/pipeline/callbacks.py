@@ -153,6 +153,7 @@ class StatsEvalCallback(EvalCallback):
             self._log_file = self.log_path + ".npz"
             self.log_path = os.path.join(os.path.dirname(self.log_path), ".evaluations.partial")
         self.best_score: tuple[float, float] | None = None
+        self._evaluations_handled = 0
         self._make_accumulators = new_accumulator
         self._accumulators: dict[int, EpisodeAccumulator] = {}
 
@@ -172,13 +173,28 @@ class StatsEvalCallback(EvalCallback):
         evaluating = self.eval_freq > 0 and self.n_calls % self.eval_freq == 0
         if evaluating and self.task_seed is not None:
             self.eval_env.seed(self.task_seed)
-        done_before = len(self.evaluations_timesteps)
+        self._evaluations_handled = len(self.evaluations_timesteps)
         continue_training = super()._on_step()
-        if self._log_file is not None and len(self.evaluations_timesteps) > done_before:
+        self._after_evaluation()
+        return continue_training
+
+    def _on_event(self) -> bool:
+        # SB3 runs ``callback_after_eval`` (a sweep's report to Ray Tune, which may stop the
+        # trial right there) after writing its log and before returning: our part first.
+        self._after_evaluation()
+        return super()._on_event()
+
+    def _after_evaluation(self) -> None:
+        """Once per new evaluation: move the log SB3 has just written into place, log the change
+        since step 0 and keep ``best/`` by the `select_saver` rule."""
+        if len(self.evaluations_timesteps) <= self._evaluations_handled:
+            return
+        self._evaluations_handled = len(self.evaluations_timesteps)
+        if self._log_file is not None:
             os.replace(self.log_path + ".npz", self._log_file)
-        if self.task_seed is not None and len(self.evaluations_timesteps) > done_before:
+        if self.task_seed is not None:
             self._log_change_since_start()
-        if self.select_saver is not None and len(self.evaluations_timesteps) > done_before:
+        if self.select_saver is not None:
             score = self.score(len(self.evaluations_timesteps) - 1)
             if self.best_score is None or score > self.best_score:
                 self.best_score = score
@@ -190,7 +206,6 @@ class StatsEvalCallback(EvalCallback):
                     eval_mean_reward=score[1],
                     eval_success_rate=score[0],
                 )
-        return continue_training
 
     def _log_change_since_start(self) -> None:
         """On the same tasks at every evaluation, the paired change of the success rate and the

@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import shutil
 import sys
 from collections.abc import Callable, Sequence
 from pathlib import Path
@@ -227,8 +228,13 @@ def evaluate_main(argv: Sequence[str] | None = None, prog: str = "evaluate.py") 
         if args.envs:
             entries, unlisted = _suite_envs(args.config, args.envs)
             overrides.append(f"envs={json.dumps(entries)}")
-            if unlisted and not any(o.startswith("title=") for o in args.overrides):
-                # an env the suite does not list: its title (say "benchmark v1") may not hold
+            default_suite = args.config is None
+            if (
+                default_suite
+                and unlisted
+                and not any(o.startswith("title=") for o in args.overrides)
+            ):
+                # an env the default suite does not list: its title ("benchmark v1") may not hold
                 overrides.append(f"title={json.dumps(DEFAULT_TITLE)}")
         for key, value in (
             ("policies", args.policies),
@@ -249,22 +255,22 @@ def evaluate_main(argv: Sequence[str] | None = None, prog: str = "evaluate.py") 
         from .study import expand_studies, write_study_section
 
         suite, studies, study_warnings = expand_studies(suite)  # ppo:<sweep dir> -> trials
-        out = Path(suite.output_dir)
-        force = args.force or _is_default_report(suite)
-        _prepare_report_dir(out, force, check_only=True)  # before the run: refusals cost nothing
+        shown = Path(suite.output_dir)
+        out = shown.resolve()  # a symbolic link: the directory it points to
+        _check_report_dir(shown, args.force or _is_default_report(suite))  # before the run
         with _partial_dir(out) as partial:  # an earlier report stays until the new one is done
             video_dir = partial / "videos" if args.video else None
             result = run_suite(suite, progress=not args.no_progress, video_dir=video_dir)
             result.warnings[:0] = study_warnings
             paths = write_report(result, partial)
             paths += write_study_section(result, studies, partial)  # none without sweep dirs
-            _prepare_report_dir(out, force).rmdir()
+            shutil.rmtree(out, ignore_errors=True)  # an earlier report, checked above
             partial.rename(out)
         for line in result.warnings:
             print(f"warning: {line}", file=sys.stderr)
         for line in result.notes:
             print(f"note: {line}", file=sys.stderr)
-        print("wrote " + ", ".join(str(out / p.relative_to(partial)) for p in paths))
+        print("wrote " + ", ".join(str(shown / p.relative_to(partial)) for p in paths))
         return 0
 
     return _run(prog, body)
@@ -304,22 +310,25 @@ def _is_default_report(suite) -> bool:
     return default is not None and out == Path(default) and (out / "metrics.json").is_file()
 
 
-def _prepare_report_dir(path: Path, force: bool, check_only: bool = False) -> Path:
-    """Empty `path` for a new report (`prepare_new_dir`); `check_only`: only raise where that
-    would be refused."""
+def _check_report_dir(path: Path, force: bool) -> None:
+    """UserError unless `path` may take a new report: not the working directory or one above
+    it (the report replaces the whole directory), and empty or missing, or with `force` an
+    earlier report (`prepare_new_dir`'s rule; nothing is changed here)."""
     from ..run_files.artifacts import prepare_new_dir
 
-    return prepare_new_dir(
-        path, force, "report directory", ("metrics.json", "report.md"), check_only=check_only
-    )
+    cwd, out = Path.cwd().resolve(), path.resolve()
+    if out == cwd or out in cwd.parents:
+        raise UserError(
+            f"the report directory {path} is the working directory or above it, which a new "
+            "report would replace; choose a new directory (e.g. --output-dir reports/mine)"
+        )
+    prepare_new_dir(path, force, "report directory", ("metrics.json",), check_only=True)
 
 
 @contextlib.contextmanager
 def _partial_dir(out: Path):
     """A new directory beside `out` that the report is written to, removed if the run fails or
     is interrupted (a finished report is renamed to `out` inside the block)."""
-    import shutil
-
     partial = out.parent / f".{out.name}.partial"
     shutil.rmtree(partial, ignore_errors=True)  # left by a killed run
     partial.mkdir(parents=True)

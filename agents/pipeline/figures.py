@@ -192,18 +192,17 @@ def learning_curves(result: EnvResult) -> bytes | None:
     a row of their own, for a run that acts once per cycle) for every PPO policy whose
     run directory holds an ``evaluations.npz`` (shipped model directories do not)."""
     from ..run_files.errors import UserError
-    from .learning_curve import EVALUATIONS_FILE, load_learning_curve
+    from .learning_curve import evaluation_log, load_learning_curve
 
     curves = {}
     for name, run in result.runs.items():
         directory = getattr(run, "model_dir", None)
-        for candidate in (directory, getattr(directory, "parent", None)):
-            if candidate is not None and (candidate / EVALUATIONS_FILE).is_file():
-                try:
-                    curves[result.label(name)] = load_learning_curve(candidate)
-                except UserError as exc:
-                    warnings.warn(f"{exc}; no learning curve for {name}", stacklevel=2)
-                break
+        log = None if directory is None else evaluation_log(directory)
+        if log is not None:
+            try:
+                curves[result.label(name)] = load_learning_curve(log.parent)
+            except UserError as exc:
+                warnings.warn(f"{exc}; no learning curve for {name}", stacklevel=2)
     if not curves:
         return None
     units = sorted({curve.unit for curve in curves.values()})

@@ -8,13 +8,14 @@ success. `load_learning_curve` reads it into arrays a report can plot or tabulat
 
 from __future__ import annotations
 
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import yaml
 
-from ..run_files.artifacts import learner_step_unit
+from ..run_files.artifacts import is_run_dir, learner_step_unit
 from ..run_files.errors import UserError
 
 EVALUATIONS_FILE = "evaluations.npz"
@@ -56,6 +57,19 @@ class LearningCurve:
         ]
 
 
+def evaluation_log(model_dir: str | Path) -> Path | None:
+    """The evaluation log of the model at `model_dir`: its own ``evaluations.npz`` (a shipped
+    model directory keeps a copy), else its run's, for a model inside a run directory
+    (``best/``, ``final/``, ``checkpoints/step_N/``); None if there is none."""
+    model_dir = Path(model_dir)
+    if (model_dir / EVALUATIONS_FILE).is_file():
+        return model_dir / EVALUATIONS_FILE
+    for run in (model_dir.parent, model_dir.parent.parent):
+        if is_run_dir(run) and (run / EVALUATIONS_FILE).is_file():
+            return run / EVALUATIONS_FILE
+    return None
+
+
 def load_learning_curve(run_dir: str | Path) -> LearningCurve:
     """The evaluation log of `run_dir`; UserError if it has none (eval.freq 0, or too early) or
     if it is damaged (unreadable, an array missing, rows of different lengths). SB3 logs
@@ -75,7 +89,7 @@ def load_learning_curve(run_dir: str | Path) -> LearningCurve:
             returns = np.asarray(data["results"], dtype=float)
             lengths = np.asarray(data["ep_lengths"], dtype=np.int64)
             successes = np.asarray(data["successes"], dtype=float) if "successes" in data else None
-    except (OSError, ValueError, KeyError, EOFError) as exc:
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
         raise UserError(f"the evaluation log {path} is damaged ({exc})") from None
     n = len(timesteps)
     if returns.ndim != 2 or len(returns) != n or lengths.shape != returns.shape:

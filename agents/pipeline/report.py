@@ -26,10 +26,10 @@ from .eval_config import DEFAULT_REFERENCES, PPO_PREFIX
 from .evaluation import EnvResult, SuiteResult
 from .summary import (
     STANDARD_METRICS,
-    TIE_TOLERANCE,
     Verdict,
     aggregate,
     compare,
+    is_tie,
     paired_difference_interval,
 )
 
@@ -241,7 +241,7 @@ def verdict_paragraph(result: EnvResult, aggs: dict[str, dict]) -> str:
     parts = [f"**Verdict:** {head}"]
     with_fasm = [n for n in leaders if math.isfinite(_median_min_fasm(aggs[n]))]
     medians = [_median_min_fasm(aggs[n]) for n in with_fasm]
-    if len(with_fasm) > 1 and not _tied(medians[0], medians[-1]):
+    if len(with_fasm) > 1 and not is_tie(medians[0], medians[-1]):
         most, least = with_fasm[0], with_fasm[-1]
         parts.append(
             f"Among them the stability cost differs: median minimum FASM "
@@ -304,11 +304,6 @@ def _rule_cells(rules: dict) -> list[str]:
         "-" if tilt is None else f"<= {tilt:g}°",
         "-" if share is None else f"<= {share * 100:g} % of the episode",
     ]
-
-
-def _tied(a: float, b: float) -> bool:
-    """Within `TIE_TOLERANCE` of the larger magnitude: the verdicts' rule for a tie."""
-    return abs(a - b) <= TIE_TOLERANCE * max(abs(a), abs(b))
 
 
 def _median_min_fasm(a: dict) -> float:

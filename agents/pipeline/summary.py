@@ -40,6 +40,12 @@ STANDARD_METRICS: dict[str, tuple[str, str, str | None]] = {
 TIE_TOLERANCE = 0.01
 """Relative difference below which two policies count as equal on a metric (1 %)."""
 
+
+def is_tie(a: float, b: float) -> bool:
+    """Two values within `TIE_TOLERANCE` of the larger magnitude: equal for a verdict."""
+    return abs(a - b) <= TIE_TOLERANCE * max(abs(a), abs(b))
+
+
 CONFIDENCE = 0.95
 """Level of the verdicts' paired-bootstrap intervals (`paired_difference_interval`)."""
 
@@ -221,7 +227,7 @@ def compare(
         if va is None or vb is None:
             continue
         diff = va - vb
-        if abs(diff) <= TIE_TOLERANCE * max(abs(va), abs(vb)):
+        if is_tie(va, vb):
             outcome = "tie"
         elif (diff > 0) == (better == "higher"):
             outcome = "better"

@@ -7,6 +7,7 @@ TensorBoard.
 from __future__ import annotations
 
 import contextlib
+import copy
 import dataclasses
 import os
 import shutil
@@ -14,6 +15,7 @@ import signal
 import sys
 import threading
 import time
+import zipfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -294,8 +296,9 @@ def resume_training(
                 f"cannot change {section!r} when resuming ({text!r}); the sections "
                 f"{list(RESUME_FIXED_SECTIONS)} are fixed by the saved model"
             )
-    saved = load_train_config(data=load_yaml(run_dir / CONFIG_FILE))
-    config = load_train_config(data=load_yaml(run_dir / CONFIG_FILE), overrides=overrides)
+    data = load_yaml(run_dir / CONFIG_FILE)
+    saved = load_train_config(data=copy.deepcopy(data))  # the overrides edit the mapping given
+    config = load_train_config(data=data, overrides=overrides)
     _check_eval_tasks_kept(run_dir, saved, config)
     candidates = saved_model_dirs(run_dir)
     if not candidates:
@@ -335,9 +338,9 @@ def resume_training(
 
 def _check_eval_tasks_kept(run_dir: Path, before: Any, after: Any) -> None:
     """UserError if the overrides change the evaluation episodes of a run with an evaluation
-    log: its rows hold ``eval.n_episodes`` episodes each (on the same tasks at every
-    evaluation with ``eval.same_tasks``), the learning curve compares them, and rows of two
-    widths cannot share the log."""
+    log: its rows hold ``eval.n_episodes`` episodes each (rows of two widths cannot share the
+    log), on the same tasks at every evaluation with ``eval.same_tasks`` (the learning curve
+    compares them)."""
     if not (run_dir / EVALUATIONS_FILE).is_file():
         return
     for key in ("n_episodes", "same_tasks"):
@@ -683,7 +686,7 @@ def _restore_eval_history(eval_cb: Any, run_dir: Path, done: int) -> None:
         for name in ("timesteps", "results", "length", "successes"):
             entries = getattr(eval_cb, f"evaluations_{name}")
             del entries[kept:]
-    except (OSError, ValueError, KeyError, EOFError) as exc:
+    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
         print(
             f"warning: the evaluation log {log} is unreadable ({exc}); it starts anew",
             file=sys.stderr,

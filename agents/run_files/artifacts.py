@@ -82,7 +82,7 @@ def prepare_new_dir(
     if path.exists() and (not path.is_dir() or any(path.iterdir())):
         if not force:
             raise UserError(f"{what} {path} already exists; pass --force to overwrite it")
-        if path.is_dir() and markers:
+        if markers:
             _check_replaceable(path, what, markers)
         if check_only:
             return path
@@ -105,6 +105,8 @@ def _check_replaceable(path: Path, what: str, markers: tuple[str, ...]) -> None:
                 f"--force would delete {path}, which is or contains {protected}; "
                 f"choose a new directory for the {what}"
             )
+    if not path.is_dir():
+        raise UserError(f"{path} exists and is not a directory; choose another {what}")
     if not any((path / name).exists() for name in markers):
         raise UserError(
             f"{path} exists and is not an earlier {what} (it has none of {list(markers)}); "

@@ -213,8 +213,8 @@ class RecoveryConfig:
             raise ValueError(f"kappa must lie in (0, 1), got {self.kappa}")
         if not 0.0 < check_number("t_min", self.t_min, strict=True) <= self.t_max:
             raise ValueError(f"need 0 < t_min <= t_max, got t_min={self.t_min}, t_max={self.t_max}")
-        ratios = np.asarray(self.cone_ratios, dtype=float)
-        if ratios.ndim != 1 or not ratios.size or not np.all((ratios > 0.0) & (ratios < 1.0)):
+        ratios = np.asarray(self.cone_ratios, dtype=float)  # () : the configured λ alone
+        if ratios.ndim != 1 or not np.all((ratios > 0.0) & (ratios < 1.0)):
             raise ValueError(f"cone_ratios must be values in (0, 1), got {self.cone_ratios!r}")
 
 

@@ -72,7 +72,7 @@ import dataclasses
 import mujoco
 import numpy as np
 
-from ..robots.heavy_duty.gait import TripodGait
+from ..robots.heavy_duty.gait import TripodGait, TripodGaitParams
 from ..terrain.cliff import CLIFF_SIDES, add_cliff
 from ..terrain.flat import add_flat
 from .difficulty import DifficultySpan
@@ -88,15 +88,17 @@ from .settings import bounded, choice, number, option
 TERRAINS = ("cliff", "flat")
 
 
-def _front_foot_x() -> float:
-    """x of the farthest foot at the start with the default robot and gait [m]: the body starts
-    at x = 0 and the gait clock at 0, where RF's stroke has it 0.07 m ahead of its neutral
-    foothold (the stroke lies mostly behind it, see `TripodGaitParams.stance_offset`)."""
-    return max(float(foot[0]) for foot in TripodGait().feet_at_phase(0.0).values())
+def front_foot_x(gait: TripodGaitParams | None = None) -> float:
+    """x of the farthest foot at the start [m]: the body starts at x = 0
+    and the gait clock at 0, where the paper's gait has RF 0.07 m ahead of its neutral foothold
+    (its stroke lies mostly behind it, see `TripodGaitParams.stance_offset`)."""
+    feet = TripodGait(gait=gait).feet_at_phase(0.0)
+    return max(float(foot[0]) for foot in feet.values())
 
 
-FRONT_FEET_X = round(_front_foot_x(), 3)
-"""x of the farthest foot at the start (RF, 2.471 m) [m]: a cliff must lie ahead of it."""
+FRONT_FEET_X = round(front_foot_x(), 3)
+"""x of the farthest foot at the start with the paper's gait (RF, 2.471 m) [m]: the bound of
+the task ranges' cliff x (a settings' own gait is checked against its own front foot)."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -141,11 +143,20 @@ class CliffWalkSettings(HeavyDutySettings):
 
     def __post_init__(self) -> None:
         super().__post_init__()
-        if self.terrain == "cliff" and self.cliff_x <= FRONT_FEET_X:
-            raise ValueError(
-                f"cliff_x={self.cliff_x} m places the cliff at or behind the robot's front feet "
-                f"(x <= {FRONT_FEET_X} m); the robot walks along +x, put the cliff ahead of it"
-            )
+        if self.terrain != "cliff":
+            return
+        front = front_foot_x(self.gait)  # with this gait (the reset's joint noise settles out)
+        for name, x in (
+            ("cliff_x", self.cliff_x),
+            ("train_ranges.cliff_x", self.train_ranges.cliff_x[0]),
+            ("test_ranges.cliff_x", self.test_ranges.cliff_x[0]),
+        ):
+            if x <= front:
+                raise ValueError(
+                    f"{name}={x} m places the cliff at or behind the robot's front feet "
+                    f"(x <= {front:.3f} m at the start); the robot walks along +x, put the "
+                    "cliff ahead of it"
+                )
 
 
 class CliffWalkEnv(HeavyDutyEnv):

@@ -376,15 +376,6 @@ class IrregularTerrainSettings(EnvSettings):
                 f"ramp_start_x={self.ramp_start_x} m puts the foot of the slope under the robot; "
                 "use <= -0.3 (start on the slope) or >= 0.3 (start on the flat approach)"
             )
-        low = self.block_height_range[0]
-        for name in ("train_ranges", "test_ranges"):
-            drawn = getattr(self, name).block_height_max
-            if drawn[0] < low:
-                raise ValueError(
-                    f"{name}.block_height_max starts at {drawn[0]} m, below block_height_range's "
-                    f"lowest block {low} m: the bed could not have blocks that low; raise it to "
-                    f">= {low} m or lower block_height_range"
-                )
 
 
 class IrregularTerrainEnv(HexapodEnv):
@@ -639,12 +630,14 @@ class IrregularTerrainEnv(HexapodEnv):
         """Set the terrain and servo parameters of `task` and rebuild the model if they changed;
         the block bed is drawn anew from the episode's `np_random` at every reset, unless
         `block_layout_seed` fixes it."""
+        low = self.blocks["height_range"][0]
+        if task["block_height_max"] < low:  # the bed's lowest block bounds its highest
+            task["block_height_max"] = low  # what the bed has, in info["task"] and its rating
         changed = task != self._built_task
         if changed:
             self._built_task = dict(task)
             self.ramp["slope_deg"] = task["slope_deg"]
-            low = self.blocks["height_range"][0]
-            self.blocks["height_range"] = (low, max(low, task["block_height_max"]))
+            self.blocks["height_range"] = (low, task["block_height_max"])
             self.blocks["block_size"] = (task["block_size"], task["block_size"])
             self.friction = task["friction"]
             self.robot = dataclasses.replace(self.robot, servo_kp=task["servo_kp"])

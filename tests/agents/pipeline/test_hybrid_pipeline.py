@@ -153,6 +153,10 @@ def test_a_damaged_learning_curve_is_a_clear_error_and_short_successes_are_left_
     np.savez(log, timesteps=[0])
     with pytest.raises(ValueError, match="evaluations.npz is damaged"):
         load_learning_curve(tmp_path)
+    np.savez(log, timesteps=[0, 1], results=np.ones((2, 2)), ep_lengths=np.ones((2, 2)))
+    log.write_bytes(log.read_bytes()[:200])  # cut short, as a kill during a write leaves it
+    with pytest.raises(ValueError, match="evaluations.npz is damaged"):
+        load_learning_curve(tmp_path)
 
 
 def test_resume_keeps_the_hybrid_and_refuses_to_change_it(tmp_path, capsys):

@@ -94,6 +94,33 @@ def test_resume_refuses_a_finished_budget_and_env_changes(run, capsys):
     assert "cannot change 'env' when resuming" in capsys.readouterr().err
 
 
+def test_the_evaluation_log_and_best_are_in_place_before_the_after_eval_callback(tmp_path):
+    """A sweep's after-eval callback reports to Ray Tune, which may end the trial right there:
+    the evaluation it reports is already in evaluations.npz and best/ by then."""
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    from agents.pipeline.learning_curve import load_learning_curve
+    from agents.pipeline.training import start_training
+    from agents.run_files.configtools import load_yaml
+    from agents.run_files.train_config import load_train_config
+
+    seen = []
+
+    class Check(BaseCallback):
+        def _on_step(self) -> bool:
+            run = tmp_path / "r"
+            seen.append(
+                (int(load_learning_curve(run).timesteps[-1]), meta(run / "best")["num_timesteps"])
+            )
+            return True
+
+    config = load_train_config(data=load_yaml(CONFIG), overrides=TINY)
+    start_training(config, tmp_path, "r", after_eval=Check())
+    assert [logged for logged, _ in seen] == [0, 512, 1024]  # each callback sees its own row
+    assert seen[0][1] == 0  # and best/ already holds the step-0 policy at the first one
+    assert not list((tmp_path / "r").glob(".evaluations.partial*"))
+
+
 def test_ctrl_c_saves_a_checkpoint_and_exits_130(tmp_path, monkeypatch, capsys):
     calls = {"n": 0}
 
@@ -388,8 +415,16 @@ def test_force_replaces_only_an_earlier_report_never_other_files(tmp_path, monke
     assert (precious / "sub" / "data.csv").is_file()
     for parent in (".", ".."):
         assert evaluate_main([*argv, "--output-dir", parent]) == 2
-        assert "choose a new directory for the report directory" in capsys.readouterr().err
-    assert (precious / "sub" / "data.csv").is_file()
+        assert "is the working directory or above it" in capsys.readouterr().err
+    (tmp_path / "notes.csv").write_text("1,2")
+    assert evaluate_main([*argv, "--output-dir", "notes.csv"]) == 2
+    assert "exists and is not a directory" in capsys.readouterr().err
+    assert (precious / "sub" / "data.csv").is_file() and (tmp_path / "notes.csv").is_file()
+    # a symbolic link to an earlier report: the report replaces the directory it points to
+    assert evaluate_main([*argv, "--output-dir", "rep"]) == 0
+    (tmp_path / "link").symlink_to(tmp_path / "rep")
+    assert evaluate_main([*argv, "--output-dir", "link"]) == 0
+    assert (tmp_path / "link").is_symlink() and (tmp_path / "link" / "metrics.json").is_file()
 
 
 def test_missing_shipped_model_is_skipped_with_a_warning_in_the_report(tmp_path):

@@ -147,6 +147,7 @@ def test_config_errors_name_the_choices():
     ):
         with pytest.raises(ValueError, match=match):
             RecoveryConfig(**kwargs)
+    assert RecoveryConfig(cone_ratios=()).cone_ratios == ()  # the paper's λ alone (row 7d)
     env = gym.make("HexapodStewartTilt-v0", scenario="climb")
     with pytest.raises(ValueError, match="valid:.*reach_model"):
         TippingRecoveryPolicy(env, reach_mode="paper")

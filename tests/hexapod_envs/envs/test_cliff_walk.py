@@ -106,6 +106,11 @@ def test_a_cliff_just_ahead_of_the_front_foot_is_accepted():
     assert front == pytest.approx(2.471, abs=1e-3) and front < 2.5
     with pytest.raises(ValueError, match="behind"):
         gym.make("HexapodCliffWalk-v0", cliff_x=2.47)
+    # a gait whose stroke starts farther forward: its own front foot is the bound
+    from hexapod_envs.robots.heavy_duty.gait import TripodGaitParams
+
+    with pytest.raises(ValueError, match=r"cliff_x=2.6 m .* \(x <= 3.050 m at the start\)"):
+        gym.make("HexapodCliffWalk-v0", cliff_x=2.6, gait=TripodGaitParams(stance_offset=0.4))
 
 
 @pytest.mark.parametrize(

@@ -176,11 +176,6 @@ def test_bad_task_ranges_are_named(ranges, error, words):
         ("HexapodIrregularTerrain-v0", {"servo_kp_scale": [[-2.0, -1.0]]}, ["servo_kp_scale"]),
         ("HexapodIrregularTerrain-v0", {"slope_deg": [[40.0, 50.0]]}, ["slope_deg", "<= 45"]),
         ("HexapodIrregularTerrain-v0", {"block_size": [0.0, 0.1]}, ["block_size", "> 0"]),
-        (
-            "HexapodIrregularTerrain-v1",
-            {"block_height_max": [0.02, 0.03]},
-            ["block_height_max starts at 0.02 m", "lowest block 0.04 m"],
-        ),
         ("HexapodDitchCrossing-v0", {"depth": [0.0, 0.1]}, ["depth", "> 0"]),
         ("HexapodDitchCrossing-v0", {"friction": [-1.0, 0.0]}, ["friction", "> 0"]),
         ("HexapodDitchCrossing-v0", {"start_x": [0.1, 0.2]}, ["start_x", ">= 0.240 m"]),

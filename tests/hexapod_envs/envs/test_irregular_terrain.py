@@ -503,3 +503,16 @@ def test_gymnasium_vector_envs_batch_the_infos_of_cycles_out_of_step():
 def test_a_servo_delay_needs_a_physics_step_its_history_covers():
     with pytest.raises(ValueError, match=r"servo_delay > 0 needs physics_dt >= 0\.0005"):
         gym.make("HexapodIrregularTerrain-v0", servo_delay=0.02, physics_dt=0.0001)
+
+
+def test_a_drawn_highest_block_below_the_lowest_is_what_the_bed_has():
+    """The bed's lowest block (block_height_range[0], 0.04 m) bounds its highest: a task drawn
+    lower records, and is rated by, the height the bed really has."""
+    env = gym.make(
+        "HexapodIrregularTerrain-v1",
+        task_distribution="train",
+        train_ranges={"block_height_max": (0.02, 0.03)},
+    )
+    _, info = env.reset(seed=0)
+    heights = env.unwrapped.terrain_info.heights
+    assert info["task"]["block_height_max"] == 0.04 == heights.min() == heights.max()
