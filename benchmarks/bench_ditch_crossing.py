@@ -8,6 +8,7 @@ cost of the env's per-step stability work and of planning at reset. Run:
 
 from __future__ import annotations
 
+import argparse
 import sys
 import time
 from pathlib import Path
@@ -27,6 +28,7 @@ ENV_ID = "HexapodDitchCrossing-v0"
 
 
 def main() -> None:
+    argparse.ArgumentParser(description=__doc__.splitlines()[0]).parse_args()  # --help
     print(
         f"{'env':32s} {'raw mj_step/s':>14s} {'env physics steps/s':>20s} {'env/raw':>8s} "
         f"{'env/sensing last':>17s}"

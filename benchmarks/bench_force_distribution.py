@@ -35,6 +35,7 @@ from agents.tipping.force_distribution import (
     ForceDistributor,
     desired_wrench,
 )
+from hexapod_envs.checks import count_argument
 from hexapod_envs.robots.heavy_duty import HeavyDutyParams, standing_feet
 
 
@@ -134,7 +135,7 @@ def print_qp_timings(repeats: int, stages: tuple[str, ...] = STAGES) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--repeats", type=int, default=3000)
+    parser.add_argument("--repeats", type=count_argument(), default=3000)
     args = parser.parse_args()
     print_qp_timings(args.repeats)
 

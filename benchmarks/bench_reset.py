@@ -20,6 +20,7 @@ import gymnasium as gym
 import numpy as np
 
 import hexapod_envs  # noqa: F401
+from hexapod_envs.checks import count_argument
 
 TARGET_MS = 20.0
 """The bound on one reset [ms] (times in the table are in ms)."""
@@ -41,7 +42,7 @@ def reset_times_ms(env_id: str, distribution: str, resets: int) -> tuple[np.ndar
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--resets", type=int, default=20)
+    parser.add_argument("--resets", type=count_argument(), default=20)
     ids = sorted(k for k in gym.registry if k.startswith("Hexapod"))
     parser.add_argument("--envs", nargs="*", default=ids, choices=ids)
     args = parser.parse_args()

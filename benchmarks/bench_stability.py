@@ -19,6 +19,7 @@ import time
 
 import numpy as np
 
+from hexapod_envs.checks import count_argument
 from hexapod_envs.stability import (
     fasm,
     fasm_from_feet,
@@ -69,7 +70,9 @@ def time_us(fn, repeats: int, batch: int = 50) -> tuple[float, float]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
-    parser.add_argument("--repeats", type=int, default=400, help="batches of 50 calls per case")
+    parser.add_argument(
+        "--repeats", type=count_argument(), default=400, help="batches of 50 calls per case"
+    )
     args = parser.parse_args()
 
     rng = np.random.default_rng(0)

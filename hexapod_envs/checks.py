@@ -64,3 +64,21 @@ def range_text(low: float | None, high: float | None, strict: bool = False) -> s
     if high is not None:
         parts.append(f"<= {high:g}")
     return " and ".join(parts)
+
+
+def count_argument(low: int = 1, high: int | None = None) -> Any:
+    """An argparse ``type`` for a whole number within [`low`, `high`] (a count of tasks, resets,
+    repeats...): the scripts' bad counts become argparse errors that name the valid range."""
+    import argparse
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            value = None
+        if value is None or value < low or (high is not None and value > high):
+            bound = f">= {low}" if high is None else f"in [{low}, {high}]"
+            raise argparse.ArgumentTypeError(f"must be a whole number {bound}, got {text!r}")
+        return value
+
+    return parse

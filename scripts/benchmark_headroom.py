@@ -16,6 +16,7 @@ import numpy as np
 import hexapod_envs
 from agents.pipeline.headroom import format_table, headroom
 from hexapod_envs.benchmark import BENCHMARK_SEEDS, V1_KWARGS
+from hexapod_envs.checks import count_argument
 
 
 def mean_difficulty(env_id: str, distribution: str, n: int) -> float:
@@ -28,7 +29,12 @@ def mean_difficulty(env_id: str, distribution: str, n: int) -> float:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--tasks", type=int, default=len(BENCHMARK_SEEDS))
+    parser.add_argument(
+        "--tasks",
+        type=count_argument(1, len(BENCHMARK_SEEDS)),
+        default=len(BENCHMARK_SEEDS),
+        help=f"the first N benchmark test tasks (1-{len(BENCHMARK_SEEDS)})",
+    )
     parser.add_argument("--env", action="append", choices=sorted(V1_KWARGS))
     args = parser.parse_args()
     print(f"hexapod_envs {hexapod_envs.__version__}")

@@ -104,11 +104,17 @@ def summary_line(model: str, record: dict) -> str:
     (s0, s1), (t0, t1) = (
         (record[k]["step0"], record[k]["trained"]) for k in ("successes", "tip_overs")
     )
-    n, (lo, hi), (rlo, rhi) = record["tasks"], record["success_interval"], record["return_interval"]
+    n = record["tasks"]
+
+    def interval(key: str, digits: int) -> str:
+        found = record[key]  # None: fewer than two paired tasks
+        return "n/a" if found is None else ", ".join(f"{x:+.{digits}f}" for x in found)
+
     return (
         f"{model} on {record['env_id']}: step 0 {s0}/{n} successes ({t0} tip-overs), trained "
-        f"{s1}/{n} ({t1}); success {(s1 - s0) / n:+.3f} [{lo:+.3f}, {hi:+.3f}], return "
-        f"{record['return_change']:+.1f} [{rlo:+.1f}, {rhi:+.1f}]: {record['verdict']}"
+        f"{s1}/{n} ({t1}); success {(s1 - s0) / n:+.3f} [{interval('success_interval', 3)}], "
+        f"return {record['return_change']:+.1f} [{interval('return_interval', 1)}]: "
+        f"{record['verdict']}"
     )
 
 
@@ -122,6 +128,10 @@ def main(argv: list[str] | None = None) -> int:
     )
     parser.add_argument("--output-dir", type=Path, default=Path("reports/step0_check"))
     args = parser.parse_args(argv)
+    if args.episodes < 2:
+        parser.error(
+            f"--episodes must be >= 2 (a paired interval needs two tasks), got {args.episodes}"
+        )
     summary_path = args.output_dir / SUMMARY_FILE
     summary = json.loads(summary_path.read_text()) if summary_path.is_file() else {}
     for model in args.models:

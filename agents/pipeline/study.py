@@ -76,6 +76,7 @@ def expand_studies(suite: EvaluationSuite) -> tuple[EvaluationSuite, list[Study]
                 "of its trials' run directories as the reference instead"
             )
         study = Study(name, sweep_dir)
+        varied: set[str] = set()
         for trial in trial_dirs(sweep_dir):
             try:  # the model evaluated: best/ > final/ > the latest checkpoint
                 evaluated = find_model(trial).directory
@@ -84,18 +85,28 @@ def expand_studies(suite: EvaluationSuite) -> tuple[EvaluationSuite, list[Study]
                 continue
             info_path = trial / TRIAL_FILE
             info = json.loads(info_path.read_text()) if info_path.is_file() else {}
+            varied.update(o.split("=", 1)[0] for o in info.get("overrides", []))
             label = " ".join(info.get("overrides", [])) or trial.name
             study.members[f"{PPO_PREFIX}{trial}"] = f"{label}{checkpoint_note(evaluated)}"
         if not study.members:
             raise UserError(f"{name}: the sweep directory {sweep_dir} holds no trained trial")
+        if varied - {"train.seed"}:
+            warnings.append(
+                f"{name}: its trials vary {sorted(varied - {'train.seed'})}, not the training "
+                "seed alone; the study pools them as if they were seeds of one policy"
+            )
         policies.extend(m for m in study.members if m not in policies)
         studies.append(study)
     return dataclasses.replace(suite, policies=policies), studies, warnings
 
 
-def _interval(matrix: np.ndarray, aggregate: Any, point: str) -> dict[str, float]:
-    """{point: estimate, ci_low, ci_high} of `aggregate` by rliable's stratified bootstrap."""
+def _interval(matrix: np.ndarray, aggregate: Any, point: str) -> dict[str, float | None]:
+    """{point: estimate, ci_low, ci_high} of `aggregate` by rliable's stratified bootstrap over
+    the rows (training seeds); no interval (None) from a single seed."""
     from rliable import library as rly
+
+    if len(matrix) < 2:
+        return {point: float(aggregate(matrix)), "ci_low": None, "ci_high": None}
 
     # rliable's StratifiedBootstrap draws its resampling indices from NumPy's global generator
     # (its random_state argument only reaches arch's unused generator); seed that for reproducible
@@ -161,6 +172,12 @@ def _pct(x: float) -> str:
     return f"{100 * x:.0f} %"
 
 
+def _ci(stats: dict[str, Any], show: Any) -> str:
+    if stats["ci_low"] is None:
+        return "no CI from one training seed"
+    return f"95 % CI {show(stats['ci_low'])} to {show(stats['ci_high'])}"
+
+
 INTRO = (
     "Each study is one policy trained with several training seeds (a sweep directory); every "
     "seed's model ran the same evaluation episodes. CI: 95 % stratified-bootstrap confidence "
@@ -177,15 +194,14 @@ def study_blocks(stats: dict[str, dict[str, Any]]) -> list[tuple[str, str, list[
         for name, s in studies.items():
             rate, iqm = s.get("success_rate"), s["iqm_return"]
             rate_text = (
-                f"success rate **{_pct(rate['mean'])}** (95 % CI {_pct(rate['ci_low'])} to "
-                f"{_pct(rate['ci_high'])})"
+                f"success rate **{_pct(rate['mean'])}** ({_ci(rate, _pct)})"
                 if rate
                 else "success rate n/a (the env reports no is_success)"
             )
             sentence = (
                 f"{s['n_seeds']} training seeds x {s['n_episodes']} episodes: {rate_text}; "
-                f"IQM return **{iqm['iqm']:.4g}** (95 % CI {iqm['ci_low']:.4g} to "
-                f"{iqm['ci_high']:.4g}); mean return {s['mean_return']:.4g}."
+                f"IQM return **{iqm['iqm']:.4g}** ({_ci(iqm, lambda x: f'{x:.4g}')}); "
+                f"mean return {s['mean_return']:.4g}."
             )
             rows = [
                 [

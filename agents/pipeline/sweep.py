@@ -112,8 +112,15 @@ def _make_reporter(node: dict[str, Any], on_eval: Any) -> Any:
     return TuneReport()
 
 
-def run_trial(params: dict[str, Any], sweep: LoadedSweep, sweep_dir: str, command: str) -> None:
-    """Ray Tune function trainable: train one run (or continue it after an interruption)."""
+def run_trial(
+    params: dict[str, Any],
+    sweep: LoadedSweep,
+    sweep_dir: str,
+    command: str,
+    trust_pickle: bool = False,
+) -> None:
+    """Ray Tune function trainable: train one run (or continue it after an interruption;
+    `trust_pickle` as ``train.py --resume --trust-pickle`` for a run with pickled files)."""
     import torch
     from ray import tune
 
@@ -155,7 +162,9 @@ def run_trial(params: dict[str, Any], sweep: LoadedSweep, sweep_dir: str, comman
         result = start_training(config, sweep_dir, name, command=command, after_eval=reporter)
     elif done < config.train.total_timesteps:
         save_info()
-        result = resume_training(run_dir, command=command, after_eval=reporter)
+        result = resume_training(
+            run_dir, command=command, after_eval=reporter, trust_pickle=trust_pickle
+        )
     save_info(interrupted=bool(result and result.interrupted))
     if reporter.reported == 0:  # nothing evaluated in this attempt: report the run's last eval
         rows = eval_rows(run_dir)
@@ -198,11 +207,17 @@ def _check_reachable(address: str, timeout_s: float = 5.0) -> None:
         ) from None
 
 
-def _tuner_parts(sweep: LoadedSweep, sweep_dir: Path, command: str) -> tuple[Any, dict]:
+def _tuner_parts(
+    sweep: LoadedSweep, sweep_dir: Path, command: str, trust_pickle: bool = False
+) -> tuple[Any, dict]:
     from ray import tune
 
     trainable = tune.with_parameters(
-        run_trial, sweep=sweep, sweep_dir=str(sweep_dir.resolve()), command=command
+        run_trial,
+        sweep=sweep,
+        sweep_dir=str(sweep_dir.resolve()),
+        command=command,
+        trust_pickle=trust_pickle,
     )
     trainable = tune.with_resources(trainable, {"cpu": sweep.config.cpus_per_trial})
     space = {key: domain.to_tune() for key, domain in sweep.config.space.items()}
@@ -255,6 +270,7 @@ def run_sweep(
     command: str | None = None,
     address: str | None = None,
     max_concurrent: int | None = None,
+    trust_pickle: bool = False,
 ) -> SweepResult:
     """Create the sweep directory, run every trial on Ray Tune, write the summaries."""
     from ray import tune
@@ -265,8 +281,8 @@ def run_sweep(
     check_env(sweep.base_config)  # before the sweep directory exists, as is:
     if address is not None:
         _check_reachable(address)
-    stem = sweep.config.name or (sweep.path.stem if sweep.path else "sweep")
-    name = name or f"{stem}__{time.strftime('%Y%m%d-%H%M%S')}"
+    stem = sweep.path.stem if sweep.path else "sweep"
+    name = name or sweep.config.name or f"{stem}__{time.strftime('%Y%m%d-%H%M%S')}"
     sweep_dir = prepare_new_dir(
         Path(output_dir) / name, force, "sweep directory", (SWEEP_FILE,)
     ).resolve()
@@ -277,7 +293,7 @@ def run_sweep(
     (sweep_dir / BASE_FILE).write_text(dump_yaml(sweep.base_data))
     (sweep_dir / "command.txt").write_text(command + "\n")
     _init_ray(address, max_concurrent, sweep.config.cpus_per_trial)
-    trainable, space = _tuner_parts(sweep, sweep_dir, command)
+    trainable, space = _tuner_parts(sweep, sweep_dir, command, trust_pickle)
     tuner = tune.Tuner(
         trainable,
         param_space=space,
@@ -292,8 +308,10 @@ def resume_sweep(
     command: str | None = None,
     address: str | None = None,
     max_concurrent: int | None = None,
+    trust_pickle: bool = False,
 ) -> SweepResult:
-    """Continue an interrupted sweep: unfinished and errored trials resume from checkpoints."""
+    """Continue an interrupted sweep: unfinished and errored trials resume from checkpoints,
+    with the concurrency the sweep started with unless `max_concurrent` is given."""
     from ray import tune
 
     sweep_dir = Path(sweep_dir).resolve()
@@ -305,15 +323,16 @@ def resume_sweep(
     command = command or command_line()
     with open(sweep_dir / "command.txt", "a") as fh:
         fh.write(command + "\n")
+    asked = max_concurrent
     max_concurrent = _default_concurrency(address, max_concurrent)
     _init_ray(address, max_concurrent, sweep.config.cpus_per_trial)
-    trainable, _ = _tuner_parts(sweep, sweep_dir, command)
+    trainable, _ = _tuner_parts(sweep, sweep_dir, command, trust_pickle)
     tuner = tune.Tuner.restore(
         str(sweep_dir / RAY_DIR), trainable, resume_unfinished=True, restart_errored=True
     )
-    if max_concurrent is not None:
-        with contextlib.suppress(AttributeError):  # concurrency is part of the restored state
-            tuner._local_tuner._tune_config.max_concurrent_trials = max_concurrent
+    if asked is not None:  # else the restored state's (the sweep's start)
+        with contextlib.suppress(AttributeError):
+            tuner._local_tuner._tune_config.max_concurrent_trials = asked
     return _fit(tuner, sweep, sweep_dir)
 
 
@@ -370,7 +389,9 @@ def sweep_main(args: Any, command: str) -> int:
     if args.resume is not None:
         if args.overrides or args.run_name or args.force:
             raise UserError("--set, --run-name and --force do not apply to resuming a sweep")
-        result = resume_sweep(args.resume, command, args.address, args.max_concurrent)
+        result = resume_sweep(
+            args.resume, command, args.address, args.max_concurrent, args.trust_pickle
+        )
     else:
         sweep = load_sweep(args.sweep, args.overrides)
         result = run_sweep(
@@ -381,6 +402,7 @@ def sweep_main(args: Any, command: str) -> int:
             command=command,
             address=args.address,
             max_concurrent=args.max_concurrent,
+            trust_pickle=args.trust_pickle,
         )
     for line in result.errors:
         print(f"trial error: {line}", file=sys.stderr)

@@ -161,7 +161,7 @@ class SweepConfig:
     space: dict[str, Domain] = field(metadata={"parse": _parse_space})
     fixed: dict[str, Any] = field(default_factory=dict, metadata={"parse": _parse_fixed})
     # fixed: dotted key -> value, set on every trial
-    name: str | None = None  # sweep directory name (default: the sweep file's stem + time)
+    name: str | None = None  # sweep directory name, as given (default: the file's stem + time)
     num_samples: int = 1
     metric: Literal["eval_success_rate", "eval_mean_reward"] = "eval_success_rate"
     mode: Literal["max", "min"] = "max"

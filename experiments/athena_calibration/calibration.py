@@ -274,9 +274,14 @@ the harder impedance with the lower armature (which did not: row 9 +10.2 %)."""
 def main(argv=None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--grid", choices=sorted(GRIDS), default="main")
-    ap.add_argument("--out", type=Path, default=RESULTS)
-    ap.add_argument("--seeds", type=int, default=4)
-    ap.add_argument("--steps", type=int, default=1200)
+    ap.add_argument(
+        "--out",
+        type=Path,
+        help=f"results file appended to (default: {RESULTS.name}; with --validate "
+        f"{VALIDATION.name}, both beside this script)",
+    )
+    ap.add_argument("--seeds", type=int, default=4, help="grid runs: seeds per setting")
+    ap.add_argument("--steps", type=int, default=1200, help="grid runs: steps per episode")
     ap.add_argument("--table", type=Path, help="print the table of this results file and exit")
     ap.add_argument(
         "--validate", type=json.loads, help='env settings (JSON) to validate, or "all": VALIDATED'
@@ -287,13 +292,13 @@ def main(argv=None) -> None:
         return
     if args.validate is not None:
         for kwargs in VALIDATED if args.validate == "all" else [args.validate]:
-            result = validate(kwargs)
-            with open(VALIDATION, "a") as f:
+            result = validate(kwargs)  # its own protocol: ramp seeds 4-11, beds 0-19
+            with open(args.out or VALIDATION, "a") as f:
                 f.write(json.dumps(result) + "\n")
             print(json.dumps(result), flush=True)
         return
     log = lambda line: print(line, flush=True)  # noqa: E731
-    run(GRIDS[args.grid], args.out, range(args.seeds), args.steps, log=log)
+    run(GRIDS[args.grid], args.out or RESULTS, range(args.seeds), args.steps, log=log)
 
 
 if __name__ == "__main__":

@@ -31,19 +31,26 @@ ENV_ID = "HexapodIrregularTerrain-v1"
 RANGE_M = 0.05
 """The knob's range here (the setting's largest): an offset of x m is the action x / RANGE_M."""
 FIRST_SEED = 1000
+MAX_SEEDS_PER_TASK = 100
+"""Seeds tried per task wanted before giving up (a difficulty no training task reaches)."""
 
 
 def hard_train_seeds(count: int, min_difficulty: float) -> list[int]:
     """The first `count` training-task seeds from `FIRST_SEED` whose task difficulty is at least
     `min_difficulty` (the env draws the task at reset, before any physics)."""
     env = gym.make(ENV_ID, task_distribution="train")
-    seeds, seed = [], FIRST_SEED
-    while len(seeds) < count:
+    seeds, seed, last = [], FIRST_SEED, FIRST_SEED + MAX_SEEDS_PER_TASK * count
+    while len(seeds) < count and seed < last:
         _, info = env.reset(seed=seed)
         if info["task"]["difficulty"] >= min_difficulty:
             seeds.append(seed)
         seed += 1
     env.close()
+    if len(seeds) < count:
+        raise SystemExit(
+            f"only {len(seeds)} of seeds {FIRST_SEED}-{last - 1} give a training task of "
+            f"difficulty >= {min_difficulty}; lower --min-difficulty (the hardest are about 0.85)"
+        )
     return seeds
 
 

@@ -31,6 +31,7 @@ import torch
 import hexapod_envs  # noqa: F401  (registers the ids)
 from agents.registry import ANALYTICAL_ENV_KWARGS, analytical_factory
 from hexapod_envs import info_keys as keys
+from hexapod_envs.checks import count_argument
 
 
 class Clone:
@@ -112,11 +113,15 @@ def episode(
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("env_id")
-    parser.add_argument("--episodes", type=int, default=8, help="training tasks per round")
-    parser.add_argument("--rounds", type=int, default=2, help="DAgger rounds after round 0")
+    parser.add_argument(
+        "--episodes", type=count_argument(), default=8, help="training tasks per round"
+    )
+    parser.add_argument(
+        "--rounds", type=count_argument(0), default=2, help="DAgger rounds after round 0"
+    )
     parser.add_argument("--epochs", type=int, default=60)
     parser.add_argument("--noise", type=float, default=0.1)
-    parser.add_argument("--tests", type=int, default=10, help="benchmark test tasks")
+    parser.add_argument("--tests", type=count_argument(0), default=10, help="benchmark test tasks")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument(
         "--action-mode", help="the env's action mode (default: the controller's, e.g. joint)"
@@ -136,6 +141,8 @@ def main() -> None:
         "training tasks (how precisely a clone must copy it) and stop",
     )
     args = parser.parse_args()
+    if args.task_inputs and not args.env_id.startswith("HexapodDitchCrossing"):
+        parser.error(f"--task-inputs is for HexapodDitchCrossing ids, not {args.env_id}")
     kwargs = dict(ANALYTICAL_ENV_KWARGS.get(args.env_id, {}))
     if args.action_mode:
         kwargs["action_mode"] = args.action_mode

@@ -1,6 +1,7 @@
 """The shared argument checks: finite numbers in range pass as floats, the rest name themselves."""
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -32,3 +33,18 @@ def test_the_settings_checks_share_the_wording():
         check_real("x", "a", (1, "a"))
     with pytest.raises(ValueError, match=r"flag must be one of \[False, True\], got 1"):
         check_choice("flag", 1, (True, False))
+
+
+def test_a_count_argument_takes_whole_numbers_in_range_and_names_the_range():
+    import argparse
+
+    from hexapod_envs.checks import count_argument
+
+    assert count_argument()("3") == 3 and count_argument(0)("0") == 0
+    for parse, text, bound in (
+        (count_argument(), "0", ">= 1"),
+        (count_argument(1, 50), "51", "in [1, 50]"),
+        (count_argument(), "2.5", ">= 1"),
+    ):
+        with pytest.raises(argparse.ArgumentTypeError, match=rf"whole number {re.escape(bound)}"):
+            parse(text)

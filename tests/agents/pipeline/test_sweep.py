@@ -201,6 +201,15 @@ def test_study_interval_is_the_rliable_stratified_bootstrap():
     assert a["ci_low"] == pytest.approx(low, abs=0.02)
     assert a["ci_high"] == pytest.approx(high, abs=0.02)
     assert a["ci_low"] < 0.6 < a["ci_high"]
+    # one training seed: its estimate and no interval (a bootstrap of one row is that row)
+    one = _interval(per_seed[:1] + 0.5, metrics.aggregate_mean, "mean")
+    assert one == {"mean": 0.5, "ci_low": None, "ci_high": None}
+    from agents.pipeline.study import study_blocks
+
+    stats = {"n_seeds": 1, "n_episodes": 2, "mean_return": 3.0, "seeds": []}
+    stats |= {"success_rate": one, "iqm_return": {"iqm": 3.0, "ci_low": None, "ci_high": None}}
+    (block,) = study_blocks({"Env-v1": {"study": stats}})
+    assert "success rate **50 %** (no CI from one training seed)" in block[1]
 
 
 def test_sweep_flags_are_checked(tmp_path):
