@@ -228,12 +228,8 @@ def evaluate_main(argv: Sequence[str] | None = None, prog: str = "evaluate.py") 
         if args.envs:
             entries, unlisted = _suite_envs(args.config, args.envs)
             overrides.append(f"envs={json.dumps(entries)}")
-            default_suite = args.config is None
-            if (
-                default_suite
-                and unlisted
-                and not any(o.startswith("title=") for o in args.overrides)
-            ):
+            titled = any(o.startswith("title=") for o in args.overrides)
+            if args.config is None and unlisted and not titled:
                 # an env the default suite does not list: its title ("benchmark v1") may not hold
                 overrides.append(f"title={json.dumps(DEFAULT_TITLE)}")
         for key, value in (
