@@ -192,5 +192,10 @@ def test_a_model_inside_a_run_reads_the_runs_evaluation_log(tmp_path):
     for sub in ("best", "final", "checkpoints/step_000000000100"):
         assert training_evaluations(run / sub)["evaluations"] == 2
     (tmp_path / "loose" / "model").mkdir(parents=True)
-    np.savez(tmp_path / "loose" / "evaluations.npz", timesteps=np.array([0]))
+    np.savez(
+        tmp_path / "loose" / "evaluations.npz",
+        timesteps=np.array([0]),
+        results=np.ones((1, 1)),
+        ep_lengths=np.ones((1, 1)),
+    )
     assert training_evaluations(tmp_path / "loose" / "model") is None

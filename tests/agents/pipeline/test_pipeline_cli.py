@@ -114,7 +114,9 @@ def test_the_evaluation_log_and_best_are_in_place_before_the_after_eval_callback
             )
             return True
 
-    config = load_train_config(data=load_yaml(CONFIG), overrides=TINY)
+    # eval.select: success keeps best/ through our callback (SB3's own saving, for "reward",
+    # already ran before the after-eval callback)
+    config = load_train_config(data=load_yaml(CONFIG), overrides=[*TINY, "eval.select=success"])
     start_training(config, tmp_path, "r", after_eval=Check())
     assert [logged for logged, _ in seen] == [0, 512, 1024]  # each callback sees its own row
     assert seen[0][1] == 0  # and best/ already holds the step-0 policy at the first one
@@ -163,6 +165,12 @@ def test_existing_run_dir_is_not_overwritten_without_force(run, capsys):
     assert train(run_dir.parent, "tiny") == 2
     assert "already exists; pass --force" in capsys.readouterr().err
     assert meta(run_dir / "final") == before
+    # --force replaces an earlier run only, not a directory without a run's config.yaml
+    (run_dir.parent / "notes").mkdir()
+    (run_dir.parent / "notes" / "todo.txt").write_text("keep")
+    assert train(run_dir.parent, "notes", "--force") == 2
+    assert "is not an earlier run directory" in capsys.readouterr().err
+    assert (run_dir.parent / "notes" / "todo.txt").is_file()
 
 
 def test_config_typo_lists_valid_keys(tmp_path, capsys):
@@ -368,6 +376,13 @@ def test_the_default_report_is_replaced_on_a_second_run_other_reports_need_force
     # a -v0 id is no part of the default suite (the v1 benchmark): the title says no more
     title = (tmp_path / "reports" / "default" / "report.md").read_text().splitlines()[0]
     assert title.startswith("# Hexapod policy evaluation") and "v1" not in title
+    listed = [a if a != "HexapodCliffWalk-v0" else "HexapodCliffWalk-v1" for a in argv]
+    for extra, expected in (
+        (listed, "# Hexapod benchmark v1"),
+        ([*argv, "--set", "title=Mine"], "# Mine"),
+    ):
+        assert evaluate_main([*extra, "--output-dir", "titled", "--force"]) == 0
+        assert (tmp_path / "titled" / "report.md").read_text().startswith(expected)
     assert evaluate_main([*argv, "--output-dir", "reports/default"]) == 0  # the same directory
     assert evaluate_main([*argv, "--output-dir", "mine"]) == 0
     capsys.readouterr()

@@ -374,6 +374,25 @@ def test_an_env_whose_episodes_all_ran_one_task_says_so():
     assert "Every episode ran the same task" not in _env_setup_text(result)
 
 
+def test_the_rules_cells_name_each_bound_and_dash_the_missing_ones():
+    from agents.pipeline.report import _rule_cells
+
+    cliff = {
+        "tip_over_angle_deg": 15.0,
+        "tip_over_margin_time": 1.0,
+        "success_max_tilt_deg": 8.0,
+        "success_max_tipping_share": 0.1,
+    }
+    assert _rule_cells(cliff) == [
+        "tilt > 15°, or FASM <= 0 for 1 s",
+        "<= 8°",
+        "<= 10 % of the episode",
+    ]
+    v0 = dict.fromkeys(cliff) | {"tip_over_angle_deg": 20.0}
+    assert _rule_cells(v0) == ["tilt > 20°", "-", "-"]
+    assert _rule_cells({}) == ["-", "-", "-"]  # an env without the settings
+
+
 def test_ppo_policies_get_short_unambiguous_aliases():
     from agents.pipeline.evaluation import policy_aliases
 

@@ -144,6 +144,8 @@ def test_config_errors_name_the_choices():
         ({"threshold_deg": float("nan")}, "threshold_deg must be a finite number"),
         ({"cone_ratios": (0.65, 1.2)}, "cone_ratios must be values in"),
         ({"swing_clearance": -0.1}, "swing_clearance"),
+        ({"arm_after": -1.0}, "arm_after"),
+        ({"angle_threshold_deg": 200.0}, "angle_threshold_deg"),
     ):
         with pytest.raises(ValueError, match=match):
             RecoveryConfig(**kwargs)

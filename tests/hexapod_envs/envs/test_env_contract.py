@@ -133,7 +133,10 @@ def test_rendering_without_an_opengl_context_says_to_set_mujoco_gl():
     import subprocess
     import sys
 
+    from helpers.paths import REPO
+
     env = {k: v for k, v in os.environ.items() if k not in ("MUJOCO_GL", "DISPLAY")}
+    env["PYTHONPATH"] = os.pathsep.join([str(REPO), env.get("PYTHONPATH", "")])
     code = (
         "import gymnasium as gym, hexapod_envs\n"
         "env = gym.make('HexapodCliffWalk-v1', render_mode='rgb_array', width=32, height=24)\n"
@@ -141,11 +144,37 @@ def test_rendering_without_an_opengl_context_says_to_set_mujoco_gl():
         "env.render()\n"
         "print('rendered')\n"
     )
-    run = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True)
+    run = subprocess.run(
+        [sys.executable, "-c", code], env=env, cwd=REPO, capture_output=True, text=True, timeout=300
+    )
     if "rendered" in run.stdout:
         pytest.skip("this machine renders without MUJOCO_GL and a display")
     assert "RuntimeError: rendering needs an OpenGL context" in run.stderr, run.stderr[-2000:]
     assert "MUJOCO_GL=egl" in run.stderr
+
+
+def test_a_missing_opengl_context_becomes_an_error_that_names_mujoco_gl(monkeypatch):
+    """The same on any machine: a renderer whose render() meets MuJoCo's no-context error."""
+    from hexapod_envs.envs import base
+
+    class FailingRenderer:
+        message = "an OpenGL platform library has not been loaded"
+
+        def render(self, mode):
+            raise mujoco.FatalError(self.message)
+
+        def close(self):
+            pass
+
+    renderer = FailingRenderer()
+    monkeypatch.setattr(base, "make_renderer", lambda *args: renderer)
+    env = gym.make("HexapodCliffWalk-v1", render_mode="rgb_array")
+    env.reset(seed=0)
+    with pytest.raises(RuntimeError, match="set MUJOCO_GL=egl"):
+        env.render()
+    renderer.message = "another fatal error"  # passed on as it is
+    with pytest.raises(mujoco.FatalError, match="another fatal error"):
+        env.render()
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
