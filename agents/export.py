@@ -32,7 +32,6 @@ import argparse
 import json
 import os
 import warnings
-import zipfile
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -43,7 +42,7 @@ import numpy as np
 from .knobs import KNOB_RANGES, PLANNER_KNOB_RANGES, settings_from_config
 from .pipeline.callbacks import evaluation_score
 from .pipeline.cli import _add_trust_pickle_option, _run
-from .pipeline.learning_curve import evaluation_log
+from .pipeline.learning_curve import evaluation_log, read_evaluation_log
 from .plan_knobs import COURSE_FEATURES, course_space
 from .policy import LearnedWithController
 from .run_files.artifacts import ModelFiles, find_model, learner_step_unit, read_meta
@@ -240,12 +239,9 @@ def training_evaluations(model_dir: Path, select: str = "reward") -> dict[str, A
     path = evaluation_log(model_dir)
     if path is None:
         return None
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            steps, results = data["timesteps"], np.asarray(data["results"], dtype=float)
-            successes = data["successes"] if "successes" in data.files else None
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
-        raise UserError(f"the evaluation log {path} is damaged ({exc})") from None
+    arrays = read_evaluation_log(path, required=("timesteps", "results"))
+    steps, results = arrays["timesteps"], np.asarray(arrays["results"], dtype=float)
+    successes = arrays.get("successes")
     if len(steps) == 0:
         return None
 

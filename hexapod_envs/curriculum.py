@@ -62,6 +62,8 @@ class DifficultyCurriculum(gym.Wrapper):
         self.window, self.max_draws = int(window), int(max_draws)
         self.promote_at, self.demote_at = float(promote_at), float(demote_at)
         self._results: list[bool] = []
+        self.warned = False
+        """Whether a reset has warned that no draw met the level (said once)."""
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         obs, info = _draw(
@@ -99,6 +101,8 @@ class MinimumDifficulty(gym.Wrapper):
         if int(max_draws) < 1:
             raise ValueError(f"max_draws must be >= 1, got {max_draws!r}")
         self.max_draws = int(max_draws)
+        self.warned = False
+        """Whether a reset has warned that no draw met the minimum (said once)."""
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
         return _draw(
@@ -125,8 +129,8 @@ def _draw(wrapper: gym.Wrapper, seed, options, max_draws: int, accept, wanted: s
         obs, info = env.reset(options=options)  # the next task from np_random
         draws += 1
     accepted = bool(accept(info["task"]["difficulty"]))
-    if not accepted and not getattr(wrapper, "_warned", False):
-        wrapper._warned = True
+    if not accepted and not wrapper.warned:
+        wrapper.warned = True
         warnings.warn(
             f"{type(wrapper).__name__}: none of {draws} tasks drawn had a difficulty {wanted}; "
             f"the reset keeps the last (difficulty {info['task']['difficulty']:.2f}, "

@@ -70,6 +70,23 @@ def evaluation_log(model_dir: str | Path) -> Path | None:
     return None
 
 
+def read_evaluation_log(
+    path: str | Path, required: tuple[str, ...] = ("timesteps", "results", "ep_lengths")
+) -> dict[str, np.ndarray]:
+    """The arrays of an evaluation log as SB3 wrote them (``successes`` absent where it logged
+    none); UserError if the file is damaged (unreadable, truncated, ragged, or without one of
+    the `required` arrays), as a kill during SB3's in-place write could leave it."""
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {name: data[name] for name in data.files}
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise UserError(f"the evaluation log {path} is damaged ({exc})") from None
+    missing = [name for name in required if name not in arrays]
+    if missing:
+        raise UserError(f"the evaluation log {path} is damaged (no {', '.join(missing)})")
+    return arrays
+
+
 def load_learning_curve(run_dir: str | Path) -> LearningCurve:
     """The evaluation log of `run_dir`; UserError if it has none (eval.freq 0, or too early) or
     if it is damaged (unreadable, an array missing, rows of different lengths). SB3 logs
@@ -83,14 +100,12 @@ def load_learning_curve(run_dir: str | Path) -> LearningCurve:
         )
     config = Path(run_dir) / "config.yaml"
     unit = learner_step_unit(yaml.safe_load(config.read_text()) if config.is_file() else None)
-    try:
-        with np.load(path, allow_pickle=False) as data:
-            timesteps = np.asarray(data["timesteps"], dtype=np.int64).reshape(-1)
-            returns = np.asarray(data["results"], dtype=float)
-            lengths = np.asarray(data["ep_lengths"], dtype=np.int64)
-            successes = np.asarray(data["successes"], dtype=float) if "successes" in data else None
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
-        raise UserError(f"the evaluation log {path} is damaged ({exc})") from None
+    arrays = read_evaluation_log(path)
+    timesteps = np.asarray(arrays["timesteps"], dtype=np.int64).reshape(-1)
+    returns = np.asarray(arrays["results"], dtype=float)
+    lengths = np.asarray(arrays["ep_lengths"], dtype=np.int64)
+    successes = arrays.get("successes")
+    successes = None if successes is None else np.asarray(successes, dtype=float)
     n = len(timesteps)
     if returns.ndim != 2 or len(returns) != n or lengths.shape != returns.shape:
         raise UserError(

@@ -15,7 +15,6 @@ import signal
 import sys
 import threading
 import time
-import zipfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from functools import partial
@@ -57,7 +56,7 @@ from ..run_files.model_files import (
 from ..run_files.train_config import TrainConfig, load_train_config
 from .envs import EnvSpec, env_time_step, make_vec_env
 from .episode import XI_F_DEG, EpisodeAccumulator, metric_specs
-from .learning_curve import EVALUATIONS_FILE
+from .learning_curve import EVALUATIONS_FILE, read_evaluation_log
 
 EVAL_SEED_OFFSET = 10_000
 """Evaluation envs are seeded apart from the training envs."""
@@ -672,22 +671,18 @@ def _restore_eval_history(eval_cb: Any, run_dir: Path, done: int) -> None:
     if not log.is_file():
         return
     try:
-        with np.load(log, allow_pickle=False) as data:
-            eval_cb.evaluations_timesteps = list(data["timesteps"])
-            eval_cb.evaluations_results = [list(r) for r in data["results"]]
-            eval_cb.evaluations_length = [list(r) for r in data["ep_lengths"]]
-            if "successes" in data:
-                eval_cb.evaluations_successes = [list(r) for r in data["successes"]]
-        if eval_cb.select_saver is not None and eval_cb.evaluations_results:
-            eval_cb.best_score = max(
-                eval_cb.score(i) for i in range(len(eval_cb.evaluations_results))
-            )
-        kept = sum(1 for t in eval_cb.evaluations_timesteps if t <= done)
-        for name in ("timesteps", "results", "length", "successes"):
-            entries = getattr(eval_cb, f"evaluations_{name}")
-            del entries[kept:]
-    except (OSError, ValueError, KeyError, EOFError, zipfile.BadZipFile) as exc:
-        print(
-            f"warning: the evaluation log {log} is unreadable ({exc}); it starts anew",
-            file=sys.stderr,
-        )
+        data = read_evaluation_log(log)
+    except UserError as exc:
+        print(f"warning: {exc}; it starts anew", file=sys.stderr)
+        return
+    eval_cb.evaluations_timesteps = list(data["timesteps"])
+    eval_cb.evaluations_results = [list(r) for r in data["results"]]
+    eval_cb.evaluations_length = [list(r) for r in data["ep_lengths"]]
+    if "successes" in data:
+        eval_cb.evaluations_successes = [list(r) for r in data["successes"]]
+    if eval_cb.select_saver is not None and eval_cb.evaluations_results:
+        eval_cb.best_score = max(eval_cb.score(i) for i in range(len(eval_cb.evaluations_results)))
+    kept = sum(1 for t in eval_cb.evaluations_timesteps if t <= done)
+    for name in ("timesteps", "results", "length", "successes"):
+        entries = getattr(eval_cb, f"evaluations_{name}")
+        del entries[kept:]
