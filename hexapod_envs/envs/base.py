@@ -35,7 +35,13 @@ from .physics import (
     step_without_sensors,
     substeps_for,
 )
-from .rendering import check_camera, make_renderer, set_visual_options
+from .rendering import (
+    check_camera,
+    close_renderer,
+    make_renderer,
+    render_frame,
+    set_visual_options,
+)
 from .safety import SafetyFigures
 from .settings import RENDER_MODES, EnvSettings
 from .task import TaskDescription
@@ -202,7 +208,7 @@ class HexapodEnv(SafetyFigures, gym.Env):
             or np.any(getattr(m, "sensor_delay", 0))
         )
         if self._renderer is not None:
-            self._renderer.close()
+            close_renderer(self._renderer)
             self._renderer = None
         self._bind_model()
 
@@ -210,13 +216,16 @@ class HexapodEnv(SafetyFigures, gym.Env):
         """A deep copy (MuJoCo model and data, controllers, RNG) that observes itself: the
         observation readers close over ``self`` and `copy.deepcopy` shares functions, so the
         copy's layout is rebuilt from its own `_observation_pieces`. Look-ahead and
-        common-random-number rollouts step such copies (`hexapod_envs.wrappers.GainsPerCycle`)."""
+        common-random-number rollouts step such copies (`hexapod_envs.wrappers.GainsPerCycle`).
+        The renderer (an OpenGL context, which cannot be copied) is not: the copy makes its own
+        at its first `render()`."""
         cls = type(self)
         new = cls.__new__(cls)
         memo[id(self)] = new
         for key, value in self.__dict__.items():
-            if key != "observation_layout":
+            if key not in ("observation_layout", "_renderer"):
                 new.__dict__[key] = copy.deepcopy(value, memo)
+        new._renderer = None
         new.observation_layout = ObservationLayout(new._observation_pieces())
         return new
 
@@ -546,7 +555,7 @@ class HexapodEnv(SafetyFigures, gym.Env):
                 self.model, self.data, self._camera_name, self._render_size
             )
         try:
-            return self._renderer.render(self.render_mode)
+            return render_frame(self._renderer, self.render_mode)
         except mujoco.FatalError as error:
             if "OpenGL" not in str(error):
                 raise
@@ -558,5 +567,5 @@ class HexapodEnv(SafetyFigures, gym.Env):
 
     def close(self):
         if self._renderer is not None:
-            self._renderer.close()
+            close_renderer(self._renderer)
             self._renderer = None

@@ -52,3 +52,26 @@ def make_renderer(
         height=size[1],
         camera_id=cam_id,
     )
+
+
+def render_frame(renderer: Any, render_mode: str) -> Any:
+    """`renderer.render(render_mode)` with its viewer's OpenGL context made current first.
+
+    Gymnasium's `MujocoRenderer` makes a context current only when one renderer holds two
+    viewers. With two envs rendering in one process, a frame would then be drawn in the context
+    made last, with the other env's meshes and textures: a wrong picture, or a black one once
+    the other env is closed."""
+    renderer._get_viewer(render_mode).make_context_current()
+    return renderer.render(render_mode)
+
+
+def close_renderer(renderer: Any) -> None:
+    """Close `renderer`'s viewers, each freeing its MuJoCo render context (`MjrContext`: the
+    framebuffers, textures and meshes on the GPU) with its own OpenGL context current.
+
+    Freed later, by garbage collection, the context's objects would be deleted by number in
+    whichever OpenGL context is current then: another env's, whose frames turn black."""
+    for viewer in renderer._viewers.values():
+        viewer.make_context_current()
+        viewer.con.free()
+    renderer.close()

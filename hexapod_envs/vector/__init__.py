@@ -53,15 +53,41 @@ def make_batched(
     return BatchedVectorEnv([world] * num_envs, nthread=nthread, autoreset_mode=autoreset_mode)
 
 
-def _entry_point(env_entry_point: str) -> Callable[..., BatchedVectorEnv]:
-    def make(num_envs: int = 1, **kwargs: Any) -> BatchedVectorEnv:
-        return make_batched(env_entry_point, num_envs, **kwargs)
+def _entry_point(name: str, env_entry_point: str) -> Callable[..., BatchedVectorEnv]:
+    def make(
+        num_envs: int = 1, *, max_episode_steps: int | None = None, **kwargs: Any
+    ) -> BatchedVectorEnv:
+        if max_episode_steps is None:  # as gym.make reads None: the registered time limit
+            max_episode_steps = _registered_limit(f"{__name__}:{name}")
+        return make_batched(
+            env_entry_point, num_envs, max_episode_steps=max_episode_steps, **kwargs
+        )
 
-    make.__doc__ = f"`make_batched` of {env_entry_point}."
+    make.__doc__ = (
+        f"`make_batched` of {env_entry_point}; ``max_episode_steps=None`` is the time limit "
+        "of the ids registered with this vector entry point, as ``gym.make`` reads it."
+    )
     return make
 
 
-cliff_walk = _entry_point("hexapod_envs.envs.cliff_walk:CliffWalkEnv")
-stewart_tilt = _entry_point("hexapod_envs.envs.stewart_tilt:StewartTiltEnv")
-irregular_terrain = _entry_point("hexapod_envs.envs.irregular_terrain:IrregularTerrainEnv")
-ditch_crossing = _entry_point("hexapod_envs.envs.ditch_crossing:DitchCrossingEnv")
+def _registered_limit(vector_entry_point: str) -> int | None:
+    """The time limit shared by the ids registered with `vector_entry_point` (None: none)."""
+    limits = {
+        spec.max_episode_steps
+        for spec in gym.registry.values()
+        if spec.vector_entry_point == vector_entry_point
+    }
+    if len(limits) > 1:
+        raise ValueError(
+            f"the ids registered with {vector_entry_point} have different time limits "
+            f"({sorted(limits, key=repr)}); pass max_episode_steps"
+        )
+    return limits.pop() if limits else None
+
+
+cliff_walk = _entry_point("cliff_walk", "hexapod_envs.envs.cliff_walk:CliffWalkEnv")
+stewart_tilt = _entry_point("stewart_tilt", "hexapod_envs.envs.stewart_tilt:StewartTiltEnv")
+irregular_terrain = _entry_point(
+    "irregular_terrain", "hexapod_envs.envs.irregular_terrain:IrregularTerrainEnv"
+)
+ditch_crossing = _entry_point("ditch_crossing", "hexapod_envs.envs.ditch_crossing:DitchCrossingEnv")

@@ -113,6 +113,21 @@ def test_registered_ids_build_batched_worlds_with_their_settings():
         assert envs.single_observation_space == single.observation_space
         envs.close()
         single.close()
+    # None is the registered time limit, as gym.make reads it; a number replaces it.
+    for limit, expected in ((None, 1500), (40, 40)):
+        envs = gym.make_vec(
+            "HexapodCliffWalk-v1",
+            2,
+            vectorization_mode="vector_entry_point",
+            nthread=0,
+            max_episode_steps=limit,
+        )
+        assert (
+            envs.envs[0]._max_episode_steps
+            == expected
+            == gym.make("HexapodCliffWalk-v1", max_episode_steps=limit)._max_episode_steps
+        )
+        envs.close()
 
 
 def test_bad_action_leaves_every_world_alone():

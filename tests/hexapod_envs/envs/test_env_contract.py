@@ -2,6 +2,7 @@
 
 import copy
 import math
+from functools import partial
 
 import gymnasium as gym
 import mujoco
@@ -126,6 +127,34 @@ def test_rgb_render_headless(env_id):
     assert frame.shape == (64, 96, 3) and frame.std() > 0
 
 
+def test_a_rendered_env_deep_copies_and_the_copy_renders_on_its_own():
+    """The renderer's OpenGL context cannot be copied: a copy of a rendered env (look-ahead
+    rollouts copy the env every cycle) makes its own, and both render the same frame."""
+    env = gym.make(ENV_IDS[0], render_mode="rgb_array", width=96, height=64).unwrapped
+    env.reset(seed=0)
+    env.render()
+    twin = copy.deepcopy(env)
+    np.testing.assert_array_equal(twin.render(), env.render())
+    twin.close()
+    assert env.render().std() > 0  # closing the copy leaves the original's renderer alone
+    env.close()
+
+
+def test_envs_rendering_in_turn_each_draw_their_own_scene():
+    """Each env's frame is drawn in its own OpenGL context, also after another env rendered
+    (Gymnasium's renderer leaves the last-made context current) and after it closed."""
+    make = partial(gym.make, render_mode="rgb_array", width=96, height=64)
+    first, second = make(ENV_IDS[0]), make("HexapodIrregularTerrain-v1")
+    first.reset(seed=0)
+    alone = first.render().copy()
+    second.reset(seed=0)
+    second.render()
+    np.testing.assert_array_equal(first.render(), alone)
+    second.close()
+    np.testing.assert_array_equal(first.render(), alone)
+    first.close()
+
+
 def test_rendering_without_an_opengl_context_says_to_set_mujoco_gl():
     """Without MUJOCO_GL and a display MuJoCo finds no OpenGL context: render() says what to
     set instead of MuJoCo's bare FatalError."""
@@ -157,11 +186,15 @@ def test_a_missing_opengl_context_becomes_an_error_that_names_mujoco_gl(monkeypa
     """The same on any machine: a renderer whose render() meets MuJoCo's no-context error."""
     from hexapod_envs.envs import base
 
-    class FailingRenderer:
+    class FailingRenderer:  # as Gymnasium's: the error comes when a viewer is made
         message = "an OpenGL platform library has not been loaded"
+        _viewers = {}
+
+        def _get_viewer(self, mode):
+            raise mujoco.FatalError(self.message)
 
         def render(self, mode):
-            raise mujoco.FatalError(self.message)
+            return self._get_viewer(mode)
 
         def close(self):
             pass
