@@ -43,9 +43,12 @@ def check_real(name: str, value: Any, shown: Any) -> float:
 
 def check_choice(name: str, value: Any, choices) -> None:
     """Raise a ValueError naming `name`, the bad value and the valid choices (a flag among
-    them takes a bool only: 1 is not True here)."""
-    is_flag = any(isinstance(c, bool) for c in choices)
-    if value not in choices or (is_flag and value is not None and not isinstance(value, bool)):
+    them takes a bool only: 1 is not True here; other choices, such as a name, stay valid)."""
+    # A number equal to a flag (1 == True, 0.0 == False) is not that flag.
+    posing = not isinstance(value, bool) and any(
+        isinstance(c, bool) and value == c for c in choices
+    )
+    if value not in choices or posing:
         valid = sorted(choices, key=repr)
         raise ValueError(f"{name} must be one of {valid}, got {value!r}")
 

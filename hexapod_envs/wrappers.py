@@ -276,15 +276,33 @@ class StabilityRulePenalty(gym.Wrapper):
       in swing until then (``swing_until_tipping``, the Stewart tilt's): standing on all six feet
       from the start would otherwise earn the most return and fail every task.
 
+    With `progress_weight` > 0 a fourth term mirrors the rule's progress part on the walking
+    heavy-duty envs (the cliff walk): ``reward_rule_progress`` = -`progress_weight` on every
+    step with ``info["behind_pace"]``, the CoG short of ``min_progress`` of the reference gait's
+    distance so far. A policy that can stop the gait (``clock_action``) otherwise earns the most
+    return by stopping early, safe and short of the distance the rule asks for.
+
     Choose `weight` against the env's alive term (what an upright step earns) so that a tipping
     step costs a visible share of it. A ValueError names the problem for an env without the
-    bound (the -v0 ids) or a weight that is not a positive number.
+    bound (the -v0 ids) or without a pace (for `progress_weight`), or a weight that is not a
+    number >= 0 (`weight` > 0).
     """
 
-    def __init__(self, env: gym.Env, weight: float):
+    def __init__(self, env: gym.Env, weight: float, progress_weight: float = 0.0):
         super().__init__(env)
         if not (np.isfinite(weight) and weight > 0):
             raise ValueError(f"the stability-rule penalty weight must be > 0, got {weight}")
+        if not (np.isfinite(progress_weight) and progress_weight >= 0):
+            raise ValueError(
+                f"the progress-rule penalty weight must be a number >= 0, got {progress_weight}"
+            )
+        self.progress_weight = float(progress_weight)
+        paced = getattr(env.unwrapped, "walks", False) and _rule_setting(env, "min_progress")
+        if self.progress_weight and not paced:
+            raise ValueError(
+                f"{_env_name(env)} has no pace (min_progress) for the progress-rule penalty to "
+                "mirror; the walking heavy-duty envs (HexapodCliffWalk-*) have one"
+            )
         bound = _rule_setting(env, "success_max_tilt_deg")
         if bound is None:
             raise ValueError(
@@ -308,4 +326,8 @@ class StabilityRulePenalty(gym.Wrapper):
             "reward_rule_tilt": tilt,
             "reward_rule_early_landing": landing,
         }
+        if self.progress_weight:
+            progress = -self.progress_weight * float(bool(info.get("behind_pace", False)))
+            info["reward_rule_progress"] = progress
+            reward = float(reward) + progress
         return obs, float(reward) + tipping + tilt + landing, terminated, truncated, info

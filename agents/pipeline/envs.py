@@ -98,6 +98,8 @@ class EnvSpec:
     stability_penalty: float = 0.0
     """Weight of `hexapod_envs.wrappers.StabilityRulePenalty` (the next wrapper: every other
     one sees its penalised rewards); 0: none."""
+    progress_penalty: float = 0.0
+    """`StabilityRulePenalty`'s ``progress_weight`` (walking heavy-duty envs); 0: none."""
 
     def make(self, **extra: Any) -> gym.Env:
         """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
@@ -121,9 +123,9 @@ class EnvSpec:
         if self.stability_penalty:
             from hexapod_envs.wrappers import StabilityRulePenalty
 
-            weight = self.stability_penalty
+            weight, progress = self.stability_penalty, self.progress_penalty
             where = f"env.stability_penalty on {self.id}"
-            env = _wrapped(env, lambda e: StabilityRulePenalty(e, weight), where)
+            env = _wrapped(env, lambda e: StabilityRulePenalty(e, weight, progress), where)
         if self.privileged_critic:
             from ..privileged_critic import PrivilegedObservation
 

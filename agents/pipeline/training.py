@@ -101,6 +101,7 @@ def env_spec(config: TrainConfig) -> EnvSpec:
         env.episode_reward,
         env.min_task_difficulty,
         env.stability_penalty,
+        env.progress_penalty,
     )
 
 

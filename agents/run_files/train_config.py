@@ -91,6 +91,11 @@ class EnvConfig:
     and ``rule_tilt``; -v1 ids): the return then pays for what the v1 success rule demands;
     0: off. Training-time evaluations include it (their returns in ``evaluations.npz`` and the
     return tie-break of ``eval.select``); ``evaluate.py`` reports the env's own return."""
+    progress_penalty: float = 0.0
+    """With ``stability_penalty``: a per-step penalty of this weight while a walking heavy-duty
+    env's CoG is short of the success rule's share of the reference gait's distance so far
+    (``info["behind_pace"]``, term ``rule_progress``; the cliff walk): a policy that can stop
+    the gait (``clock_action``) otherwise earns the most return by stopping early; 0: off."""
     min_task_difficulty: float | None = None
     """Train (and evaluate during training) on the sampled tasks of difficulty at least this
     (`hexapod_envs.curriculum.MinimumDifficulty`, drawn through the env's ``np_random``); None:
@@ -412,6 +417,16 @@ class TrainConfig:
             raise ValueError(
                 f"env.stability_penalty must be a number >= 0 (0: off), got "
                 f"{self.env.stability_penalty}"
+            )
+        if not (self.env.progress_penalty >= 0 and math.isfinite(self.env.progress_penalty)):
+            raise ValueError(
+                f"env.progress_penalty must be a number >= 0 (0: off), got "
+                f"{self.env.progress_penalty}"
+            )
+        if self.env.progress_penalty and not self.env.stability_penalty:
+            raise ValueError(
+                "env.progress_penalty is a term of the stability-rule penalty's wrapper: set "
+                "env.stability_penalty > 0 too (or env.progress_penalty: 0)"
             )
         if self.env.vectorization == "batched" and self.vec_env.type == "subprocess":
             raise ValueError(

@@ -9,7 +9,8 @@ and, without a recovery controller, the robot tips over.
 18 values in [-1, 1] (J_x, J_z, J_theta per leg in LF LM LR RF RM RR order): joint targets in
 ``action_mode="joint"``, or offsets from the reference tripod gait in ``"residual"`` (default;
 see `HeavyDutyEnv`). ``clock_action=True`` (residual mode) adds a 19th: the reference gait's
-clock rate, 1 + min(a, 0), so that a policy can slow or hold the gait.
+clock rate, 1 + min(a, 0), so that a policy can slow or hold the gait; ``clock_action="stop"``
+makes it a one-way stop (the first walking step at -1 stops the gait for the episode).
 
 ## Observation Space
 
@@ -52,8 +53,9 @@ payload). ``info["task"]`` holds the values and their ``difficulty``.
 Terminated on a tip-over: the body tilts past ``tip_over_angle_deg`` (-v0: 20°; -v1: 15°), or
 (-v1) the FASM stays at or below 0 for ``tip_over_margin_time`` (1 s). Truncated at 1500 steps
 (30 s). ``info["is_success"]`` at the last step: no tip-over and at least ``min_progress`` of the
-reference gait's distance; -v1 also needs the tilt within 8° and at most 10 % of the episode
-below ξ_f (docs/benchmark.md).
+reference gait's distance (``info["behind_pace"]`` while it is short of that share of the
+distance the reference covers in the walking time so far); -v1 also needs the tilt within 8°
+and at most 10 % of the episode below ξ_f (docs/benchmark.md).
 
 ## Arguments
 `CliffWalkSettings` and `HeavyDutySettings` (``gym.make(id, **kwargs)``; unknown keys are an

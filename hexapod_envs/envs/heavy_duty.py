@@ -9,10 +9,14 @@ Action modes:
   (walking scenarios) a 19th value sets how far the reference gait's clock advances after this
   step, 1 + min(a, 0) control steps: 0 keeps the paper's pace, -1 holds the gait where it is
   (every leg's target stays from the next step on; the ``gait_phase`` observation follows the
-  clock).
+  clock). With ``clock_action="stop"`` the 19th value is a one-way stop instead: the first
+  walking step it is at its lower bound (-1) stops the gait's clock for the rest of the episode
+  (the walking flag of ``gait_phase`` then reads 0); any value above walks at the paper's pace.
+  A stop is one decision per episode, where a hold through the rate needs -1 at every step.
 
 ``is_success``: not tipped over and, in walking scenarios, at least ``min_progress`` of the
 distance the reference gait covers in the elapsed walking time.
+``info["behind_pace"]`` (walking scenarios): walking, and the CoG is short of that distance.
 """
 
 from __future__ import annotations
@@ -51,6 +55,8 @@ peaks near 20, random actions reach 150. Bounded costs let the alive term make e
 step's reward >= 0, so that tipping over early never pays more than staying up."""
 
 ACTION_MODES = ("joint", "residual")
+CLOCK_ACTIONS = (False, True, "stop")
+"""``clock_action`` values: none, the gait clock's rate, a one-way stop."""
 
 
 @dataclasses.dataclass(frozen=True)
@@ -111,11 +117,11 @@ class HeavyDutySettings(EnvSettings):
     """Share of the reference gait's distance a successful walking episode covers."""
     gait: TripodGaitParams | None = option(None, kind=TripodGaitParams)
     """The reference tripod gait (None: the paper's)."""
-    clock_action: bool = choice(False, (False, True))
-    """Residual mode of a walking scenario: add the reference gait's clock rate as a 19th action
-    (see the module docstring). The reference's pace is the one thing per-step joint residuals
-    cannot change: slowing or holding the whole gait would take a residual that tracks the
-    moving reference."""
+    clock_action: bool | str = choice(False, CLOCK_ACTIONS)
+    """Residual mode of a walking scenario: add the reference gait's clock as a 19th action,
+    its rate (True) or a one-way stop ("stop"; see the module docstring). The reference's pace
+    is the one thing per-step joint residuals cannot change: slowing or holding the whole gait
+    would take a residual that tracks the moving reference."""
 
 
 class HeavyDutyEnv(HexapodEnv):
@@ -125,6 +131,9 @@ class HeavyDutyEnv(HexapodEnv):
 
     walks: bool = True
     """Walking scenarios follow the reference tripod gait and observe its phase."""
+
+    _stopped: bool = False
+    """With ``clock_action="stop"``: the gait was stopped for the rest of the episode."""
 
     def _setup(self) -> None:
         s = self.settings
@@ -147,8 +156,8 @@ class HeavyDutyEnv(HexapodEnv):
         self.action_map = JointActionMap(np.tile(self.robot.joint_ranges, (6, 1)))
         if s.clock_action and (s.action_mode != "residual" or not self.walks):
             raise ValueError(
-                "clock_action=True adds the reference gait's clock rate to the residual action of "
-                f"a walking scenario; got action_mode={s.action_mode!r} on "
+                f"clock_action={s.clock_action!r} adds the reference gait's clock to the residual "
+                f"action of a walking scenario; got action_mode={s.action_mode!r} on "
                 f"{type(self).__name__} (walks: {self.walks})"
             )
         self.clock_action = s.clock_action
@@ -213,7 +222,7 @@ class HeavyDutyEnv(HexapodEnv):
     # --- time and reference gait ------------------------------------------------------------
     def _gait_step(self) -> int:
         """Index into the reference table (the gait clock is frozen while standing)."""
-        if self.clock_action:
+        if self.clock_action:  # the clock's own count (rate or stop)
             return int(self._clock) % self._steps_per_cycle
         return max(0, self._step_count - self._stand_steps) % self._steps_per_cycle
 
@@ -239,6 +248,7 @@ class HeavyDutyEnv(HexapodEnv):
         self._residual = np.zeros(18)
         self._clock = 0.0
         """With `clock_action`: reference-gait control steps walked so far (fractional)."""
+        self._stopped = False
 
     def _apply_action(self, action: np.ndarray) -> None:
         """Joint targets from the action (MuJoCo clamps them to the servo ranges, ctrlrange):
@@ -258,7 +268,11 @@ class HeavyDutyEnv(HexapodEnv):
             self._act_ids,
         )
         if self.clock_action and self._step_count >= self._stand_steps:
-            self._clock += 1.0 + min(float(action[18]), 0.0)
+            if self.clock_action == "stop":
+                self._stopped = self._stopped or bool(action[18] <= -1.0)
+                self._clock += 0.0 if self._stopped else 1.0
+            else:
+                self._clock += 1.0 + min(float(action[18]), 0.0)
 
     def _before_physics(self) -> None:
         """Hook run before each control period's physics (e.g. driving a platform)."""
@@ -331,8 +345,9 @@ class HeavyDutyEnv(HexapodEnv):
         return pieces
 
     def _gait_phase(self) -> np.ndarray:
-        """sin, cos of the gait clock's phase, and 1 once walking."""
-        return self._phase_table[int(self._step_count >= self._stand_steps), self._gait_step()]
+        """sin, cos of the gait clock's phase, and 1 once walking (until a stop)."""
+        walking = self._step_count >= self._stand_steps and not self._stopped
+        return self._phase_table[int(walking), self._gait_step()]
 
     def step_cost_bound(self) -> float:
         """The largest cost one step can carry (the sum of the bounded negative parts of the
@@ -363,12 +378,18 @@ class HeavyDutyEnv(HexapodEnv):
         return terms
 
     def _extra_info(self, unstable: bool) -> dict:
-        return {"actuator_power_w": self._power}
+        info = {"actuator_power_w": self._power}
+        if self.walks:  # while standing the pace asks for nothing
+            info["behind_pace"] = self.time > self.gait.gait.stand_time and not self._on_pace()
+        return info
 
     def _is_success(self) -> bool:
         """Walking envs: at least `min_progress` of the reference gait's distance so far."""
-        if not self.walks:
-            return True
+        return not self.walks or self._on_pace()
+
+    def _on_pace(self) -> bool:
+        """Whether the CoG has advanced at least `min_progress` of the reference gait's distance
+        in the walking time so far (``info["behind_pace"]`` is its negation)."""
         walked = max(0.0, self.time - self.gait.gait.stand_time)
         progress = float(self._cog[0]) - self._start_cog_x
         return progress >= self.min_progress * self.gait.gait.body_speed * walked

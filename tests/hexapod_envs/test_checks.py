@@ -33,6 +33,12 @@ def test_the_settings_checks_share_the_wording():
         check_real("x", "a", (1, "a"))
     with pytest.raises(ValueError, match=r"flag must be one of \[False, True\], got 1"):
         check_choice("flag", 1, (True, False))
+    flag_or_name = (False, True, "stop")  # a flag with a named third value (clock_action)
+    check_choice("clock_action", "stop", flag_or_name)
+    check_choice("clock_action", False, flag_or_name)
+    for number in (1, 0.0, np.int64(1)):
+        with pytest.raises(ValueError, match=r"must be one of \['stop', False, True\]"):
+            check_choice("clock_action", number, flag_or_name)
 
 
 def test_a_count_argument_takes_whole_numbers_in_range_and_names_the_range():

@@ -120,3 +120,55 @@ def test_the_training_config_wraps_the_env_and_checks_the_weight():
             CONFIG,
             ["env.vectorization=batched", "policy.critic_privileged=false"],
         )
+
+
+def _cliff_return(progress_weight, stop_at):
+    """A flat cliff walk with the one-way stop at step `stop_at` (None: never): the summed
+    reward and progress terms, and whether the episode met the success rule."""
+    env = StabilityRulePenalty(
+        gym.make("HexapodCliffWalk-v1", terrain="flat", clock_action="stop"), 2.0, progress_weight
+    )
+    env.reset(seed=0)
+    action = np.zeros(19, dtype=np.float32)
+    total = progress = 0.0
+    for step in range(1500):
+        action[18] = -1.0 if step == stop_at else 0.0
+        _, reward, terminated, truncated, info = env.step(action)
+        total += reward
+        progress += info.get("reward_rule_progress", 0.0)
+        assert info.get("reward_rule_progress", 0.0) == -progress_weight * info["behind_pace"]
+        if terminated or truncated:
+            return total, progress, info["is_success"]
+    raise AssertionError("the time limit should have ended the episode")
+
+
+def test_the_progress_term_charges_the_walking_steps_behind_the_rules_pace():
+    """On flat ground a stop that leaves the robot short of half the reference distance fails
+    the rule and pays on every step from when it falls behind; a late stop and walking on do
+    not (the few steps of the gait's start, when the body lags the pace, cost all alike)."""
+    walk, walk_progress, walk_success = _cliff_return(2.0, None)
+    late, late_progress, late_success = _cliff_return(2.0, 1000)
+    early, early_progress, early_success = _cliff_return(2.0, 600)
+    assert walk_success and late_success and not early_success
+    assert walk_progress == late_progress > -20.0  # a handful of steps at the start
+    assert early_progress < -500.0  # hundreds of steps behind, each charged 2
+    assert walk > late > early
+    plain_early, none, _ = _cliff_return(0.0, 600)
+    assert none == 0.0 and plain_early - early == pytest.approx(-early_progress)
+
+
+def test_the_progress_term_needs_a_pace_and_the_config_the_stability_penalty():
+    with pytest.raises(ValueError, match="HexapodStewartTilt-v1 has no pace"):
+        StabilityRulePenalty(gym.make("HexapodStewartTilt-v1"), 1.0, 1.0)
+    with pytest.raises(ValueError, match="progress-rule penalty weight must be a number >= 0"):
+        StabilityRulePenalty(gym.make("HexapodCliffWalk-v1"), 1.0, -1.0)
+    cliff = REPO / "configs" / "cliff_walk_v1_ppo_stop.yaml"
+    config = load_train_config(cliff, ["env.max_episode_steps=5"])
+    env = env_spec(config).make()
+    while not isinstance(env, StabilityRulePenalty):
+        env = env.env
+    assert env.progress_weight == config.env.progress_penalty == 2.0
+    with pytest.raises((ConfigError, ValueError), match="set env.stability_penalty > 0 too"):
+        load_train_config(cliff, ["env.stability_penalty=0"])
+    with pytest.raises((ConfigError, ValueError), match="progress_penalty must be a number >= 0"):
+        load_train_config(cliff, ["env.progress_penalty=-2"])

@@ -172,10 +172,32 @@ def test_clock_action_minus_one_holds_the_gait_and_half_walks_at_half_pace():
     assert 0.4 < progress < 0.6
 
 
+def test_clock_action_stop_walks_above_minus_one_and_stops_for_good_at_it():
+    walk = 150 + 100  # the 3 s of standing, then 2 s of walking
+    env = gym.make("HexapodCliffWalk-v1", terrain="flat", clock_action="stop")
+    assert env.action_space.shape == (19,)
+    rates = gym.make("HexapodCliffWalk-v1", terrain="flat", clock_action=True)
+    walked = _walk_with_clock(env, [0.5] * 125 + [-0.999] * 125)
+    expected = _walk_with_clock(rates, [0.0] * walk)
+    np.testing.assert_array_equal([i["cog"] for i in walked], [i["cog"] for i in expected])
+    # One step at -1 stops the gait as the rate's hold at -1 on every step does, and a value
+    # above -1 afterwards does not restart it.
+    stopped = _walk_with_clock(env, [0.0] * walk + [-1.0] + [1.0] * 99)
+    held = _walk_with_clock(rates, [0.0] * walk + [-1.0] * 100)
+    np.testing.assert_array_equal([i["cog"] for i in stopped], [i["cog"] for i in held])
+    assert np.ptp([i["cog"][0] for i in stopped[walk + 25 :]]) < 0.005  # [m]
+    sin_cos_walking = env.unwrapped._gait_phase()
+    np.testing.assert_array_equal(sin_cos_walking[:2], rates.unwrapped._gait_phase()[:2])
+    assert sin_cos_walking[2] == 0.0 and rates.unwrapped._gait_phase()[2] == 1.0
+    env.reset(seed=0)  # a new episode walks again
+    assert not env.unwrapped._stopped
+
+
 @pytest.mark.parametrize(
     ("env_id", "kwargs"),
     [("HexapodCliffWalk-v1", {"action_mode": "joint"}), ("HexapodStewartTilt-v1", {})],
 )
 def test_clock_action_needs_the_residual_mode_of_a_walking_scenario(env_id, kwargs):
-    with pytest.raises(ValueError, match="clock_action.*walking scenario"):
-        gym.make(env_id, clock_action=True, **kwargs)
+    for clock_action in (True, "stop"):
+        with pytest.raises(ValueError, match="clock_action.*walking scenario"):
+            gym.make(env_id, clock_action=clock_action, **kwargs)
