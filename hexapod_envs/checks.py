@@ -44,11 +44,9 @@ def check_real(name: str, value: Any, shown: Any) -> float:
 def check_choice(name: str, value: Any, choices) -> None:
     """Raise a ValueError naming `name`, the bad value and the valid choices (a flag among
     them takes a bool only: 1 is not True here; other choices, such as a name, stay valid)."""
-    # A number equal to a flag (1 == True, 0.0 == False) is not that flag.
-    posing = not isinstance(value, bool) and any(
-        isinstance(c, bool) and value == c for c in choices
-    )
-    if value not in choices or posing:
+    flags = [c for c in choices if isinstance(c, bool)]
+    number_for_flag = not isinstance(value, bool) and value in flags  # 1 == True, 0.0 == False
+    if value not in choices or number_for_flag:
         valid = sorted(choices, key=repr)
         raise ValueError(f"{name} must be one of {valid}, got {value!r}")
 

@@ -222,7 +222,7 @@ class HeavyDutyEnv(HexapodEnv):
     # --- time and reference gait ------------------------------------------------------------
     def _gait_step(self) -> int:
         """Index into the reference table (the gait clock is frozen while standing)."""
-        if self.clock_action:  # the clock's own count (rate or stop)
+        if self.clock_action:
             return int(self._clock) % self._steps_per_cycle
         return max(0, self._step_count - self._stand_steps) % self._steps_per_cycle
 
