@@ -28,7 +28,8 @@ an episode (ATHENA's body height: the height control reaches a new reference ove
 cycles, so per-cycle rewards credit little of it). The step's reward is the episode's outcome.
 
 `StabilityRulePenalty`: per-step penalties that mirror a ``-v1`` success rule's bounds on the
-time spent tipping and the largest tilt, for learners that act at every step.
+time spent tipping and the largest tilt (and, on the cliff walk, its pace), for learners that
+act at every step.
 """
 
 from __future__ import annotations

@@ -124,7 +124,7 @@ class EnvSpec:
             from hexapod_envs.wrappers import StabilityRulePenalty
 
             weight, progress = self.stability_penalty, self.progress_penalty
-            where = f"env.stability_penalty on {self.id}"
+            where = f"env.stability_penalty / env.progress_penalty on {self.id}"
             env = _wrapped(env, lambda e: StabilityRulePenalty(e, weight, progress), where)
         if self.privileged_critic:
             from ..privileged_critic import PrivilegedObservation

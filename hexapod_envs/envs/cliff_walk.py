@@ -24,7 +24,7 @@ makes it a one-way stop (the first walking step at -1 stops the gait for the epi
 | imu_gyro | 3 | body angular velocity [rad/s] |
 | imu_accel | 3 | accelerometer [m/s²] |
 | imu_quat | 4 | body orientation (w, x, y, z) |
-| gait_phase | 3 | sin, cos of the gait clock, 1 once walking |
+| gait_phase | 3 | sin, cos of the gait clock, 1 once walking (0 again after a stop) |
 
 ## Rewards
 

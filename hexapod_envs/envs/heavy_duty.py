@@ -16,7 +16,8 @@ Action modes:
 
 ``is_success``: not tipped over and, in walking scenarios, at least ``min_progress`` of the
 distance the reference gait covers in the elapsed walking time.
-``info["behind_pace"]`` (walking scenarios): walking, and the CoG is short of that distance.
+``info["behind_pace"]`` (walking scenarios): past the standing phase (also after a stop), the
+CoG is short of that distance.
 """
 
 from __future__ import annotations
@@ -280,7 +281,7 @@ class HeavyDutyEnv(HexapodEnv):
     def _reference_description(self) -> dict:
         """The reference: tripod gait parameters, its table of joint targets per control step
         of a cycle, steps per cycle and standing steps, residual scale and filter, and whether
-        the action ends with the gait clock's rate (`clock_action`)."""
+        the action ends with the gait clock's rate or stop (`clock_action`)."""
         return {
             "gait": self.gait.gait,
             "reference_table": self._reference_table.copy(),
@@ -389,7 +390,8 @@ class HeavyDutyEnv(HexapodEnv):
 
     def _on_pace(self) -> bool:
         """Whether the CoG has advanced at least `min_progress` of the reference gait's distance
-        in the walking time so far (``info["behind_pace"]`` is its negation)."""
+        in the walking time so far (``info["behind_pace"]`` is its negation past the standing
+        phase)."""
         walked = max(0.0, self.time - self.gait.gait.stand_time)
         progress = float(self._cog[0]) - self._start_cog_x
         return progress >= self.min_progress * self.gait.gait.body_speed * walked

@@ -7,7 +7,14 @@ from typing import Any
 
 import mujoco
 
-__all__ = ["DEFAULT_CAMERA", "check_camera", "make_renderer", "set_visual_options"]
+__all__ = [
+    "DEFAULT_CAMERA",
+    "check_camera",
+    "close_renderer",
+    "make_renderer",
+    "render_frame",
+    "set_visual_options",
+]
 
 DEFAULT_CAMERA = {"distance": 14.0, "elevation": -20.0, "azimuth": 135.0, "trackbodyid": 1}
 """The free camera of an env rendered without a `camera_name`."""
@@ -70,8 +77,17 @@ def close_renderer(renderer: Any) -> None:
     framebuffers, textures and meshes on the GPU) with its own OpenGL context current.
 
     Freed later, by garbage collection, the context's objects would be deleted by number in
-    whichever OpenGL context is current then: another env's, whose frames turn black."""
+    whichever OpenGL context is current then: another env's, whose frames turn black.
+    Gymnasium's `close()` of an offscreen viewer also terminates GLFW, which with
+    ``MUJOCO_GL=glfw`` would destroy every other env's context: an offscreen viewer frees its
+    own context only; a window ("human") is closed as Gymnasium closes it."""
+    from gymnasium.envs.mujoco.mujoco_rendering import OffScreenViewer
+
     for viewer in renderer._viewers.values():
         viewer.make_context_current()
         viewer.con.free()
-    renderer.close()
+        if isinstance(viewer, OffScreenViewer):
+            viewer.free()
+        else:
+            viewer.close()
+    renderer._viewers.clear()

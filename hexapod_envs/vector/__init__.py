@@ -80,7 +80,7 @@ def _registered_limit(vector_entry_point: str) -> int | None:
     if len(limits) > 1:
         raise ValueError(
             f"the ids registered with {vector_entry_point} have different time limits "
-            f"({sorted(limits, key=repr)}); pass max_episode_steps"
+            f"({sorted(limits, key=repr)}); pass a number as max_episode_steps"
         )
     return limits.pop() if limits else None
 

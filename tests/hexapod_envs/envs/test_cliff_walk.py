@@ -180,6 +180,8 @@ def test_clock_action_stop_walks_above_minus_one_and_stops_for_good_at_it():
     walked = _walk_with_clock(env, [0.5] * 125 + [-0.999] * 125)
     expected = _walk_with_clock(rates, [0.0] * walk)
     np.testing.assert_array_equal([i["cog"] for i in walked], [i["cog"] for i in expected])
+    standing = _walk_with_clock(env, [-1.0] * 150 + [0.0] * 100)  # no stop before walking
+    np.testing.assert_array_equal([i["cog"] for i in standing], [i["cog"] for i in expected])
     # One step at -1 stops the gait as the rate's hold at -1 on every step does, and a value
     # above -1 afterwards does not restart it.
     stopped = _walk_with_clock(env, [0.0] * walk + [-1.0] + [1.0] * 99)
