@@ -321,14 +321,9 @@ class StabilityRulePenalty(gym.Wrapper):
         tilt = -self.weight * float(info.get(keys.TILT_DEG, 0.0) > self.tilt_bound_deg)
         early = self.bounds_swing and bool(info.get("early_landing", False))
         landing = -self.weight * float(early)
-        info = {
-            **info,
-            "reward_rule_tipping": tipping,
-            "reward_rule_tilt": tilt,
-            "reward_rule_early_landing": landing,
-        }
+        terms = {"rule_tipping": tipping, "rule_tilt": tilt, "rule_early_landing": landing}
         if self.progress_weight:
-            progress = -self.progress_weight * float(bool(info.get("behind_pace", False)))
-            info["reward_rule_progress"] = progress
-            reward = float(reward) + progress
-        return obs, float(reward) + tipping + tilt + landing, terminated, truncated, info
+            behind = bool(info.get("behind_pace", False))
+            terms["rule_progress"] = -self.progress_weight * float(behind)
+        info = {**info, **{keys.REWARD_PREFIX + name: v for name, v in terms.items()}}
+        return obs, sum(terms.values(), float(reward)), terminated, truncated, info

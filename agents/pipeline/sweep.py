@@ -323,16 +323,14 @@ def resume_sweep(
     command = command or command_line()
     with open(sweep_dir / "command.txt", "a") as fh:
         fh.write(command + "\n")
-    asked = max_concurrent
-    max_concurrent = _default_concurrency(address, max_concurrent)
-    _init_ray(address, max_concurrent, sweep.config.cpus_per_trial)
+    _init_ray(address, _default_concurrency(address, max_concurrent), sweep.config.cpus_per_trial)
     trainable, _ = _tuner_parts(sweep, sweep_dir, command, trust_pickle)
     tuner = tune.Tuner.restore(
         str(sweep_dir / RAY_DIR), trainable, resume_unfinished=True, restart_errored=True
     )
-    if asked is not None:  # else the restored state's (the sweep's start)
+    if max_concurrent is not None:  # else the restored state's (the sweep's start)
         with contextlib.suppress(AttributeError):
-            tuner._local_tuner._tune_config.max_concurrent_trials = asked
+            tuner._local_tuner._tune_config.max_concurrent_trials = max_concurrent
     return _fit(tuner, sweep, sweep_dir)
 
 
