@@ -133,9 +133,6 @@ class HeavyDutyEnv(HexapodEnv):
     walks: bool = True
     """Walking scenarios follow the reference tripod gait and observe its phase."""
 
-    _stopped: bool = False
-    """With ``clock_action="stop"``: the gait was stopped for the rest of the episode."""
-
     def _setup(self) -> None:
         s = self.settings
         self.stability_criterion = (
@@ -250,6 +247,7 @@ class HeavyDutyEnv(HexapodEnv):
         self._clock = 0.0
         """With `clock_action`: reference-gait control steps walked so far (fractional)."""
         self._stopped = False
+        """With ``clock_action="stop"``: the gait was stopped for the rest of the episode."""
 
     def _apply_action(self, action: np.ndarray) -> None:
         """Joint targets from the action (MuJoCo clamps them to the servo ranges, ctrlrange):
