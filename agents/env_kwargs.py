@@ -26,6 +26,7 @@ POLICY_SETTINGS = (
     "gains_height_offset_m",
     "clock_action",
     "landing_action",
+    "stride_action",
 )
 """Env kwargs that say how an action is read or what the observation holds (not which task is
 posed): a policy is evaluated with the ones it was built for, on the suite's task."""

@@ -70,6 +70,12 @@ class UpuGaitPolicy(EnvBound):
                 f"UpuGaitPolicy needs a HexapodDitchCrossing env; {type(base).__name__} declares "
                 "no UPU gait in its task description"
             )
+        if task.reference.get("stride_action"):
+            raise ValueError(
+                "UpuGaitPolicy plans every stride itself; an env with stride_action=True takes "
+                "the strides as actions (make the env without it, in joint mode for the "
+                "closed-loop gait)"
+            )
         self.env = base
         self.task = task
         """The env's declared task description, read again on the first call of an episode."""

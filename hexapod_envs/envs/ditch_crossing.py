@@ -54,6 +54,18 @@ CoG passes 15 mm from a support edge at 0.4 m height, the nearly vertical limbs 
 length into ~10 mm of platform travel, and 1 mm of leg-length difference tilts the body by
 0.2 degrees; uniformly random actions with these defaults still cross in most episodes.
 
+``stride_action=True`` (residual mode, ``reference_plan="flat"``) adds a 10th value: the stride
+of each platform step, read on the step's first control step (observation piece
+``stride_decision``), the full 160 mm for a >= 0 and (1 + a) x 160 mm below, at least 5 mm and
+within the room the other platform leaves (`hexapod_envs.robots.upu.online_gait`). The
+reference gait is then built online, one step at a time, and its legs land at the ground under
+each foot (the ditch's depth over the ditch), as the paper's planner's do. Two observation
+pieces follow the others: ``ditch_ahead`` (5: the near and far edge x relative to the upper,
+then the lower platform centre where the decided steps leave them [m], then the depth [m]; on
+flat ground both edges at the finish line and depth 0) and ``stride_decision`` (2: 1 if the
+upper platform moves next; 1 if the next action's stride value decides that step). The zero
+action walks full strides; on flat ground that is the flat reference, bit for bit.
+
 Control runs at 10 Hz (control_dt = 0.1 s, physics 2 ms); the servo drives interpolate: each
 target is approached linearly over the control period, at most 0.25 m/s for a limb and 1 m/s
 for a leg (`model.add_upu`, ``command="interpolated"``), as the stiff limb servos would
@@ -85,7 +97,10 @@ stance_legs, is_tipping (static_margin_m <= 0: the CoG projection is not inside 
 feet's polygon), min_static_margin_m (the smallest static_margin_m since reset [m]: how close
 the crossing came to tipping), is_tipped_over, is_success, sim_unstable, distance (CoG advance
 [m]), tilt_deg, planner_status, planner_reason, ditch (start_x, width, depth [m]; None on flat
-ground), finish_x [m], gait_step and gait_phase (the reference's plan step and phase), time, cog.
+ground), finish_x [m], gait_step and gait_phase (the reference's plan step and phase), time, cog;
+with ``stride_action``, unread_actions: ``(9,)`` on the steps whose stride value decided
+nothing, else ``()`` (training can score those values at the policy's mean,
+``ppo.score_unread_at_mean``).
 
 ## Arguments
 `DitchCrossingSettings` (``gym.make(id, **kwargs)``).
@@ -124,6 +139,7 @@ from ..robots.upu.gait_schedule import (
     walking_height,
 )
 from ..robots.upu.model import add_upu
+from ..robots.upu.online_gait import OnlineGait
 from ..robots.upu.params import LEG_NAMES, UpuParams
 from ..stability import _compiled as _stability
 from ..terrain.ditch import add_ditch
@@ -239,6 +255,11 @@ class DitchCrossingSettings(EnvSettings):
     like the paper's planner), "flat" is the flat-ground gait to the same finish line, blind to
     the ditch (-v1: crossing needs the ditch sensed and the steps adapted)."""
     action_mode: str = choice("residual", ACTION_MODES)
+    stride_action: bool = choice(False, (False, True))
+    """Residual mode with the flat reference plan: a 10th action value sets the stride of each
+    platform step as it begins (`OnlineGait.stride_for`: the full stride for a >= 0, shortened
+    in proportion below), the legs land at the ground under each foot, and the observation
+    gains ``ditch_ahead`` and ``stride_decision`` (see the module docstring)."""
     residual_limb_m: float = number(0.002)
     """Residual action 1 on a limb [m]."""
     residual_leg_m: float = number(0.005)
@@ -339,7 +360,16 @@ class DitchCrossingEnv(HexapodEnv):
         self.command_low, self.command_high = low, high
         self._center = (low + high) / 2
         self._half = (high - low) / 2
-        self.action_space = spaces.Box(-1.0, 1.0, shape=(len(COMMAND_NAMES),), dtype=np.float32)
+        if s.stride_action and (s.action_mode != "residual" or s.reference_plan != "flat"):
+            raise ValueError(
+                "stride_action=True builds the reference gait online, one platform step at a "
+                "time from the full-stride flat gait, under the residual action; it needs "
+                f"action_mode='residual' and reference_plan='flat', got {s.action_mode!r} and "
+                f"{s.reference_plan!r}"
+            )
+        self.stride_action = s.stride_action
+        n_actions = len(COMMAND_NAMES) + (1 if s.stride_action else 0)
+        self.action_space = spaces.Box(-1.0, 1.0, shape=(n_actions,), dtype=np.float32)
         self._reference_power = self.weight_n * 0.1
         self._inv_dt = 1.0 / self.control_dt
         self._plans: dict[tuple, GaitPlan] = {}
@@ -471,6 +501,7 @@ class DitchCrossingEnv(HexapodEnv):
             "finish_x": self.finish_x,
             "residual_gain": tuple(float(g) for g in self.residual_gain),
             "residual_filter_alpha": float(self.residual_filter_alpha),
+            "stride_action": self.stride_action,
         }
 
     def paper_task(self) -> dict:
@@ -537,6 +568,28 @@ class DitchCrossingEnv(HexapodEnv):
             "planner_reason": self.plan.reason,
             "finish_x": self.finish_x,
         }
+        if self.stride_action:
+            ditch = self.ditch if self.terrain == "ditch" else None
+            self.online_gait = OnlineGait(self.params, self.gait_settings, self.start_x, ditch)
+            """With `stride_action`: the online gait's state and the steps decided so far."""
+            self._set_online_schedule()
+            self._stride_read = True
+            """With `stride_action`: the last action's stride value set a step's stride."""
+
+    def _set_online_schedule(self) -> None:
+        """With `stride_action`: the reference gait is the decided steps and, pending, the
+        full-stride step from where they end. The pending step's first phases (unload, lift,
+        hold) do not depend on its stride, so its rows before the transfer are exact; its
+        first row is the control step whose action decides the stride (`_decide_at`)."""
+        gait = self.online_gait
+        pending = gait.next_step(gait.stride_for(0.0))
+        self.plan = gait.plan(pending)
+        self.schedule = GaitSchedule(self.plan, self.params, self.control_dt, self.gait_timing)
+        self._reference_actions = np.clip(
+            (self.schedule.commands - self._center) / self._half, -1.0, 1.0
+        )
+        self._decide_at = self.schedule.n_ticks - sum(self.schedule.phase_ticks)
+        """The control step whose action sets the pending step's stride."""
 
     def reference_command(self, tick: int | None = None) -> np.ndarray:
         """The reference gait's command (`COMMAND_NAMES`, [m]) at control step `tick` (default:
@@ -544,11 +597,16 @@ class DitchCrossingEnv(HexapodEnv):
         return self.schedule.command(self._step_count if tick is None else tick)
 
     def _apply_action(self, action: np.ndarray) -> None:
+        if self.stride_action:
+            self._stride_read = self._step_count == self._decide_at
+            if self._stride_read:
+                self.online_gait.advance(self.online_gait.stride_for(action[9]))
+                self._set_online_schedule()
         if self.action_mode == "joint":
             target = self._center + self._half * action
         else:
             r = self._residual
-            r += self.residual_filter_alpha * (self.residual_gain * action - r)
+            r += self.residual_filter_alpha * (self.residual_gain * action[:9] - r)
             target = self.schedule.command(self._step_count) + r
         # Interpolated commands: the servo targets (act) move linearly to `target` during the
         # control period; MuJoCo clamps the rate to the speed limits, the target to the ranges.
@@ -599,7 +657,7 @@ class DitchCrossingEnv(HexapodEnv):
 
     def _observation_pieces(self) -> dict:
         # Readers look the data up at call time: a task may rebuild the model (and its data).
-        return {
+        pieces = {
             "joint_pos": (9, lambda: self.data.actuator_length[self._act]),
             "joint_vel": (9, lambda: self.data.actuator_velocity[self._act]),
             "foot_force": (18, lambda: self._forces.reshape(-1)),
@@ -612,6 +670,31 @@ class DitchCrossingEnv(HexapodEnv):
             "reference_action": (9, self._reference_action),
             "residual_state": (9, lambda: self._residual * self._inv_residual_gain),
         }
+        if self.stride_action:
+            pieces["ditch_ahead"] = (5, self._ditch_ahead)
+            pieces["stride_decision"] = (2, self._stride_decision)
+        return pieces
+
+    def _ditch_ahead(self) -> np.ndarray:
+        """With `stride_action`: the ditch's near and far edges relative to the upper, then
+        the lower platform centre where the decided steps leave them [m], and its depth [m]
+        (on flat ground both edges at the finish line, depth 0)."""
+        g = self.online_gait
+        near, far = (self.ditch.start_x, self.ditch.end_x)
+        depth = self.ditch.depth
+        if self.terrain != "ditch":
+            near = far = self.finish_x
+            depth = 0.0
+        return np.array(
+            [near - g.x_upper, far - g.x_upper, near - g.x_lower, far - g.x_lower, depth]
+        )
+
+    def _stride_decision(self) -> np.ndarray:
+        """With `stride_action`: (1 if the upper platform moves next, 1 if the next action's
+        stride value decides that step)."""
+        return np.array(
+            [float(self.online_gait.moving == "upper"), float(self._step_count == self._decide_at)]
+        )
 
     def _reference_action(self) -> np.ndarray:
         """The reference gait's command now, normalised like a "joint" action."""
@@ -664,4 +747,5 @@ class DitchCrossingEnv(HexapodEnv):
             "ditch": self._ditch_info,  # a new dict every step (callers may keep infos)
             "gait_step": step,
             "gait_phase": phase,
+            **({"unread_actions": () if self._stride_read else (9,)} if self.stride_action else {}),
         }

@@ -155,3 +155,9 @@ def test_policy_replans_for_a_randomised_ditch_and_is_registered():
     with pytest.raises(ValueError, match="HexapodDitchCrossing"):
         UpuGaitPolicy(gym.make("HexapodCliffWalk-v0"))
     env.close()
+
+
+def test_policy_refuses_an_env_whose_strides_are_actions():
+    env = gym.make("HexapodDitchCrossing-v1", stride_action=True)
+    with pytest.raises(ValueError, match="stride_action=True takes the strides"):
+        UpuGaitPolicy(env)

@@ -350,7 +350,8 @@ def _other(platform: str) -> str:
     return "lower" if platform == "upper" else "upper"
 
 
-def _stride_limit(params: UpuParams, settings: GaitSettings) -> float:
+def stride_limit(params: UpuParams, settings: GaitSettings) -> float:
+    """The longest platform step [m]: eq. (17), or `settings.max_stride` where shorter."""
     limit = max_stride(params.support_inradius, params.leg_radius)
     return limit if settings.max_stride is None else min(limit, settings.max_stride)
 
@@ -407,6 +408,56 @@ def _transfer_margin(params: UpuParams, moving: str, x0: float, x1: float) -> fl
     return min(values)
 
 
+def platform_step(
+    params: UpuParams,
+    settings: GaitSettings,
+    moving: str,
+    start_x: float,
+    end_x: float,
+    support_x: float,
+    landing_extension: dict[str, float] | None = None,
+    support_extension: dict[str, float] | None = None,
+) -> PlatformStep | str:
+    """The step moving the `moving` platform's centre from world x `start_x` to `end_x` while
+    the other stands at `support_x` [m], with the largest lift the workspace allows; or why
+    there is none (a string: the path leaves the workspace, or the static margin falls below
+    `settings.min_margin`). Extensions default to 0 (level ground) [m]."""
+    x0, x1 = start_x - support_x, end_x - support_x
+    lift = _feasible_lift(params, settings, moving, x0, x1)
+    if lift is None:
+        return f"the {moving} step from {start_x:.4f} to {end_x:.4f} m leaves the workspace"
+    margin = _transfer_margin(params, moving, x0, x1)
+    if margin < settings.min_margin:
+        return (
+            f"the {moving} step drops the static margin to {margin:.4f} m "
+            f"< min_margin {settings.min_margin} m"
+        )
+    return PlatformStep(
+        moving=moving,
+        start_x=start_x,
+        end_x=end_x,
+        support_x=support_x,
+        lift=lift,
+        swing_extension=_swing_extension(moving, params, settings),
+        landing_extension=landing_extension or dict.fromkeys(PLATFORM_LEGS[moving], 0.0),
+        support_extension=support_extension or dict.fromkeys(PLATFORM_LEGS[_other(moving)], 0.0),
+        min_margin=margin,
+    )
+
+
+def landing_extensions(
+    params: UpuParams, moving: str, end_x: float, ditch: Ditch | None
+) -> dict[str, float]:
+    """Moving leg -> its extension at touchdown [m] for a step ending at world x `end_x`: the
+    ditch's depth for a foot whose centre lands over the ditch, 0 elsewhere (§7, Fig. 13)."""
+    landing = {}
+    for leg in PLATFORM_LEGS[moving]:
+        foot_x = end_x + float(params.foot_offset(leg)[0])
+        below = ditch is not None and ditch.ground_height(foot_x) < 0
+        landing[leg] = ditch.depth if below else 0.0
+    return landing
+
+
 def plan_flat_walk(
     params: UpuParams,
     n_cycles: int,
@@ -419,7 +470,7 @@ def plan_flat_walk(
     settings = settings or GaitSettings()
     if not (isinstance(n_cycles, int | np.integer) and n_cycles >= 1):
         raise ValueError(f"n_cycles must be an integer >= 1, got {n_cycles!r}")
-    limit = _stride_limit(params, settings)
+    limit = stride_limit(params, settings)
     stride = limit if stride is None else float(stride)
     if not 0 < stride <= limit + 1e-12:
         raise ValueError(f"stride must be in (0, {limit:.4f}] m (eq. 17), got {stride}")
@@ -429,29 +480,10 @@ def plan_flat_walk(
         for moving in ("upper", "lower"):
             x0 = x_upper if moving == "upper" else x_lower
             support_x = x_lower if moving == "upper" else x_upper
-            lift = _feasible_lift(params, settings, moving, x0 - support_x, x0 + stride - support_x)
-            if lift is None:
-                return GaitPlan("no_plan", f"the {moving} step of {stride} m leaves the workspace")
-            margin = _transfer_margin(params, moving, x0 - support_x, x0 + stride - support_x)
-            if margin < settings.min_margin:
-                return GaitPlan(
-                    "no_plan",
-                    f"stride {stride} m drops the static margin to {margin:.4f} m "
-                    f"< min_margin {settings.min_margin} m",
-                )
-            steps.append(
-                PlatformStep(
-                    moving=moving,
-                    start_x=x0,
-                    end_x=x0 + stride,
-                    support_x=support_x,
-                    lift=lift,
-                    swing_extension=_swing_extension(moving, params, settings),
-                    landing_extension={leg: 0.0 for leg in PLATFORM_LEGS[moving]},
-                    support_extension=dict.fromkeys(PLATFORM_LEGS[_other(moving)], 0.0),
-                    min_margin=margin,
-                )
-            )
+            step = platform_step(params, settings, moving, x0, x0 + stride, support_x)
+            if isinstance(step, str):
+                return GaitPlan("no_plan", f"stride {stride} m: {step}")
+            steps.append(step)
             if moving == "upper":
                 x_upper += stride
             else:
@@ -507,7 +539,7 @@ class _Crossing:
         self.grid = g = settings.grid
         self.band = params.foot_radius + settings.edge_clearance
         """Closest a foot's centre may land to a ditch edge [m]."""
-        self.limit = _stride_limit(params, settings)
+        self.limit = stride_limit(params, settings)
         self.can_stand = ditch.depth <= params.leg_extend and ditch.width >= 2 * self.band + g
         """A foot can stand on the bottom: within the legs' reach and wide enough."""
         self.can_step_over = ditch.width + 2 * self.band <= self.limit
@@ -642,10 +674,7 @@ def _platform_steps(crossing: _Crossing, chain) -> tuple[PlatformStep, ...]:
         else:
             lift, margin = moves.lower[j0, j1]
             start_x, end_x, support_x = x_lower0, x_lower1, x_upper0
-        landing = {}
-        for leg in PLATFORM_LEGS[mover]:
-            foot_x = end_x + float(params.foot_offset(leg)[0])
-            landing[leg] = crossing.ditch.depth if crossing.ditch.ground_height(foot_x) < 0 else 0.0
+        landing = landing_extensions(params, mover, end_x, crossing.ditch)
         steps.append(
             PlatformStep(
                 moving=mover,
@@ -721,7 +750,7 @@ def plan_flat_past(
         raise ValueError(
             f"goal_x = {goal_x} m is already behind the robot's rear feet (start x = {x_start} m)"
         )
-    stride = _stride_limit(params, settings)
+    stride = stride_limit(params, settings)
     return plan_flat_walk(
         params, int(math.ceil(distance / stride - 1e-9)), x_start=x_start, settings=settings
     )

@@ -706,3 +706,41 @@ def test_same_task_evaluations_log_the_change_since_step_0():
     callback._log_change_since_start()
     assert logger.values["eval/success_change_since_start"] == pytest.approx(0.5)
     assert logger.values["eval/return_change_since_start"] == pytest.approx(3.0)
+
+
+@pytest.mark.parametrize(
+    "env_id",
+    [
+        "HexapodCliffWalk-v1",
+        "HexapodStewartTilt-v1",
+        "HexapodIrregularTerrain-v1",
+        "HexapodDitchCrossing-v1",
+    ],
+)
+def test_every_switch_that_shapes_the_spaces_is_a_policy_setting(env_id):
+    """A run is evaluated with the POLICY_SETTINGS it was trained with; an on/off setting that
+    changes the action or observation space but is missing there would be evaluated with the
+    suite's default, and the model would not fit the env."""
+    import dataclasses
+
+    from agents.env_kwargs import POLICY_SETTINGS
+
+    with gym.make(env_id) as env:
+        base = env.unwrapped
+        spaces = (env.action_space.shape, env.observation_space.shape)
+        switches = [
+            f.name
+            for f in dataclasses.fields(base.settings)
+            if getattr(base.settings, f.name) is False
+        ]
+    assert switches  # the envs have such switches (the scans, the extra actions)
+    shaping = []
+    for name in switches:
+        try:
+            made = gym.make(env_id, **{name: True})
+        except ValueError:  # needs other settings too (e.g. a walking scenario)
+            continue
+        with made:
+            if (made.action_space.shape, made.observation_space.shape) != spaces:
+                shaping.append(name)
+    assert shaping and not set(shaping) - set(POLICY_SETTINGS), shaping

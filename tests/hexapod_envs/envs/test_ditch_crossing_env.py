@@ -277,3 +277,54 @@ def test_an_episode_past_the_bonus_horizon_warns_once():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         env.step(ZERO)
+
+
+def test_stride_action_needs_the_residual_mode_and_the_flat_reference():
+    with pytest.raises(ValueError, match="reference_plan='flat'"):
+        gym.make("HexapodDitchCrossing-v0", stride_action=True)  # -v0 plans for the course
+    with pytest.raises(ValueError, match="action_mode='residual'"):
+        gym.make("HexapodDitchCrossing-v1", stride_action=True, action_mode="joint")
+    with pytest.raises(ValueError, match="stride_action"):
+        gym.make("HexapodDitchCrossing-v1", stride_action="yes")
+
+
+def test_full_strides_walk_the_flat_reference_bit_for_bit_on_flat_ground():
+    plain = gym.make("HexapodDitchCrossing-v1", terrain="flat")
+    strided = gym.make("HexapodDitchCrossing-v1", terrain="flat", stride_action=True)
+    assert strided.action_space.shape == (10,)
+    size = plain.observation_space.shape[0]
+    a, _ = plain.reset(seed=3)
+    b, _ = strided.reset(seed=3)
+    np.testing.assert_array_equal(a, b[:size])  # the extra pieces come last
+    for _ in range(160):  # three platform steps, decided at 0, 51 and 102
+        a, ra, *_, ia = plain.step(ZERO)
+        b, rb, *_, ib = strided.step(np.zeros(10))
+        np.testing.assert_array_equal(a, b[:size])
+        assert ra == rb and (ia["gait_step"], ia["gait_phase"]) == (
+            ib["gait_step"],
+            ib["gait_phase"],
+        )
+
+
+def test_the_stride_value_counts_only_on_a_steps_first_control_step():
+    env = gym.make("HexapodDitchCrossing-v1", stride_action=True)  # the paper's ditch
+    base = env.unwrapped
+    obs, _ = env.reset(seed=0)
+    ahead = obs[base.observation_structure["ditch_ahead"]]
+    decision = base.observation_structure["stride_decision"]
+    np.testing.assert_allclose(ahead, [0.6, 0.95, 0.6, 0.95, 0.14])  # both centres at x = 0
+    assert obs[decision].tolist() == [1.0, 1.0]  # the upper platform, decided by this action
+    action = np.zeros(10)
+    action[9] = -0.5
+    obs, *_ = env.step(action)  # step 0: half a stride
+    action[9] = -1.0  # ignored until the next step begins
+    decided_at = []
+    for t in range(1, 60):
+        if obs[decision][1]:
+            decided_at.append(t)
+            action[9] = 0.0
+        obs, *_ = env.step(action)
+    assert decided_at == [51]  # 5.1 s per platform step at 10 Hz
+    gait = base.online_gait
+    assert [s.stride for s in gait.steps] == pytest.approx([0.08, 0.08])  # the lower's room
+    np.testing.assert_allclose(obs[base.observation_structure["ditch_ahead"]][[0, 2]], 0.52)

@@ -1,0 +1,159 @@
+"""Does the ditch env's stride action hold a crossing? Simple stride rules played through it.
+
+`HexapodDitchCrossing-v1(stride_action=True)` builds the reference gait one platform step at a
+time: the action's 10th value sets each step's stride as it begins and the legs land at the
+ground under each foot (docs/results.md, "Pure PPO on the ditch crossing"). Before pure PPO is
+asked to learn a stride policy, this study checks which simple rules succeed through that
+action (the nine residuals stay 0):
+
+- ``full``: every stride full (the zero action): the flat gait, landing in the ditch;
+- ``random``: a uniform random stride value at every step (exploration's lower bound);
+- ``planner``: the strides of the paper's planner (`plan_ditch_crossing`) for the task's ditch;
+- ``greedy``: from the observation alone (``ditch_ahead``, ``stride_decision``): the longest
+  stride that lands every moving foot at least the planner's band (foot radius + edge
+  clearance) from both edges, else the one that lands them farthest from an edge.
+
+    python experiments/ditch_stride/rules.py [--distribution train] [--tasks 10] [--rules greedy]
+
+Prints one line per rule and task distribution (successes, tip-overs, CoG advance) and the
+per-task outcomes. Findings: README.md.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import gymnasium as gym
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+import hexapod_envs  # noqa: E402,F401
+from agents.policy import ObservationReader  # noqa: E402
+from hexapod_envs.checks import count_argument  # noqa: E402
+from hexapod_envs.robots.upu.gait_plan import plan_ditch_crossing  # noqa: E402
+from hexapod_envs.robots.upu.params import PLATFORM_LEGS  # noqa: E402
+
+ENV_ID = "HexapodDitchCrossing-v1"
+RULES = ("full", "random", "planner", "greedy")
+
+
+def stride_value(stride: float, max_stride: float) -> float:
+    """The action value whose stride is `stride` [m] (0 for the full stride)."""
+    return min(stride / max_stride - 1.0, 0.0)
+
+
+class StrideRule:
+    """A policy of the stride action: residuals 0, the stride value from `stride()`."""
+
+    def __init__(self, env: gym.Env, rule: str, seed: int = 0):
+        self.env, self.rule = env.unwrapped, rule
+        self.read = ObservationReader(self.env.observation_structure)
+        self.rng = np.random.default_rng(seed)
+        params, settings = self.env.params, self.env.gait_settings
+        self.band = params.foot_radius + settings.edge_clearance
+        self.reach = params.leg_extend
+        self.offsets = {
+            m: np.array([params.foot_offset(leg)[0] for leg in PLATFORM_LEGS[m]])
+            for m in PLATFORM_LEGS
+        }
+        self.plan = None
+
+    def reset(self) -> None:
+        self.plan = None
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        action = np.zeros(10, dtype=np.float32)
+        obs = self.read(observation)
+        if obs["stride_decision"][1] > 0.5:
+            action[9] = self.stride_value(obs)
+        return action
+
+    def stride_value(self, obs: dict) -> float:
+        gait = self.env.online_gait
+        if self.rule == "full":
+            return 0.0
+        if self.rule == "random":
+            return float(self.rng.uniform(-1.0, 1.0))
+        if self.rule == "planner":
+            if self.plan is None:
+                self.plan = plan_ditch_crossing(
+                    self.env.params, self.env.ditch, self.env.start_x, self.env.gait_settings
+                )
+            k = len(gait.steps)
+            if not self.plan.ok or k >= len(self.plan.steps):
+                return 0.0
+            return stride_value(self.plan.steps[k].stride, gait.max_stride)
+        return self.greedy(obs["ditch_ahead"], obs["stride_decision"][0] > 0.5, gait)
+
+    def greedy(self, ahead: np.ndarray, upper_next: bool, gait) -> float:
+        """The longest stride landing every moving foot `band` from both edges (observation
+        only; the stride limits are the robot's constants)."""
+        near_u, far_u, near_l, far_l, depth = ahead
+        lead = near_l - near_u  # x_upper - x_lower
+        room = gait.max_stride - lead if upper_next else lead
+        near, far = (near_u, far_u) if upper_next else (near_l, far_l)
+        feet0 = self.offsets["upper" if upper_next else "lower"]
+        grid = gait.min_stride
+        strides = np.arange(max(room, grid), grid - 1e-9, -grid)
+        feet = strides[:, None] + feet0[None, :]  # foot x relative to the edges' frame
+        if depth <= self.reach:
+            clear = np.minimum(np.abs(feet - near), np.abs(feet - far)).min(axis=1)
+        else:  # too deep to stand in: a foot may not land in the ditch at all
+            inside = (feet > near - self.band) & (feet < far + self.band)
+            gap = np.minimum(np.abs(feet - near), np.abs(feet - far))
+            clear = np.where(inside, -gap, gap).min(axis=1)
+        ok = np.flatnonzero(clear >= self.band)
+        best = ok[0] if ok.size else int(np.argmax(clear))
+        return stride_value(float(strides[best]), gait.max_stride)
+
+
+def run(rule: str, distribution: str, tasks: int) -> list[dict]:
+    env = gym.make(ENV_ID, stride_action=True, task_distribution=distribution)
+    policy = StrideRule(env, rule)
+    rows = []
+    for seed in range(tasks):
+        obs, info = env.reset(seed=seed)
+        policy.reset()
+        done = False
+        while not done:
+            obs, _, terminated, truncated, info = env.step(policy(obs))
+            done = terminated or truncated
+        rows.append(
+            {
+                "seed": seed,
+                "success": bool(info["is_success"]),
+                "tipped": bool(info["is_tipped_over"]),
+                "distance": float(info["distance"]),
+                "max_tilt": float(info["max_tilt_deg"]),
+                "ditch": info["ditch"],
+            }
+        )
+    env.close()
+    return rows
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--distribution", choices=("train", "test"), default="train")
+    ap.add_argument("--tasks", type=count_argument(), default=10)
+    ap.add_argument("--rules", nargs="+", choices=RULES, default=list(RULES))
+    args = ap.parse_args()
+    for rule in args.rules:
+        rows = run(rule, args.distribution, args.tasks)
+        wins = sum(r["success"] for r in rows)
+        tips = sum(r["tipped"] for r in rows)
+        print(
+            f"{rule:8s} {args.distribution}: {wins}/{len(rows)} crossed, {tips} tip-overs; "
+            + " ".join(
+                f"{r['seed']}:{'S' if r['success'] else 'T' if r['tipped'] else '-'}"
+                f"({r['distance']:.2f} m, {r['max_tilt']:.1f} deg)"
+                for r in rows
+            ),
+            flush=True,
+        )
+
+
+if __name__ == "__main__":
+    main()

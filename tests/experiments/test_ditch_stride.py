@@ -1,0 +1,26 @@
+"""experiments/ditch_stride/rules.py: stride rules through the ditch env's stride action."""
+
+import gymnasium as gym
+import numpy as np
+
+from experiments.ditch_stride.rules import ENV_ID, StrideRule, run
+
+
+def test_the_greedy_rule_reads_the_observation_and_crosses_where_full_strides_tip():
+    greedy = run("greedy", "train", 2)  # training ditches 0 and 1: the full stride tips on both
+    full = run("full", "train", 2)
+    assert [r["success"] for r in greedy] == [True, True]
+    assert [r["tipped"] for r in full] == [True, True]
+
+
+def test_a_rule_sets_the_stride_value_only_when_a_step_is_decided():
+    env = gym.make(ENV_ID, stride_action=True, task_distribution="train")
+    policy = StrideRule(env, "random", seed=1)
+    obs, _ = env.reset(seed=0)
+    decision = env.unwrapped.observation_structure["stride_decision"]
+    for _ in range(60):
+        action = policy(obs)
+        assert action.shape == (10,) and not action[:9].any()
+        assert (action[9] != 0) == bool(obs[decision][1])  # a random value is never exactly 0
+        obs, *_ = env.step(action)
+    assert np.all([-1 <= s.stride / 0.16 - 1 <= 0 for s in env.unwrapped.online_gait.steps])
