@@ -463,8 +463,7 @@ def _callbacks(
 ) -> list[Any]:
     """The training callbacks other than evaluation: each finished episode's statistics to the
     log, each step's safety override into the rollout buffer when ``hybrid.mask_overridden``,
-    the unread action values scored at the mean when ``ppo.score_unread_at_mean``, and a
-    checkpoint every ``checkpoint.freq`` steps (0: none)."""
+    and a checkpoint every ``checkpoint.freq`` steps (0: none)."""
     from .callbacks import CheckpointEvery, EpisodeStatsCallback
 
     callbacks = [EpisodeStatsCallback(new_accumulator)]
@@ -472,10 +471,6 @@ def _callbacks(
         from .override_mask import RecordOverrides
 
         callbacks.append(RecordOverrides())
-    if config.ppo.score_unread_at_mean:
-        from .unread_actions import ScoreUnreadAtMean
-
-        callbacks.append(ScoreUnreadAtMean())
     if config.checkpoint.freq > 0:
         callbacks.append(CheckpointEvery(config.checkpoint.freq, saver))
     return callbacks

@@ -223,9 +223,6 @@ class PPOConfig:
     use_sde: bool = False
     sde_sample_freq: int = -1
     target_kl: float | None = None
-    score_unread_at_mean: bool = False
-    """Score the action values the env did not read at a step (its ``info["unread_actions"]``)
-    at the policy's mean (`agents.pipeline.unread_actions`); not an SB3 argument."""
 
     def __post_init__(self):
         _require_schedule("ppo.learning_rate", self.learning_rate)
