@@ -64,7 +64,9 @@ pieces follow the others: ``ditch_ahead`` (5: the near and far edge x relative t
 then the lower platform centre where the decided steps leave them [m], then the depth [m]; on
 flat ground both edges at the finish line and depth 0) and ``stride_decision`` (2: 1 if the
 upper platform moves next; 1 if the next action's stride value decides that step). The zero
-action walks full strides; on flat ground that is the flat reference, bit for bit.
+action walks full strides; on flat ground that is the flat reference, bit for bit, to the end
+of the flat reference's plan (which then stands, where the online gait walks on). A ditch
+deeper than a leg's reach (0.16 m) gets the leg's full extension.
 
 Control runs at 10 Hz (control_dt = 0.1 s, physics 2 ms); the servo drives interpolate: each
 target is approached linearly over the control period, at most 0.25 m/s for a limb and 1 m/s
@@ -97,10 +99,7 @@ stance_legs, is_tipping (static_margin_m <= 0: the CoG projection is not inside 
 feet's polygon), min_static_margin_m (the smallest static_margin_m since reset [m]: how close
 the crossing came to tipping), is_tipped_over, is_success, sim_unstable, distance (CoG advance
 [m]), tilt_deg, planner_status, planner_reason, ditch (start_x, width, depth [m]; None on flat
-ground), finish_x [m], gait_step and gait_phase (the reference's plan step and phase), time, cog;
-with ``stride_action``, unread_actions: ``(9,)`` on the steps whose stride value decided
-nothing, else ``()`` (training can score those values at the policy's mean,
-``ppo.score_unread_at_mean``).
+ground), finish_x [m], gait_step and gait_phase (the reference's plan step and phase), time, cog.
 
 ## Arguments
 `DitchCrossingSettings` (``gym.make(id, **kwargs)``).
@@ -563,23 +562,21 @@ class DitchCrossingEnv(HexapodEnv):
     def _start_episode(self) -> None:
         self._residual = np.zeros(len(COMMAND_NAMES))
         self._min_static_margin = np.inf
-        self._episode_info = {  # info entries fixed for the episode
-            "planner_status": self.plan.status,
-            "planner_reason": self.plan.reason,
-            "finish_x": self.finish_x,
-        }
         if self.stride_action:
             ditch = self.ditch if self.terrain == "ditch" else None
             self.online_gait = OnlineGait(self.params, self.gait_settings, self.start_x, ditch)
             """With `stride_action`: the online gait's state and the steps decided so far."""
             self._set_online_schedule()
-            self._stride_read = True
-            """With `stride_action`: the last action's stride value set a step's stride."""
+        self._episode_info = {  # info entries fixed for the episode
+            "planner_status": self.plan.status,
+            "planner_reason": self.plan.reason,
+            "finish_x": self.finish_x,
+        }
 
     def _set_online_schedule(self) -> None:
         """With `stride_action`: the reference gait is the decided steps and, pending, the
         full-stride step from where they end. The pending step's first phases (unload, lift,
-        hold) do not depend on its stride, so its rows before the transfer are exact; its
+        unloaded) do not depend on its stride, so its rows before the transfer are exact; its
         first row is the control step whose action decides the stride (`_decide_at`)."""
         gait = self.online_gait
         pending = gait.next_step(gait.stride_for(0.0))
@@ -597,11 +594,9 @@ class DitchCrossingEnv(HexapodEnv):
         return self.schedule.command(self._step_count if tick is None else tick)
 
     def _apply_action(self, action: np.ndarray) -> None:
-        if self.stride_action:
-            self._stride_read = self._step_count == self._decide_at
-            if self._stride_read:
-                self.online_gait.advance(self.online_gait.stride_for(action[9]))
-                self._set_online_schedule()
+        if self.stride_action and self._step_count == self._decide_at:
+            self.online_gait.advance(self.online_gait.stride_for(action[9]))
+            self._set_online_schedule()
         if self.action_mode == "joint":
             target = self._center + self._half * action
         else:
@@ -747,5 +742,4 @@ class DitchCrossingEnv(HexapodEnv):
             "ditch": self._ditch_info,  # a new dict every step (callers may keep infos)
             "gait_step": step,
             "gait_phase": phase,
-            **({"unread_actions": () if self._stride_read else (9,)} if self.stride_action else {}),
         }

@@ -114,4 +114,6 @@ class OnlineGait:
         """The steps taken so far (and `pending`, a step not yet taken) as a `GaitPlan`, for
         `gait_schedule.GaitSchedule`."""
         steps = tuple(self.steps) + ((pending,) if pending is not None else ())
-        return GaitPlan("ok", f"{len(self.steps)} steps decided online", steps, self.ditch)
+        return GaitPlan(
+            "ok", "strides decided online, one platform step at a time", steps, self.ditch
+        )

@@ -328,3 +328,13 @@ def test_the_stride_value_counts_only_on_a_steps_first_control_step():
     gait = base.online_gait
     assert [s.stride for s in gait.steps] == pytest.approx([0.08, 0.08])  # the lower's room
     np.testing.assert_allclose(obs[base.observation_structure["ditch_ahead"]][[0, 2]], 0.52)
+
+
+def test_the_online_gaits_planner_info_does_not_depend_on_the_last_episode():
+    env = gym.make("HexapodDitchCrossing-v1", stride_action=True)
+    _, first = env.reset(seed=0)
+    for _ in range(60):
+        env.step(np.zeros(10))
+    _, again = env.reset(seed=0)
+    assert first["planner_reason"] == again["planner_reason"] == env.unwrapped.plan.reason
+    assert "online" in first["planner_reason"] and len(env.unwrapped.online_gait.steps) == 0
