@@ -674,10 +674,10 @@ class DitchCrossingEnv(HexapodEnv):
         """With `stride_action`: the ditch's near and far edges relative to the upper, then
         the lower platform centre where the decided steps leave them [m], and its depth [m]
         (on flat ground both edges at the finish line, depth 0)."""
-        g = self.online_gait
-        near, far = (self.ditch.start_x, self.ditch.end_x)
-        depth = self.ditch.depth
-        if self.terrain != "ditch":
+        g, d = self.online_gait, self.ditch
+        if self.terrain == "ditch":
+            near, far, depth = d.start_x, d.end_x, d.depth
+        else:
             near = far = self.finish_x
             depth = 0.0
         return np.array(
