@@ -194,7 +194,7 @@ def new_model(config: TrainConfig, venv: Any) -> Any:
     from stable_baselines3 import PPO
 
     model = PPO(
-        policy_class(config.policy.critic_privileged),
+        policy_class(config.policy.critic_privileged, config.policy.score_read_actions_only),
         venv,
         policy_kwargs=config.policy.policy_kwargs(),
         seed=config.train.seed,
@@ -206,7 +206,24 @@ def new_model(config: TrainConfig, venv: Any) -> Any:
         from ..hybrid import zero_init_action_net
 
         zero_init_action_net(model)
+    _set_action_read_flags(config, model, venv)
     return model
+
+
+def _set_action_read_flags(config: TrainConfig, model: Any, venv: Any) -> None:
+    """With ``policy.score_read_actions_only``: tell the policy which action values the env
+    reads only on some steps (UserError for an env that reads every value on every step)."""
+    if not config.policy.score_read_actions_only:
+        return
+    flags = venv.get_attr("action_read_flags", indices=[0])[0]
+    if not flags:
+        raise UserError(
+            f"policy.score_read_actions_only: {config.env.id} with env.kwargs "
+            f"{dict(config.env.kwargs)} reads every action value on every step (no "
+            "action_read_flags), so there is nothing to leave out; the option applies to "
+            "HexapodDitchCrossing-v1 with stride_action: true, or set it to false"
+        )
+    model.policy.set_action_read_flags(flags)
 
 
 def _masks_overridden(config: TrainConfig) -> bool:
@@ -386,6 +403,7 @@ def _load_checkpoint(
         clip_range=ppo.clip_range,
         clip_range_vf=ppo.clip_range_vf,
         privileged_critic=config.policy.critic_privileged,
+        score_read_actions_only=config.policy.score_read_actions_only,
     )
     try:
         model = load_ppo(
@@ -397,6 +415,7 @@ def _load_checkpoint(
             verbose=config.logging.verbose,
             **_ppo_kwargs(config),
         )
+        _set_action_read_flags(config, model, venv)
     except BaseException:
         for env in (venv, eval_env):
             close_vec_env(env)

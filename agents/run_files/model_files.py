@@ -235,9 +235,14 @@ def pickled_entries(model_zip: str | Path) -> list[str]:
     return sorted(k for k, v in data.items() if isinstance(v, dict) and ":serialized:" in v)
 
 
-def policy_class(privileged_critic: bool = False) -> Any:
+def policy_class(privileged_critic: bool = False, score_read_actions_only: bool = False) -> Any:
     """The SB3 policy class of a run: ``MlpPolicy``, or with ``policy.critic_privileged`` the
-    asymmetric `agents.privileged_critic_policy.PrivilegedCriticPolicy`."""
+    asymmetric `agents.privileged_critic_policy.PrivilegedCriticPolicy`; with
+    ``policy.score_read_actions_only`` their forms of `agents.read_actions` (the same weights)."""
+    if score_read_actions_only:
+        from ..read_actions import ReadActionsMlpPolicy, ReadActionsPrivilegedPolicy
+
+        return ReadActionsPrivilegedPolicy if privileged_critic else ReadActionsMlpPolicy
     if privileged_critic:
         from ..privileged_critic_policy import PrivilegedCriticPolicy
 
@@ -255,13 +260,14 @@ def ppo_custom_objects(
     clip_range: Any = 0.0,
     clip_range_vf: Any = None,
     privileged_critic: bool = False,
+    score_read_actions_only: bool = False,
 ) -> dict[str, Any]:
     """Objects that replace every pickled entry of a PPO zip (see `_REBUILT_ENTRIES`).
 
     Inference needs no schedules (0.0); resuming passes the config's learning-rate and clip
     schedules. The policy class is the one `training` trains (`policy_class`)."""
     return {
-        "policy_class": policy_class(privileged_critic),
+        "policy_class": policy_class(privileged_critic, score_read_actions_only),
         "policy_kwargs": dict(policy_kwargs),
         "observation_space": observation_space,
         "action_space": action_space,

@@ -170,6 +170,11 @@ class PolicyConfig:
     """An asymmetric actor-critic: the value function also sees the task's parameters and the
     elapsed share of the episode (`agents.privileged_critic`); the actor still sees only the
     sensor observation."""
+    score_read_actions_only: bool = False
+    """PPO's likelihood counts an action value only on the steps where the env reads it (an env
+    that reads some values only on some steps names them in ``action_read_flags``, such as the
+    ditch's stride value): an ignored value's sample adds noise and no signal to the gradient
+    (`agents.read_actions`). Training only; a trained model acts as any other."""
 
     def __post_init__(self):
         for name in ("pi", "vf"):
@@ -452,6 +457,14 @@ class TrainConfig:
                 "the ditch crossing, whose planner's settings a knobs section learns "
                 '(knobs.reward); with env.decision: episode use "success", "stable_success" or '
                 '"return"'
+            )
+        if self.policy.score_read_actions_only and (
+            self.hybrid is not None or self.knobs is not None or self.ppo.use_sde
+        ):
+            raise ValueError(
+                "policy.score_read_actions_only scores the env's own action values with a "
+                "diagonal Gaussian; it needs no hybrid or knobs section (they change the action) "
+                "and ppo.use_sde: false"
             )
         planner_knobs = self.knobs is not None and self.knobs.controller == "planner"
         if planner_knobs and self.policy.critic_privileged:

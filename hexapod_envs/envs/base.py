@@ -234,6 +234,15 @@ class HexapodEnv(SafetyFigures, gym.Env):
         """Name -> slice of every piece of the flat observation vector."""
         return dict(self.observation_layout.slices)
 
+    @property
+    def action_read_flags(self) -> dict[int, int]:
+        """Action values the env reads only on some steps: action index -> index of the
+        observation value that is 1.0 when the next action's value at that index is read and
+        0.0 when it is ignored. Empty (every env's default): every value is read on every step.
+        A learner can leave an ignored value out of its action's likelihood
+        (`agents.read_actions`)."""
+        return {}
+
     def _observation(self) -> np.ndarray:
         self.observation_layout.write(self._obs_buffer)
         if self.sensor_noise:

@@ -66,7 +66,9 @@ flat ground both edges at the finish line and depth 0) and ``stride_decision`` (
 upper platform moves next; 1 if the next action's stride value decides that step). The zero
 action walks full strides; on flat ground that is the flat reference, bit for bit, to the end
 of the flat reference's plan (which then stands, where the online gait walks on). A ditch
-deeper than a leg's reach (0.16 m) gets the leg's full extension.
+deeper than a leg's reach (0.16 m) gets the leg's full extension. ``action_read_flags`` names
+the stride value and its flag, for learners that score a value only where it is read
+(`agents.read_actions`).
 
 Control runs at 10 Hz (control_dt = 0.1 s, physics 2 ms); the servo drives interpolate: each
 target is approached linearly over the control period, at most 0.25 m/s for a limb and 1 m/s
@@ -159,6 +161,8 @@ from .settings import (
 
 TERRAINS = ("ditch", "flat")
 ACTION_MODES = ("joint", "residual")
+STRIDE_ACTION = len(COMMAND_NAMES)
+"""With `stride_action`: the index of the stride value, after the nine `COMMAND_NAMES`."""
 GRAVITY = 9.81
 
 
@@ -595,7 +599,7 @@ class DitchCrossingEnv(HexapodEnv):
 
     def _apply_action(self, action: np.ndarray) -> None:
         if self.stride_action and self._step_count == self._decide_at:
-            self.online_gait.advance(self.online_gait.stride_for(action[9]))
+            self.online_gait.advance(self.online_gait.stride_for(action[STRIDE_ACTION]))
             self._set_online_schedule()
         if self.action_mode == "joint":
             target = self._center + self._half * action
@@ -683,6 +687,14 @@ class DitchCrossingEnv(HexapodEnv):
         return np.array(
             [near - g.x_upper, far - g.x_upper, near - g.x_lower, far - g.x_lower, depth]
         )
+
+    @property
+    def action_read_flags(self) -> dict[int, int]:
+        """With `stride_action`: the stride value (action 9) is read when ``stride_decision``'s
+        second value is 1, on a platform step's first control step."""
+        if not self.stride_action:
+            return {}
+        return {STRIDE_ACTION: self.observation_layout.slices["stride_decision"].start + 1}
 
     def _stride_decision(self) -> np.ndarray:
         """With `stride_action`: (1 if the upper platform moves next, 1 if the next action's

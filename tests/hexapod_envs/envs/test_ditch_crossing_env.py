@@ -288,6 +288,10 @@ def test_stride_action_needs_the_residual_mode_and_the_flat_reference():
         gym.make("HexapodDitchCrossing-v1", stride_action="yes")
 
 
+def test_without_the_stride_action_every_action_value_is_read_on_every_step():
+    assert gym.make("HexapodDitchCrossing-v1").unwrapped.action_read_flags == {}
+
+
 def test_full_strides_walk_the_flat_reference_bit_for_bit_on_flat_ground():
     plain = gym.make("HexapodDitchCrossing-v1", terrain="flat")
     strided = gym.make("HexapodDitchCrossing-v1", terrain="flat", stride_action=True)
@@ -314,6 +318,7 @@ def test_the_stride_value_counts_only_on_a_steps_first_control_step():
     decision = base.observation_structure["stride_decision"]
     np.testing.assert_allclose(ahead, [0.6, 0.95, 0.6, 0.95, 0.14])  # both centres at x = 0
     assert obs[decision].tolist() == [1.0, 1.0]  # the upper platform, decided by this action
+    assert base.action_read_flags == {9: decision.start + 1}  # the stride, read on that flag
     action = np.zeros(10)
     action[9] = -0.5
     obs, *_ = env.step(action)  # step 0: half a stride
