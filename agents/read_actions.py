@@ -7,13 +7,15 @@ are and which observation value flags the steps that read them (``env.action_rea
 action index -> observation index of a 0/1 flag).
 
 PPO's likelihood ratio multiplies the likelihoods of all action values. An ignored value's
-sample changes nothing that follows, so its term carries no signal; but its score,
-``(a - mu) / sigma^2``, weighted by the step's advantage, still enters the gradient of its mean
-and standard deviation: noise that, for the stride, outnumbers the signal 50 to 1. Leaving an
-ignored value out of the log-likelihood (and the entropy) removes that noise and no signal, as
-invalid-action masking does for discrete actions: the policy gradient stays unbiased because
-the value's sample is independent of the rest of the episode. Sampling and acting are unchanged;
-only training differs, so a deployed model is an ordinary SB3 policy.
+sample changes nothing that follows, so its term carries no signal; but its scores (for the
+mean ``(a - mu) / sigma^2``, for the log standard deviation ``(a - mu)^2 / sigma^2 - 1``),
+weighted by the step's advantage, still enter the gradient: zero-mean noise, from 50 of every
+51 steps for the stride against the one step whose sample matters. Leaving an ignored value
+out of the log-likelihood removes that noise and no signal, as invalid-action masking does for
+discrete actions: the policy gradient stays unbiased because the value's sample is independent
+of the rest of the episode. The entropy bonus (``ent_coef``) counts the value on the same steps
+only. Sampling and acting are unchanged; only training differs, so a deployed model is an
+ordinary SB3 policy.
 
 A training config turns it on with ``policy.score_read_actions_only: true``; the policies here
 are SB3's ``MlpPolicy`` and the asymmetric `PrivilegedCriticPolicy` with that scoring.

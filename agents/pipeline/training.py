@@ -106,16 +106,24 @@ def env_spec(config: TrainConfig) -> EnvSpec:
 
 
 def _probe(
-    spec: EnvSpec,
+    spec: EnvSpec, score_read_actions_only: bool = False
 ) -> tuple[Callable[[], EpisodeAccumulator], dict[str, Any] | None]:
     """Make one env in this process: clear errors early; read its time step (None when a
     learner step is a gait cycle), metric specs and the robot's tipping threshold ξ (the time
     below it is logged). Returns a factory of episode
     accumulators for the training and evaluation callbacks, and the env's resolved settings
     (recorded with the run, see `agents.run_files.env_settings`); with ``reward_exclude``, one
-    step checks that the terms exist."""
+    step checks that the terms exist; with `score_read_actions_only`, that the env has action
+    values it reads only on some steps."""
     env = spec.make()
     try:
+        if score_read_actions_only and not env.unwrapped.action_read_flags:
+            raise UserError(
+                f"policy.score_read_actions_only: {spec.id} with env.kwargs {spec.kwargs} "
+                "reads every action value on every step (no action_read_flags), so there is "
+                "nothing to leave out; the option applies to HexapodDitchCrossing-v1 with "
+                "stride_action: true, or set it to false"
+            )
         if spec.reward_exclude:  # a term missing from the info is named at the first step
             env.reset(seed=0)
             env.step(np.zeros(env.action_space.shape, env.action_space.dtype))
@@ -132,7 +140,7 @@ def _probe(
 def check_env(config: TrainConfig) -> None:
     """Build the config's env once in this process, so that its errors (an unknown keyword, a
     misspelt reward term) come before any folder exists, e.g. before a sweep starts Ray."""
-    _probe(env_spec(config))
+    _probe(env_spec(config), config.policy.score_read_actions_only)
 
 
 def _vec_envs(config: TrainConfig, seed: int, stats: NormalizationStats | None = None):
@@ -212,18 +220,9 @@ def new_model(config: TrainConfig, venv: Any) -> Any:
 
 def _set_action_read_flags(config: TrainConfig, model: Any, venv: Any) -> None:
     """With ``policy.score_read_actions_only``: tell the policy which action values the env
-    reads only on some steps (UserError for an env that reads every value on every step)."""
-    if not config.policy.score_read_actions_only:
-        return
-    flags = venv.get_attr("action_read_flags", indices=[0])[0]
-    if not flags:
-        raise UserError(
-            f"policy.score_read_actions_only: {config.env.id} with env.kwargs "
-            f"{dict(config.env.kwargs)} reads every action value on every step (no "
-            "action_read_flags), so there is nothing to leave out; the option applies to "
-            "HexapodDitchCrossing-v1 with stride_action: true, or set it to false"
-        )
-    model.policy.set_action_read_flags(flags)
+    reads only on some steps (`_probe` has checked that it has some)."""
+    if config.policy.score_read_actions_only:
+        model.policy.set_action_read_flags(venv.get_attr("action_read_flags", indices=[0])[0])
 
 
 def _masks_overridden(config: TrainConfig) -> bool:
@@ -245,7 +244,7 @@ def untrained_model(config: TrainConfig) -> tuple[Any, dict[str, Any] | None]:
     """`new_model` on the config's training vec env (VecNormalize on top when configured), for
     models fitted outside PPO's own loop (e.g. by distillation), and the env's resolved
     settings (to record with the model, see `agents.run_files.env_settings`)."""
-    _, settings = _probe(env_spec(config))
+    _, settings = _probe(env_spec(config), config.policy.score_read_actions_only)
     venv, eval_env = _vec_envs(config, config.train.seed)
     if eval_env is not None:
         eval_env.close()
@@ -268,7 +267,7 @@ def start_training(
     metrics to Ray Tune.
     """
     spec = env_spec(config)
-    new_accumulator, settings = _probe(spec)
+    new_accumulator, settings = _probe(spec, config.policy.score_read_actions_only)
     name = name or run_name(config.env.id, config.train.seed)
     run_dir = prepare_new_dir(Path(output_dir) / name, force, "run directory", (CONFIG_FILE,))
     try:
@@ -321,7 +320,7 @@ def resume_training(
     if not candidates:
         raise UserError(f"{run_dir} holds no checkpoint to resume from")
     spec = env_spec(config)
-    new_accumulator, settings = _probe(spec)
+    new_accumulator, settings = _probe(spec, config.policy.score_read_actions_only)
     _warn_if_settings_changed(run_dir, settings)
     model = eval_env = None
     problems = []

@@ -459,12 +459,16 @@ class TrainConfig:
                 '"return"'
             )
         if self.policy.score_read_actions_only and (
-            self.hybrid is not None or self.knobs is not None or self.ppo.use_sde
+            self.hybrid is not None
+            or self.knobs is not None
+            or self.env.decision != "step"
+            or self.ppo.use_sde
         ):
             raise ValueError(
-                "policy.score_read_actions_only scores the env's own action values with a "
-                "diagonal Gaussian; it needs no hybrid or knobs section (they change the action) "
-                "and ppo.use_sde: false"
+                "policy.score_read_actions_only scores the env's own action values, one per "
+                "control step, with a diagonal Gaussian; it needs no hybrid or knobs section, "
+                "env.decision: step (the others change the action and the observation) and "
+                "ppo.use_sde: false"
             )
         planner_knobs = self.knobs is not None and self.knobs.controller == "planner"
         if planner_knobs and self.policy.critic_privileged:

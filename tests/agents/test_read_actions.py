@@ -9,9 +9,13 @@ from stable_baselines3.common.policies import ActorCriticPolicy
 
 import hexapod_envs  # noqa: F401  (registers the ids)
 from agents.pipeline.cli import train_main
+from agents.pipeline.training import check_env, untrained_model
 from agents.pipeline.zoo import zoo_unsupported
 from agents.ppo import PPOPolicy
+from agents.privileged_critic import PRIVILEGED_DIM
+from agents.privileged_critic_policy import PrivilegedCriticPolicy
 from agents.read_actions import ReadActionsMlpPolicy, ReadActionsPrivilegedPolicy
+from agents.run_files.errors import UserError
 from agents.run_files.train_config import load_train_config
 
 OBS = gym.spaces.Box(-np.inf, np.inf, shape=(4,), dtype=np.float32)
@@ -73,6 +77,24 @@ def test_forward_samples_as_ever_and_scores_like_evaluate_actions():
     torch.testing.assert_close(log_prob, scoring.evaluate_actions(obs, actions)[1])
 
 
+def test_the_privileged_critic_form_matches_its_plain_policy_where_the_values_are_read():
+    """The actor and the critic with separate features (`PrivilegedCriticPolicy`)."""
+    space = gym.spaces.Box(-np.inf, np.inf, shape=(4 + PRIVILEGED_DIM,), dtype=np.float32)
+    torch.manual_seed(0)
+    scoring = ReadActionsPrivilegedPolicy(space, ACT, lambda _: 1e-3)
+    scoring.set_action_read_flags({2: 3})
+    plain = PrivilegedCriticPolicy(space, ACT, lambda _: 1e-3)
+    plain.load_state_dict(scoring.state_dict())
+    obs, actions = _batch()
+    obs = torch.cat([obs, torch.linspace(-1, 1, PRIVILEGED_DIM).expand(3, -1)], dim=1)
+    values, log_prob, _ = scoring.evaluate_actions(obs, actions)
+    plain_values, plain_log_prob, _ = plain.evaluate_actions(obs, actions)
+    torch.testing.assert_close(values, plain_values)
+    torch.testing.assert_close(log_prob[0], plain_log_prob[0])
+    per_value = plain.get_distribution(obs).distribution.log_prob(actions)
+    torch.testing.assert_close(log_prob[1:], per_value[1:, :2].sum(dim=1))
+
+
 def test_flags_outside_the_spaces_and_a_state_dependent_noise_are_refused():
     scoring, _ = _policies()
     with pytest.raises(ValueError, match="outside the 3 action values or the 4 observation"):
@@ -83,7 +105,12 @@ def test_flags_outside_the_spaces_and_a_state_dependent_noise_are_refused():
 
 @pytest.mark.parametrize(
     "overrides",
-    [["ppo.use_sde=true"], ["hybrid={}"], ["knobs={}", "policy.critic_privileged=false"]],
+    [
+        ["ppo.use_sde=true"],
+        ["hybrid={}"],
+        ["knobs={}", "policy.critic_privileged=false"],
+        ["env.decision=episode"],
+    ],
 )
 def test_configs_that_change_the_action_or_its_noise_are_refused(overrides):
     with pytest.raises(ValueError, match="score_read_actions_only"):
@@ -134,6 +161,19 @@ def test_a_run_trains_and_resumes_with_the_flags_and_loads_as_a_plain_policy(tmp
     assert policy(obs).shape == (10,)
 
 
-def test_an_env_that_reads_every_value_is_refused_by_name(tmp_path, capsys):
+def test_a_new_model_is_told_the_envs_flags():
+    config = load_train_config(STRIDE_CONFIG, ["policy.pi=[16]", "policy.vf=[16]"])
+    model, _ = untrained_model(config)
+    flag = model.get_env().get_attr("observation_structure")[0]["stride_decision"].start + 1
+    assert isinstance(model.policy, ReadActionsPrivilegedPolicy)
+    assert model.policy.action_read_flags == {9: flag}
+    model.get_env().close()
+
+
+def test_an_env_that_reads_every_value_is_refused_by_name_before_a_run_starts(tmp_path, capsys):
     assert _train(tmp_path, "env.kwargs={task_distribution: train}") == 2
     assert "reads every action value on every step" in capsys.readouterr().err
+    assert not (tmp_path / "run").exists()
+    config = load_train_config(STRIDE_CONFIG, ["env.kwargs={task_distribution: train}"])
+    with pytest.raises(UserError, match="nothing to leave out"):
+        check_env(config)  # what a sweep runs before it starts Ray
