@@ -1,7 +1,8 @@
 """Does a trained model beat its own step-0 policy? Paired evaluation on fixed tasks.
 
 For each model: rebuild its step-0 policy (`agents.run_files.step0`: the model with its actor's
-zero-initialised output layer zeroed again), then evaluate both on the same tasks of the
+zero-initialised output layer zeroed again, or a warm-started run's ``warm_start/`` model), then
+evaluate both on the same tasks of the
 training env (its config's env id, kwargs and minimum task difficulty; `--distribution train`
 by default: the tasks training drew from) with `evaluate.py`, the step-0 policy as the
 reference. Each model's suite and report go to

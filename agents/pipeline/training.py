@@ -29,6 +29,7 @@ from ..run_files.artifacts import (
     CONFIG_FILE,
     FINAL,
     MODEL_FILE,
+    WARM_START,
     command_line,
     prepare_new_dir,
     read_meta,
@@ -61,7 +62,7 @@ from .learning_curve import EVALUATIONS_FILE, read_evaluation_log
 EVAL_SEED_OFFSET = 10_000
 """Evaluation envs are seeded apart from the training envs."""
 
-RESUME_FIXED_SECTIONS = ("env", "policy", "normalize", "hybrid", "knobs")
+RESUME_FIXED_SECTIONS = ("env", "policy", "normalize", "hybrid", "knobs", "warm_start")
 """Config sections a resumed run cannot change (the model and its statistics depend on them)."""
 
 RESUME_FREE_KEYS = (("env", "vectorization"),)
@@ -277,11 +278,41 @@ def start_training(
         atomic_write_text(run_dir / COMMAND_FILE, command + "\n")
         venv, eval_env = _vec_envs(config, config.train.seed)
         model = new_model(config, venv)
+        if config.warm_start is not None:
+            _warm_start(model, config, venv, spec, run_dir, command, settings)
     except BaseException:
         shutil.rmtree(run_dir, ignore_errors=True)
         raise
     return _learn(
         model, config, run_dir, command, eval_env, new_accumulator, False, after_eval, settings
+    )
+
+
+def _warm_start(
+    model: Any,
+    config: TrainConfig,
+    venv: Any,
+    spec: EnvSpec,
+    run_dir: Path,
+    command: str,
+    settings: dict[str, Any] | None,
+) -> None:
+    """Clone the config's teacher into the actor (`agents.warm_start`) and save the result as
+    the run's ``warm_start/`` model: its step-0 policy."""
+    from ..warm_start import warm_start
+    from .callbacks import ModelSaver
+
+    ws = config.warm_start
+    print(f"warm start: cloning {ws.teacher!r} from {ws.episodes} episodes", flush=True)
+    summary = warm_start(model, venv, spec.make, ws, config.train.seed)
+    ModelSaver(run_dir, config, command, settings).save(
+        model, "warm_start", run_dir / WARM_START, warm_start=summary
+    )
+    print(
+        f"warm start: the teacher succeeded in {summary['teacher_successes']} of "
+        f"{summary['teacher_episodes']}; {summary['pairs']} pairs, fit loss "
+        f"{summary['final_loss']:.4g}",
+        flush=True,
     )
 
 

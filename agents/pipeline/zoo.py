@@ -79,6 +79,8 @@ def zoo_unsupported(config: TrainConfig) -> str | None:
     task, or a wrapper train.py adds around the env."""
     if config.policy.critic_privileged:
         return "policy.critic_privileged (the zoo's MlpPolicy has no privileged critic)"
+    if config.warm_start is not None:
+        return "warm_start (train.py clones a teacher into the actor first)"
     if config.policy.score_read_actions_only:
         return "policy.score_read_actions_only (the zoo's MlpPolicy scores every action value)"
     if config.env.stability_penalty:

@@ -54,6 +54,8 @@ COMMAND_FILE = "command.txt"
 META_FILE = "meta.json"
 CHECKPOINTS = "checkpoints"
 BEST, FINAL = "best", "final"
+WARM_START = "warm_start"
+"""A warm-started run's model after the warm start, before PPO: its step-0 policy."""
 
 
 def command_line(argv: list[str] | None = None) -> str:

@@ -1,4 +1,5 @@
-"""A trained model's step-0 policy, rebuilt from the model itself.
+"""A trained model's step-0 policy, rebuilt from the model itself (or, for a warm-started run,
+the run's ``warm_start/`` model: the clone of its teacher, before PPO).
 
 A run whose config zeroes the actor's last layer at the start (``policy.zero_init_action_net``,
 or the ``hybrid`` / ``knobs`` sections' key of that name) starts with a deterministic action of
@@ -20,7 +21,7 @@ import shutil
 import zipfile
 from pathlib import Path
 
-from .artifacts import META_FILE, MODEL_FILE, find_model, read_meta
+from .artifacts import META_FILE, MODEL_FILE, WARM_START, find_model, is_complete, read_meta
 from .errors import UserError
 from .model_files import atomic_path
 from .train_config import load_train_config
@@ -43,6 +44,8 @@ def write_step0_model(model_path: str | Path, out_dir: str | Path) -> Path:
             f"{files.model}: give the model's directory (its {MODEL_FILE}) to rebuild its step 0"
         )
     config = files.training_config()
+    if config is not None and load_train_config(data=config).warm_start is not None:
+        return _copy_warm_start(files.directory, Path(out_dir))
     if config is None or not load_train_config(data=config).starts_at_zero_action:
         raise UserError(
             f"the model at {files.model} was not trained from a zero-initialised actor "
@@ -58,6 +61,24 @@ def write_step0_model(model_path: str | Path, out_dir: str | Path) -> Path:
     for key in [k for k in meta if k.startswith("eval_")]:
         del meta[key]  # the trained model's evaluation, not this policy's
     (out_dir / META_FILE).write_text(json.dumps(meta, indent=2) + "\n")
+    return out_dir
+
+
+def _copy_warm_start(model_dir: Path, out_dir: Path) -> Path:
+    """A warm-started run's step 0 is its ``warm_start/`` model (the clone, before PPO), beside
+    the model directory (``best/``, ``final/``) or above its checkpoints folder."""
+    for run_dir in (model_dir.parent, model_dir.parent.parent):
+        start = run_dir / WARM_START
+        if is_complete(start):
+            break
+    else:
+        raise UserError(
+            f"the model at {model_dir} was warm-started, and its step 0 is the run's "
+            f"{WARM_START}/ model, which is not beside it; give the model inside its run directory"
+        )
+    if out_dir.exists():
+        shutil.rmtree(out_dir)
+    shutil.copytree(start, out_dir)
     return out_dir
 
 

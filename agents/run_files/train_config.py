@@ -35,6 +35,7 @@ from hexapod_envs.wrappers import EpisodeReward
 
 from ..hybrid import HybridSettings
 from ..knobs import KnobSettings
+from ..warm_start import WarmStartSettings
 from .configtools import apply_overrides, from_mapping, load_yaml
 from .errors import ConfigError
 from .schedules import Schedule, parse_optional_schedule, parse_schedule
@@ -382,6 +383,8 @@ class TrainConfig:
     logging: LoggingConfig = field(default_factory=LoggingConfig)
     hybrid: HybridConfig | None = None  # None: plain PPO; see agents/hybrid.py
     knobs: KnobConfig | None = None  # None: no controller knobs; see agents/knobs.py
+    warm_start: WarmStartSettings | None = None  # None: PPO from its initial actor; see
+    # agents/warm_start.py (behaviour cloning of a teacher into the actor first)
 
     @property
     def starts_at_zero_action(self) -> bool:
@@ -469,6 +472,13 @@ class TrainConfig:
                 "control step, with a diagonal Gaussian; it needs no hybrid or knobs section, "
                 "env.decision: step (the others change the action and the observation) and "
                 "ppo.use_sde: false"
+            )
+        if self.warm_start is not None and (
+            self.hybrid is not None or self.knobs is not None or self.env.decision != "step"
+        ):
+            raise ValueError(
+                "warm_start clones a teacher's actions into the actor, one per control step of "
+                "the env as configured; it needs no hybrid or knobs section and env.decision: step"
             )
         planner_knobs = self.knobs is not None and self.knobs.controller == "planner"
         if planner_knobs and self.policy.critic_privileged:

@@ -11,7 +11,8 @@ action (the nine residuals stay 0):
 - ``planner``: the strides of the paper's planner (`plan_ditch_crossing`) for the task's ditch;
 - ``greedy``: from the observation alone (``ditch_ahead``, ``stride_decision``): the longest
   stride that lands every moving foot at least the planner's band (foot radius + edge
-  clearance) from both edges, else the one that lands them farthest from an edge.
+  clearance) from both edges, else the one that lands them farthest from an edge
+  (`agents.upu_stride.ClearStridePolicy`).
 
     python experiments/ditch_stride/rules.py [--distribution train] [--tasks 10] [--rules greedy]
 
@@ -31,33 +32,22 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 import hexapod_envs  # noqa: E402,F401
 from agents.policy import ObservationReader  # noqa: E402
+from agents.upu_stride import ClearStridePolicy, stride_value  # noqa: E402
 from hexapod_envs.checks import count_argument  # noqa: E402
 from hexapod_envs.robots.upu.gait_plan import plan_ditch_crossing  # noqa: E402
-from hexapod_envs.robots.upu.params import PLATFORM_LEGS  # noqa: E402
 
 ENV_ID = "HexapodDitchCrossing-v1"
 RULES = ("full", "random", "planner", "greedy")
 
 
-def stride_value(stride: float, max_stride: float) -> float:
-    """The action value whose stride is `stride` [m] (0 for the full stride)."""
-    return min(stride / max_stride - 1.0, 0.0)
-
-
 class StrideRule:
-    """A policy of the stride action: residuals 0, the stride value from `stride()`."""
+    """A policy of the stride action: residuals 0, the stride value from `stride_value()`."""
 
     def __init__(self, env: gym.Env, rule: str, seed: int = 0):
         self.env, self.rule = env.unwrapped, rule
         self.read = ObservationReader(self.env.observation_structure)
         self.rng = np.random.default_rng(seed)
-        params, settings = self.env.params, self.env.gait_settings
-        self.band = params.foot_radius + settings.edge_clearance
-        self.reach = params.leg_extend
-        self.offsets = {
-            m: np.array([params.foot_offset(leg)[0] for leg in PLATFORM_LEGS[m]])
-            for m in PLATFORM_LEGS
-        }
+        self.greedy = ClearStridePolicy(env)
         self.plan = None
 
     def reset(self) -> None:
@@ -85,28 +75,7 @@ class StrideRule:
             if not self.plan.ok or k >= len(self.plan.steps):
                 return 0.0
             return stride_value(self.plan.steps[k].stride, gait.max_stride)
-        return self.greedy(obs["ditch_ahead"], obs["stride_decision"][0] > 0.5, gait)
-
-    def greedy(self, ahead: np.ndarray, upper_next: bool, gait) -> float:
-        """The longest stride landing every moving foot `band` from both edges (observation
-        only; the stride limits are the robot's constants)."""
-        near_u, far_u, near_l, far_l, depth = ahead
-        lead = near_l - near_u  # x_upper - x_lower
-        room = gait.max_stride - lead if upper_next else lead
-        near, far = (near_u, far_u) if upper_next else (near_l, far_l)
-        feet0 = self.offsets["upper" if upper_next else "lower"]
-        grid = gait.min_stride
-        strides = np.arange(max(room, grid), grid - 1e-9, -grid)
-        feet = strides[:, None] + feet0[None, :]  # foot x relative to the edges' frame
-        if depth <= self.reach:
-            clear = np.minimum(np.abs(feet - near), np.abs(feet - far)).min(axis=1)
-        else:  # too deep to stand in: a foot may not land in the ditch at all
-            inside = (feet > near - self.band) & (feet < far + self.band)
-            gap = np.minimum(np.abs(feet - near), np.abs(feet - far))
-            clear = np.where(inside, -gap, gap).min(axis=1)
-        ok = np.flatnonzero(clear >= self.band)
-        best = ok[0] if ok.size else int(np.argmax(clear))
-        return stride_value(float(strides[best]), gait.max_stride)
+        return self.greedy.stride(obs["ditch_ahead"], obs["stride_decision"][0] > 0.5)
 
 
 def run(rule: str, distribution: str, tasks: int) -> list[dict]:

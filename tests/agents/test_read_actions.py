@@ -4,7 +4,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
-from helpers.paths import REPO
+from helpers.ditch_stride_runs import READ_CONFIG, train_tiny
 from stable_baselines3.common.policies import ActorCriticPolicy
 
 import hexapod_envs  # noqa: F401  (registers the ids)
@@ -20,7 +20,6 @@ from agents.run_files.train_config import load_train_config
 
 OBS = gym.spaces.Box(-np.inf, np.inf, shape=(4,), dtype=np.float32)
 ACT = gym.spaces.Box(-1.0, 1.0, shape=(3,), dtype=np.float32)
-STRIDE_CONFIG = REPO / "configs" / "ditch_crossing_v1_ppo_stride_read.yaml"
 
 
 def _policies():
@@ -114,31 +113,12 @@ def test_flags_outside_the_spaces_and_a_state_dependent_noise_are_refused():
 )
 def test_configs_that_change_the_action_or_its_noise_are_refused(overrides):
     with pytest.raises(ValueError, match="score_read_actions_only"):
-        load_train_config(STRIDE_CONFIG, overrides)
+        load_train_config(READ_CONFIG, overrides)
 
 
 def test_the_zoo_names_the_option_it_cannot_train():
-    config = load_train_config(STRIDE_CONFIG, ["policy.critic_privileged=false"])
+    config = load_train_config(READ_CONFIG, ["policy.critic_privileged=false"])
     assert "score_read_actions_only" in zoo_unsupported(config)
-
-
-TINY = [
-    "ppo.n_steps=64",
-    "ppo.batch_size=32",
-    "ppo.n_epochs=1",
-    "policy.pi=[16]",
-    "policy.vf=[16]",
-    "train.total_timesteps=64",
-    "env.max_episode_steps=20",
-    "eval.freq=64",
-    "eval.n_episodes=1",
-    "checkpoint.freq=64",
-]
-
-
-def _train(tmp_path, *extra):
-    argv = ["--config", str(STRIDE_CONFIG), "--output-dir", str(tmp_path), "--run-name", "run"]
-    return train_main([*argv, *(a for o in [*TINY, *extra] for a in ("--set", o))])
 
 
 def test_a_run_trains_and_resumes_with_the_flags_and_loads_as_a_plain_policy(tmp_path, monkeypatch):
@@ -150,7 +130,7 @@ def test_a_run_trains_and_resumes_with_the_flags_and_loads_as_a_plain_policy(tmp
         original(self, flags)
 
     monkeypatch.setattr(ReadActionsPrivilegedPolicy, "set_action_read_flags", spy)
-    assert _train(tmp_path) == 0
+    assert train_tiny(READ_CONFIG, tmp_path) == 0
     run_dir = tmp_path / "run"
     assert train_main(["--resume", str(run_dir), "--set", "train.total_timesteps=128"]) == 0
     env = gym.make("HexapodDitchCrossing-v1", stride_action=True)
@@ -162,7 +142,7 @@ def test_a_run_trains_and_resumes_with_the_flags_and_loads_as_a_plain_policy(tmp
 
 
 def test_a_new_model_is_told_the_envs_flags():
-    config = load_train_config(STRIDE_CONFIG, ["policy.pi=[16]", "policy.vf=[16]"])
+    config = load_train_config(READ_CONFIG, ["policy.pi=[16]", "policy.vf=[16]"])
     model, _ = untrained_model(config)
     flag = model.get_env().get_attr("observation_structure")[0]["stride_decision"].start + 1
     assert isinstance(model.policy, ReadActionsPrivilegedPolicy)
@@ -171,9 +151,9 @@ def test_a_new_model_is_told_the_envs_flags():
 
 
 def test_an_env_that_reads_every_value_is_refused_by_name_before_a_run_starts(tmp_path, capsys):
-    assert _train(tmp_path, "env.kwargs={task_distribution: train}") == 2
+    assert train_tiny(READ_CONFIG, tmp_path, "env.kwargs={task_distribution: train}") == 2
     assert "reads every action value on every step" in capsys.readouterr().err
     assert not (tmp_path / "run").exists()
-    config = load_train_config(STRIDE_CONFIG, ["env.kwargs={task_distribution: train}"])
+    config = load_train_config(READ_CONFIG, ["env.kwargs={task_distribution: train}"])
     with pytest.raises(UserError, match="nothing to leave out"):
         check_env(config)  # what a sweep runs before it starts Ray

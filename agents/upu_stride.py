@@ -1,0 +1,89 @@
+"""A stride rule for the ditch crossing's stride action: each platform step as long as it can be
+while every moving foot lands clear of the ditch's edges.
+
+`HexapodDitchCrossing-v1(stride_action=True)` builds its reference gait one platform step at a
+time; the 10th action value sets each step's stride as it begins (read when the observation's
+``stride_decision`` says so). `ClearStridePolicy` chooses it from the observation alone
+(``ditch_ahead``: the edges relative to both platform centres, the depth; ``stride_decision``:
+which platform moves next) and the robot's constants: the longest stride, on the grid of the
+paper's planner, that lands every foot of the moving platform at least the planner's band (the
+foot radius plus the edge clearance) from both edges; where none does, the one that lands them
+farthest from an edge. A ditch deeper than a leg reaches is stepped over: no foot may land in
+it. The nine residuals stay 0. It crosses 19 of 20 training and 18 of 20 test ditches of the
+benchmark (``experiments/ditch_stride``), the paper's planner's strides 18 and 17, and it is a
+function of the observation, which makes it a teacher for a learner's warm start
+(`agents.warm_start`).
+"""
+
+from __future__ import annotations
+
+import gymnasium as gym
+import numpy as np
+
+from hexapod_envs.envs.ditch_crossing import STRIDE_ACTION
+from hexapod_envs.robots.upu.params import PLATFORM_LEGS
+
+from .policy import ObservationReader
+
+
+def stride_value(stride: float, max_stride: float) -> float:
+    """The action value whose stride is `stride` [m] (0 for the full stride)."""
+    return min(stride / max_stride - 1.0, 0.0)
+
+
+class ClearStridePolicy:
+    """The clear-stride rule (module docstring) as a `Policy` of a ditch-crossing env with
+    ``stride_action=True``."""
+
+    def __init__(self, env: gym.Env):
+        base = env.unwrapped
+        if not getattr(base, "stride_action", False):
+            raise ValueError(
+                "ClearStridePolicy chooses the stride action of HexapodDitchCrossing-v1 with "
+                "stride_action=True; this env has no stride action"
+            )
+        self.env = base
+        self.read = ObservationReader(base.observation_structure)
+        params = base.params
+        self.band = params.foot_radius + base.gait_settings.edge_clearance
+        """How far from an edge a foot must land [m]."""
+        self.reach = params.leg_extend
+        """The deepest ditch a foot can stand in [m]."""
+        self.offsets = {
+            m: np.array([params.foot_offset(leg)[0] for leg in PLATFORM_LEGS[m]])
+            for m in PLATFORM_LEGS
+        }
+        """Each platform's feet, x relative to its centre [m]."""
+        self.n_actions = base.action_space.shape[0]
+
+    def reset(self) -> None:
+        pass
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        action = np.zeros(self.n_actions, dtype=np.float32)
+        obs = self.read(observation)
+        upper_next, decides = obs["stride_decision"] > 0.5
+        if decides:
+            action[STRIDE_ACTION] = self.stride(obs["ditch_ahead"], upper_next)
+        return action
+
+    def stride(self, ahead: np.ndarray, upper_next: bool) -> float:
+        """The stride value for the platform about to move, from ``ditch_ahead``."""
+        gait = self.env.online_gait  # the robot's stride limits: constants of the env
+        near_u, far_u, near_l, far_l, depth = ahead
+        lead = near_l - near_u  # x_upper - x_lower
+        room = gait.max_stride - lead if upper_next else lead
+        near, far = (near_u, far_u) if upper_next else (near_l, far_l)
+        feet0 = self.offsets["upper" if upper_next else "lower"]
+        grid = gait.min_stride
+        strides = np.arange(max(room, grid), grid - 1e-9, -grid)
+        feet = strides[:, None] + feet0[None, :]  # foot x in the frame of the edges
+        gap = np.minimum(np.abs(feet - near), np.abs(feet - far))
+        if depth <= self.reach:
+            clear = gap.min(axis=1)
+        else:  # too deep to stand in: a foot may not land in the ditch at all
+            inside = (feet > near - self.band) & (feet < far + self.band)
+            clear = np.where(inside, -gap, gap).min(axis=1)
+        ok = np.flatnonzero(clear >= self.band)
+        best = ok[0] if ok.size else int(np.argmax(clear))
+        return stride_value(float(strides[best]), gait.max_stride)
