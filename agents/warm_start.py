@@ -188,10 +188,12 @@ def warm_start(
     make_env: Callable[[], gym.Env],
     settings: WarmStartSettings,
     seed: int,
+    log: Callable[[str], Any] = lambda line: None,
 ) -> dict[str, Any]:
     """Clone the teacher into `model`'s actor (module docstring), then run the DAgger rounds.
     `venv` is the model's training vec env: a VecNormalize on it takes its observation
-    statistics from the labelled observations first. Returns what to record with the run."""
+    statistics from the labelled observations first. `log` gets a line after each fit. Returns
+    what to record with the run."""
     normalize = getattr(venv, "norm_obs", False)
 
     def as_seen(observations: np.ndarray) -> np.ndarray:
@@ -213,6 +215,11 @@ def warm_start(
             venv.obs_rms.update(new.observations)
         loss = fit_actor(
             model.policy, as_seen(data.observations), data.actions, data.read, settings, seed
+        )
+        driver = "the teacher" if round_ == 0 else "the clone"
+        log(
+            f"round {round_}: {driver} succeeded in {new.successes} of {new.episodes}; "
+            f"fitted on {len(data.actions)} pairs, loss {loss:.3g}"
         )
     return {
         **dataclasses.asdict(settings),

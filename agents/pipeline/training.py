@@ -299,20 +299,24 @@ def _warm_start(
 ) -> None:
     """Clone the config's teacher into the actor (`agents.warm_start`) and save the result as
     the run's ``warm_start/`` model: its step-0 policy."""
+    import torch
+
     from ..warm_start import warm_start
     from .callbacks import ModelSaver
 
+    torch.set_num_threads(config.train.num_threads)  # as the PPO updates will
     ws = config.warm_start
     print(f"warm start: cloning {ws.teacher!r} from {ws.episodes} episodes", flush=True)
-    summary = warm_start(model, venv, spec.make, ws, config.train.seed)
+    summary = warm_start(
+        model,
+        venv,
+        spec.make,
+        ws,
+        config.train.seed,
+        lambda line: print(f"warm start: {line}", flush=True),
+    )
     ModelSaver(run_dir, config, command, settings).save(
         model, "warm_start", run_dir / WARM_START, warm_start=summary
-    )
-    print(
-        f"warm start: the teacher succeeded in {summary['teacher_successes']} of "
-        f"{summary['teacher_episodes']}; {summary['pairs']} pairs, fit loss "
-        f"{summary['final_loss']:.4g}",
-        flush=True,
     )
 
 
