@@ -56,6 +56,9 @@ class WarmStartSettings:
     dagger_rounds: int = 0
     """Rounds of DAgger (Ross et al. 2011) after the first fit: the clone drives ``episodes``
     fresh tasks, the teacher labels every step, and the actor is fitted again on all pairs."""
+    critic_steps: int = 0
+    """PPO's first env steps that update the critic only (`agents.pipeline.callbacks.
+    CriticFirst`): the actor stays the clone until the value function has learnt its returns."""
 
     def __post_init__(self):
         if self.teacher not in TEACHERS:
@@ -67,6 +70,7 @@ class WarmStartSettings:
             ("epochs", 1),
             ("batch_size", 1),
             ("dagger_rounds", 0),
+            ("critic_steps", 0),
         ):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < least:

@@ -91,6 +91,42 @@ class ModelSaver:
         )
 
 
+class CriticFirst(BaseCallback):
+    """PPO's updates leave the actor (its network, output layer and log standard deviation)
+    untouched until `steps` env steps have been collected: the critic first learns the values of
+    the policy it starts from (a warm start's clone), so that the actor's first updates follow
+    advantages of a trained critic rather than of a random one."""
+
+    def __init__(self, steps: int):
+        super().__init__()
+        self.steps = int(steps)
+
+    def _actor(self) -> list[Any]:
+        policy = self.model.policy
+        return [
+            *policy.mlp_extractor.policy_net.parameters(),
+            *policy.action_net.parameters(),
+            policy.log_std,
+        ]
+
+    def _set_actor_trainable(self, trainable: bool) -> None:
+        for parameter in self._actor():
+            parameter.requires_grad_(trainable)
+
+    def _on_training_start(self) -> None:
+        self._set_actor_trainable(self.model.num_timesteps >= self.steps)
+
+    def _on_rollout_end(self) -> None:  # the update of this rollout comes next
+        if self.model.num_timesteps >= self.steps:
+            self._set_actor_trainable(True)
+
+    def _on_training_end(self) -> None:
+        self._set_actor_trainable(True)
+
+    def _on_step(self) -> bool:
+        return True
+
+
 class CheckpointEvery(BaseCallback):
     """Saves a checkpoint each time num_timesteps passes a multiple of `freq` (resume-safe)."""
 

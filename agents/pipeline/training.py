@@ -516,10 +516,13 @@ def _callbacks(
 ) -> list[Any]:
     """The training callbacks other than evaluation: each finished episode's statistics to the
     log, each step's safety override into the rollout buffer when ``hybrid.mask_overridden``,
-    and a checkpoint every ``checkpoint.freq`` steps (0: none)."""
-    from .callbacks import CheckpointEvery, EpisodeStatsCallback
+    the critic's head start after a warm start (``warm_start.critic_steps``) and a checkpoint
+    every ``checkpoint.freq`` steps (0: none)."""
+    from .callbacks import CheckpointEvery, CriticFirst, EpisodeStatsCallback
 
     callbacks = [EpisodeStatsCallback(new_accumulator)]
+    if config.warm_start is not None and config.warm_start.critic_steps > 0:
+        callbacks.append(CriticFirst(config.warm_start.critic_steps))
     if _masks_overridden(config):
         from .override_mask import RecordOverrides
 

@@ -8,9 +8,11 @@ import numpy as np
 import pytest
 import torch
 from helpers.ditch_stride_runs import WARM_CONFIG, train_tiny
+from stable_baselines3 import PPO
 from stable_baselines3.common.policies import ActorCriticPolicy
 
 import hexapod_envs  # noqa: F401  (registers the ids)
+from agents.pipeline.callbacks import CriticFirst
 from agents.ppo import PPOPolicy
 from agents.run_files.artifacts import WARM_START, read_meta
 from agents.run_files.step0 import write_step0_model
@@ -55,6 +57,7 @@ def test_the_clear_stride_rule_sets_the_stride_only_when_a_step_is_decided():
         ({"dagger_rounds": -1}, "dagger_rounds must be an integer >= 0"),
         ({"epochs": 2.5}, "epochs must be an integer"),
         ({"learning_rate": 0}, "learning_rate must be a number > 0"),
+        ({"critic_steps": -5}, "critic_steps must be an integer >= 0"),
     ],
 )
 def test_bad_settings_are_refused_by_name(kwargs, message):
@@ -116,3 +119,26 @@ def test_a_warm_started_run_saves_its_clone_as_its_step_0(tmp_path):
     obs, _ = env.reset(seed=0)
     assert start(obs).shape == trained(obs).shape == (10,)
     json.dumps(record)  # the summary is plain data
+
+
+def test_the_critic_learns_alone_until_its_steps_are_collected():
+    model = PPO(
+        "MlpPolicy", gym.make("Pendulum-v1"), n_steps=128, batch_size=64, n_epochs=2, seed=0
+    )
+    policy = model.policy
+    actor = [*policy.mlp_extractor.policy_net.parameters(), *policy.action_net.parameters()]
+    actor.append(policy.log_std)
+
+    def snapshot(parameters):
+        return [p.detach().clone() for p in parameters]
+
+    def same(a, b):
+        return all(torch.equal(x, y) for x, y in zip(a, b, strict=True))
+
+    actor0, critic0 = snapshot(actor), snapshot(policy.value_net.parameters())
+    model.learn(256, callback=CriticFirst(257))  # two updates, both before 257 steps
+    actor1, critic1 = snapshot(actor), snapshot(policy.value_net.parameters())
+    assert same(actor0, actor1) and not same(critic0, critic1)
+    assert all(p.requires_grad for p in actor)  # trainable again when training ends
+    model.learn(128, callback=CriticFirst(257), reset_num_timesteps=False)  # 384 steps: past it
+    assert not same(actor1, snapshot(actor))
