@@ -1,14 +1,15 @@
 """A warm start for PPO: behaviour cloning of a teacher into the actor before PPO (kick-starting).
 
 PPO from a zero-initialised actor starts at the zero action; where that fails and the useful
-actions are rare (the ditch's strides: a few decisions an episode, each needing a stride placed
-within a band of about 20 mm), exploration may never find them in the budget. A warm start
+actions are rare (the ditch's strides: a few decisions an episode, each needing a stride that
+keeps every foot its radius plus 20 mm from an edge), exploration may never find them in the budget. A warm start
 copies a teacher first: the teacher drives ``episodes`` tasks of the training distribution
 (seeded apart from training and evaluation), every (observation, action) is kept, and the
-actor's mean is fitted to the teacher's actions by mean squared error, through the same
-observation normalisation that PPO then uses (the VecNormalize statistics start from the
-teacher's observations). The log standard deviation and the critic are left as configured;
-PPO starts from the clone, and its step-0 evaluation is the clone's.
+actor's mean is fitted to the teacher's actions by mean squared error, through the observation
+normalisation PPO starts with (the VecNormalize statistics start from the labelled
+observations; PPO's rollouts then keep updating them, so the clone's inputs drift as training
+goes on, even while the actor is unchanged). The log standard deviation and the critic are
+left as configured; PPO starts from the clone, and its step-0 evaluation is the clone's.
 
 An action value that the env reads only on some steps (`HexapodEnv.action_read_flags`, such as
 the ditch's stride) is fitted on those steps only; each action value's error is averaged over
@@ -158,9 +159,10 @@ def fit_actor(
     import torch
 
     generator = torch.Generator().manual_seed(seed)
-    x = torch.as_tensor(observations, dtype=torch.float32)
-    y = torch.as_tensor(actions, dtype=torch.float32)
-    w = torch.as_tensor(read, dtype=torch.float32)
+    x, y, w = (
+        torch.as_tensor(a, dtype=torch.float32, device=policy.device)
+        for a in (observations, actions, read)
+    )
     actor = [
         *policy.pi_features_extractor.parameters(),
         *policy.mlp_extractor.policy_net.parameters(),
@@ -171,7 +173,8 @@ def fit_actor(
     loss_value = float("nan")
     for _ in range(settings.epochs):
         losses = []
-        for batch in torch.randperm(len(x), generator=generator).split(settings.batch_size):
+        order = torch.randperm(len(x), generator=generator).to(policy.device)
+        for batch in order.split(settings.batch_size):
             mean = policy.get_distribution(x[batch]).distribution.mean
             weights = w[batch]
             per_value = (weights * (mean - y[batch]) ** 2).sum(dim=0)

@@ -92,10 +92,11 @@ class ModelSaver:
 
 
 class CriticFirst(BaseCallback):
-    """PPO's updates leave the actor (its network, output layer and log standard deviation)
-    untouched until `steps` env steps have been collected: the critic first learns the values of
-    the policy it starts from (a warm start's clone), so that the actor's first updates follow
-    advantages of a trained critic rather than of a random one."""
+    """PPO's updates leave the actor (its own feature extractor where the critic has another,
+    its network, output layer and log standard deviation) untouched until `steps` env steps
+    have been collected: the critic first learns the values of the policy it starts from (a
+    warm start's clone), so that the actor's first updates follow advantages of a trained
+    critic rather than of a random one."""
 
     def __init__(self, steps: int):
         super().__init__()
@@ -103,7 +104,10 @@ class CriticFirst(BaseCallback):
 
     def _actor(self) -> list[Any]:
         policy = self.model.policy
+        shared = policy.share_features_extractor  # then the critic's features too: left
+        features = [] if shared else list(policy.pi_features_extractor.parameters())
         return [
+            *features,
             *policy.mlp_extractor.policy_net.parameters(),
             *policy.action_net.parameters(),
             policy.log_std,

@@ -36,7 +36,8 @@ STEP0_KIND = "step0"
 
 def write_step0_model(model_path: str | Path, out_dir: str | Path) -> Path:
     """Write `model_path`'s step-0 policy as a model directory at `out_dir` (replaced if it
-    exists) and return it. UserError when the model's run did not zero-initialise its actor:
+    exists) and return it: a warm-started run's ``warm_start/`` model, or the model with its
+    zero-initialised output layer zeroed again. UserError when the model's run did neither:
     its step 0 was a random network that the model no longer holds."""
     files = find_model(model_path)
     if files.model.name != MODEL_FILE:
