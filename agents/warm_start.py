@@ -2,22 +2,25 @@
 
 PPO from a zero-initialised actor starts at the zero action; where that fails and the useful
 actions are rare (the ditch's strides: a few decisions an episode, each needing a stride that
-keeps every foot its radius plus 20 mm from an edge), exploration may never find them in the budget. A warm start
-copies a teacher first: the teacher drives ``episodes`` tasks of the training distribution
-(seeded apart from training and evaluation), every (observation, action) is kept, and the
-actor's mean is fitted to the teacher's actions by mean squared error, through the observation
-normalisation PPO starts with (the VecNormalize statistics start from the labelled
-observations; PPO's rollouts then keep updating them, so the clone's inputs drift as training
-goes on, even while the actor is unchanged). The log standard deviation and the critic are
-left as configured; PPO starts from the clone, and its step-0 evaluation is the clone's.
+keeps every foot its radius plus 20 mm from an edge), exploration may never find them in the
+budget. A warm start copies a teacher first: the teacher drives ``episodes`` tasks of the
+training distribution (seeded apart from training and evaluation), every (observation, action)
+is kept, and the actor's mean is fitted to the teacher's actions by mean squared error, through
+the observation normalisation PPO starts with (the VecNormalize statistics start from the
+labelled observations; PPO's rollouts then keep updating them, so the clone's inputs drift as
+training goes on, even while the actor is unchanged). The log standard deviation and the critic
+are left as configured; PPO starts from the clone, and its step-0 evaluation is the clone's.
 
 An action value that the env reads only on some steps (`HexapodEnv.action_read_flags`, such as
 the ditch's stride) is fitted on those steps only; each action value's error is averaged over
 its own steps, so a value read on 1 step of 51 weighs as much as one read on every step.
 
 Teachers (``warm_start.teacher``): ``analytical``, the env's registered controller
-(`agents.registry`) on the env as configured; ``clear_stride``, the ditch's stride rule
-(`agents.upu_stride.ClearStridePolicy`). A config turns it on with a ``warm_start`` section
+(`agents.registry`) on the env as configured (in a residual action mode a controller's
+commands beyond the residual's range are clipped, see `agents.registry.ANALYTICAL_ENV_KWARGS`;
+in DAgger rounds a controller with a gait clock or a plan labels states it did not drive
+into); ``clear_stride``, the ditch's stride rule (`agents.upu_stride.ClearStridePolicy`), a
+function of the observation. A config turns it on with a ``warm_start`` section
 (docs/training.md).
 """
 
