@@ -271,6 +271,7 @@ def start_training(
     new_accumulator, settings = _probe(spec, config.policy.score_read_actions_only)
     name = name or run_name(config.env.id, config.train.seed)
     run_dir = prepare_new_dir(Path(output_dir) / name, force, "run directory", (CONFIG_FILE,))
+    venv = eval_env = None
     try:
         command = command or command_line()
         atomic_write_text(run_dir / CONFIG_FILE, dump_yaml(config))
@@ -280,7 +281,10 @@ def start_training(
         model = new_model(config, venv)
         if config.warm_start is not None:
             _warm_start(model, config, venv, spec, run_dir, command, settings)
-    except BaseException:
+    except BaseException:  # e.g. Ctrl-C during a warm start: close the envs, remove the run
+        for env in (venv, eval_env):
+            if env is not None:
+                close_vec_env(env)
         shutil.rmtree(run_dir, ignore_errors=True)
         raise
     return _learn(

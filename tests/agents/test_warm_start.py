@@ -12,6 +12,7 @@ from stable_baselines3 import PPO
 from stable_baselines3.common.policies import ActorCriticPolicy
 
 import hexapod_envs  # noqa: F401  (registers the ids)
+from agents.pipeline import training
 from agents.pipeline.callbacks import CriticFirst
 from agents.ppo import PPOPolicy
 from agents.run_files.artifacts import WARM_START, read_meta
@@ -142,3 +143,17 @@ def test_the_critic_learns_alone_until_its_steps_are_collected():
     assert all(p.requires_grad for p in actor)  # trainable again when training ends
     model.learn(128, callback=CriticFirst(257), reset_num_timesteps=False)  # 384 steps: past it
     assert not same(actor1, snapshot(actor))
+
+
+def test_a_warm_start_that_fails_closes_its_envs_and_leaves_no_run(tmp_path, monkeypatch):
+    closed = []
+    monkeypatch.setattr(training, "close_vec_env", lambda env, **kw: closed.append(env))
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(training, "_warm_start", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        train_tiny(WARM_CONFIG, tmp_path)
+    assert len(closed) == 2  # the training and the evaluation vec envs
+    assert not (tmp_path / "run").exists()
