@@ -56,6 +56,11 @@ def analytical_factory(env_id: str) -> PolicyFactory:
             f"no analytical controller registered for {env_id!r}; registered: "
             f"{sorted(ANALYTICAL_POLICIES)} (add one in agents/registry.py)"
         ) from None
+    return load_factory(entry)
+
+
+def load_factory(entry: str | PolicyFactory) -> PolicyFactory:
+    """A ``"module:attribute"`` entry, imported; a callable as it is."""
     if isinstance(entry, str):
         module, _, attribute = entry.partition(":")
         return getattr(importlib.import_module(module), attribute)

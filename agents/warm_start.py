@@ -27,12 +27,13 @@ function of the observation. A config turns it on with a ``warm_start`` section
 from __future__ import annotations
 
 import dataclasses
-import importlib
 from collections.abc import Callable
 from typing import Any
 
 import gymnasium as gym
 import numpy as np
+
+from .registry import load_factory
 
 TEACHERS: dict[str, str] = {
     "analytical": "agents.registry:analytical_policy",
@@ -84,11 +85,6 @@ class WarmStartSettings:
             raise ValueError(f"warm_start.learning_rate must be a number > 0, got {rate!r}")
 
 
-def teacher_factory(name: str) -> Callable[[gym.Env], Any]:
-    module, _, attribute = TEACHERS[name].partition(":")
-    return getattr(importlib.import_module(module), attribute)
-
-
 @dataclasses.dataclass
 class TeacherData:
     """Episodes labelled by the teacher: raw observations, its actions (clipped to the action
@@ -123,7 +119,7 @@ def teacher_data(
     keep every step's observation and the teacher's action."""
     env = make_env()
     try:
-        policy = teacher_factory(teacher)(env)
+        policy = load_factory(TEACHERS[teacher])(env)
         space = env.action_space
         flags = env.unwrapped.action_read_flags
         observations, actions, successes = [], [], 0

@@ -45,17 +45,15 @@ def write_step0_model(model_path: str | Path, out_dir: str | Path) -> Path:
             f"{files.model}: give the model's directory (its {MODEL_FILE}) to rebuild its step 0"
         )
     config = files.training_config()
-    if config is not None and load_train_config(data=config).warm_start is not None:
-        return _copy_warm_start(files.directory, Path(out_dir))
-    if config is None or not load_train_config(data=config).starts_at_zero_action:
+    train_config = None if config is None else load_train_config(data=config)
+    if train_config is not None and train_config.warm_start is not None:
+        return _copy_model_dir(_warm_start_dir(files.directory), Path(out_dir))
+    if train_config is None or not train_config.starts_at_zero_action:
         raise UserError(
             f"the model at {files.model} was not trained from a zero-initialised actor "
             "(zero_init_action_net in its config.yaml), so its step-0 policy cannot be rebuilt"
         )
-    out_dir = Path(out_dir)
-    if out_dir.exists():
-        shutil.rmtree(out_dir)
-    shutil.copytree(files.directory, out_dir)
+    out_dir = _copy_model_dir(files.directory, Path(out_dir))
     _zero_action_net(out_dir / MODEL_FILE)
     meta = {**read_meta(files.directory), "kind": STEP0_KIND, "num_timesteps": 0}
     meta["rebuilt_from"] = str(files.model)
@@ -65,22 +63,24 @@ def write_step0_model(model_path: str | Path, out_dir: str | Path) -> Path:
     return out_dir
 
 
-def _copy_warm_start(model_dir: Path, out_dir: Path) -> Path:
+def _copy_model_dir(source: Path, out_dir: Path) -> Path:
+    """`source` copied to `out_dir` (replaced if it exists)."""
+    if out_dir.exists():
+        shutil.rmtree(out_dir)
+    shutil.copytree(source, out_dir)
+    return out_dir
+
+
+def _warm_start_dir(model_dir: Path) -> Path:
     """A warm-started run's step 0 is its ``warm_start/`` model (the clone, before PPO), beside
     the model directory (``best/``, ``final/``) or above its checkpoints folder."""
     for run_dir in (model_dir.parent, model_dir.parent.parent):
-        start = run_dir / WARM_START
-        if is_complete(start):
-            break
-    else:
-        raise UserError(
-            f"the model at {model_dir} was warm-started, and its step 0 is the run's "
-            f"{WARM_START}/ model, which is not beside it; give the model inside its run directory"
-        )
-    if out_dir.exists():
-        shutil.rmtree(out_dir)
-    shutil.copytree(start, out_dir)
-    return out_dir
+        if is_complete(run_dir / WARM_START):
+            return run_dir / WARM_START
+    raise UserError(
+        f"the model at {model_dir} was warm-started, and its step 0 is the run's "
+        f"{WARM_START}/ model, which is not beside it; give the model inside its run directory"
+    )
 
 
 def _zero_action_net(model_zip: Path) -> None:

@@ -31,7 +31,6 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 import hexapod_envs  # noqa: E402,F401
-from agents.policy import ObservationReader  # noqa: E402
 from agents.upu_stride import ClearStridePolicy, stride_value  # noqa: E402
 from hexapod_envs.checks import count_argument  # noqa: E402
 from hexapod_envs.robots.upu.gait_plan import plan_ditch_crossing  # noqa: E402
@@ -40,27 +39,20 @@ ENV_ID = "HexapodDitchCrossing-v1"
 RULES = ("full", "random", "planner", "greedy")
 
 
-class StrideRule:
-    """A policy of the stride action: residuals 0, the stride value from `stride_value()`."""
+class StrideRule(ClearStridePolicy):
+    """A policy of the stride action: residuals 0, the stride value of `rule` (``greedy``: the
+    clear-stride rule it extends)."""
 
     def __init__(self, env: gym.Env, rule: str, seed: int = 0):
-        self.env, self.rule = env.unwrapped, rule
-        self.read = ObservationReader(self.env.observation_structure)
+        super().__init__(env)
+        self.rule = rule
         self.rng = np.random.default_rng(seed)
-        self.greedy = ClearStridePolicy(env)
         self.plan = None
 
     def reset(self) -> None:
         self.plan = None
 
-    def __call__(self, observation: np.ndarray) -> np.ndarray:
-        action = np.zeros(10, dtype=np.float32)
-        obs = self.read(observation)
-        if obs["stride_decision"][1] > 0.5:
-            action[9] = self.stride_value(obs)
-        return action
-
-    def stride_value(self, obs: dict) -> float:
+    def stride(self, ahead: np.ndarray, upper_next: bool) -> float:
         gait = self.env.online_gait
         if self.rule == "full":
             return 0.0
@@ -75,7 +67,7 @@ class StrideRule:
             if not self.plan.ok or k >= len(self.plan.steps):
                 return 0.0
             return stride_value(self.plan.steps[k].stride, gait.max_stride)
-        return self.greedy.stride(obs["ditch_ahead"], obs["stride_decision"][0] > 0.5)
+        return super().stride(ahead, upper_next)
 
 
 def run(rule: str, distribution: str, tasks: int) -> list[dict]:
