@@ -43,7 +43,7 @@ from .rendering import (
     set_visual_options,
 )
 from .safety import SafetyFigures
-from .settings import RENDER_MODES, EnvSettings
+from .settings import RENDER_MODES, TASK_DISTRIBUTIONS, EnvSettings
 from .task import TaskDescription
 
 __all__ = ["HexapodEnv", "Measurement"]
@@ -274,6 +274,16 @@ class HexapodEnv(SafetyFigures, gym.Env):
         return self._step_count * self.control_dt
 
     def reset(self, *, seed: int | None = None, options: dict | None = None):
+        """A new episode on a task drawn from ``task_distribution`` with ``np_random`` (seeded
+        by `seed`). The hexapod envs take no reset `options` (None or empty): the task comes
+        from the seed and the distribution, and a non-empty dict is refused rather than
+        ignored."""
+        if options:
+            raise ValueError(
+                f"{type(self).__name__}.reset takes no options, got {sorted(options, key=str)}; "
+                "the task comes from the seed and task_distribution (make the env with "
+                f"task_distribution= one of {list(TASK_DISTRIBUTIONS)})"
+            )
         super().reset(seed=seed, options=options)
         self._needs_reset = False
         if self.task_distribution == "paper":
@@ -523,6 +533,11 @@ class HexapodEnv(SafetyFigures, gym.Env):
         """
         t_expected = self.data.time + self.control_dt
         self._run_physics()
+        return self._stayed_stable_to(t_expected)
+
+    def _stayed_stable_to(self, t_expected: float) -> bool:
+        """After a control period's physics: the clock reached `t_expected` [s] and MuJoCo
+        counted no instability warning."""
         if abs(self.data.time - t_expected) > 1e-6:
             return False
         return not any(self.data.warning.number[self._UNSTABLE_WARNINGS].tolist())

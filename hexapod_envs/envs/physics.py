@@ -10,6 +10,7 @@ import mujoco
 
 __all__ = [
     "INTEGRATOR_IDS",
+    "SENSORS_OFF",
     "SOLVER_IDS",
     "UNSTABLE_WARNINGS",
     "set_physics_options",
@@ -18,7 +19,8 @@ __all__ = [
     "substeps_for",
 ]
 
-_SENSORS_OFF = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+SENSORS_OFF = int(mujoco.mjtDisableBit.mjDSBL_SENSOR)
+"""``opt.disableflags`` bit that skips the sensors in a MuJoCo step."""
 
 SOLVER_IDS = {
     "newton": mujoco.mjtSolver.mjSOL_NEWTON,
@@ -99,7 +101,7 @@ def step_without_sensors(model: mujoco.MjModel, data: mujoco.MjData, nstep: int)
     """`nstep` MuJoCo steps with the sensors disabled (`data.sensordata` keeps its values)."""
     opt = model.opt
     flags = opt.disableflags
-    opt.disableflags = flags | _SENSORS_OFF
+    opt.disableflags = flags | SENSORS_OFF
     try:
         mujoco.mj_step(model, data, nstep=nstep)
     finally:

@@ -7,11 +7,16 @@ Each world is an ordinary env instance (its own `MjModel`, `MjData`, task, contr
 1. on the calling thread, every stepping world validates its action; then, world by world, it
    applies the action (the servo commands, residual filters and gait controllers:
    `HexapodEnv._apply_action`)
-2. and queues that world's control period of physics (its own `HexapodEnv._simulate`,
-   ATHENA's contact checks included) on ``nthread`` threads, so the first worlds' physics
-   starts while later actions are applied; MuJoCo releases the GIL inside ``mj_step``, so the
-   worlds' physics runs in parallel (a world that no thread has started when the calling
-   thread needs it runs on the calling thread);
+2. and its control period of physics starts on another thread while later actions are
+   applied. Where the period is plain MuJoCo steps (the cliff walk, the Stewart tilt, the
+   ditch crossing: `BatchedPhysics.compiled`), the worlds are split in contiguous shares: each
+   of ``nthread - 1`` helper threads steps its share in one compiled call that holds no GIL
+   (`hexapod_envs.vector.compiled_steps`), handed over once its share's actions are applied,
+   and the calling thread steps the first share itself, sized every step so that the helpers
+   finish when the calling thread reaches their worlds. Otherwise (ATHENA's contact checks
+   within a period) a pool of ``nthread`` threads runs each world's own `_simulate`, and MuJoCo
+   releases the GIL inside each ``mj_step`` (a world that no thread has started when the
+   calling thread needs it runs on the calling thread);
 3. meanwhile the calling thread runs Gymnasium's `SyncVectorEnv.step`, which steps every world
    as usual with its action application and physics replaced, for this one call, by phase 1
    and by waiting for its physics: world k's measurement, tip-over, success, reward,
@@ -21,8 +26,9 @@ Each world is an ordinary env instance (its own `MjModel`, `MjData`, task, contr
    Gymnasium's world-by-world merge (which the same-step autoreset keeps).
 
 So the results are bit-identical to `SyncVectorEnv` over ``gym.make(id)`` envs with the same
-seeds (tests/hexapod_envs/test_vector_env.py), whatever the thread count: each world runs its
-own code on its own data, and only the order in which the worlds' pieces run changes.
+seeds (tests/hexapod_envs/test_vector_env.py), whatever the thread count and the split: each
+world runs its own code on its own data, and only the order in which the worlds' pieces run
+changes.
 
 Why not `mujoco.rollout` (MuJoCo 4.0): a rollout is stateless by design. It loads each world's
 state into a per-thread scratch `MjData`, zeroes ``qacc_warmstart`` unless given and returns
@@ -34,13 +40,17 @@ single env's warm start from one control period to the next. `mujoco.batch` keep
 `MjData` per simulation, which would have to be copied into each env's data in and out of
 every step, and ATHENA's contact checks within a period would be reimplemented.
 
-What the threads buy, and what caps it (the calling thread's share of a step, caches that go
-cold between a world's turns): benchmarks/README.md, ``bench_vector_env.py``.
+What the threads buy, and what caps it (the calling thread's share of a step, two cores that
+together run physics only 1.4-1.9 x as fast as one): benchmarks/README.md,
+``bench_vector_env.py``.
 """
 
 from __future__ import annotations
 
 import os
+import platform
+import threading
+import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import Future, ThreadPoolExecutor, wait
 from contextlib import contextmanager
@@ -53,6 +63,8 @@ from gymnasium.vector import AutoresetMode, SyncVectorEnv
 from gymnasium.vector.utils import iterate
 
 from ..envs.base import HexapodEnv
+from ..envs.physics import SENSORS_OFF
+from .compiled_steps import compiled_steps_available, run_control_periods
 from .infos import merge_infos
 
 __all__ = ["BatchedPhysics", "BatchedVectorEnv"]
@@ -86,9 +98,29 @@ class BatchedPhysics:
         if not isinstance(nthread, int | np.integer) or isinstance(nthread, bool) or nthread < 0:
             raise ValueError(f"nthread must be an integer >= 0, got {nthread!r}")
         self.nthread = int(nthread)
-        """Threads that run the worlds' physics (0: the calling thread runs it)."""
-        self._pool = ThreadPoolExecutor(self.nthread) if self.nthread else None
+        """Threads that run the worlds' physics (0: the calling thread runs it with the rest of
+        each world's step; see `compiled`)."""
+        self.compiled = (
+            self.nthread > 0
+            and all(_plain_periods(world) for world in self.worlds)
+            and compiled_steps_available()
+        )
+        """The worlds' control periods are plain MuJoCo steps, run in shares of worlds by
+        `run_control_periods` without the GIL: the calling thread runs the first share between
+        its Python and ``nthread - 1`` helper threads the rest. Otherwise (ATHENA's contact
+        checks within a period) a pool of ``nthread`` threads runs each world's `_simulate`."""
+        helpers = self.nthread - 1 if self.compiled else self.nthread
+        self._pool = ThreadPoolExecutor(helpers) if helpers else None
         self._running: list[Future] = []
+        self._own_share = 1.0 / max(self.nthread, 1)
+        """The calling thread's share of the worlds in the compiled mode, tuned every step so
+        that the helpers finish their worlds when the calling thread reaches them."""
+        n = len(self.worlds)
+        self._models = np.zeros(n, np.int64)
+        self._datas = np.zeros(n, np.int64)
+        self._flags = np.zeros((n, 2), np.int32)
+        self._nsteps = np.zeros(n, np.int64)
+        self._done = np.zeros(n, np.int8)
 
     @contextmanager
     def step(self, stepping: Sequence[int], actions: Sequence[np.ndarray]) -> Iterator[None]:
@@ -118,6 +150,8 @@ class BatchedPhysics:
         `_simulate`) on the threads at once, in world order, so that the first worlds' physics
         runs while the later actions are applied; world -> a call that waits for it and returns
         whether it stayed stable. Without threads the call runs the physics itself."""
+        if self.compiled and all(_plain_periods(self.worlds[i]) for i in worlds):
+            return self._start_compiled(worlds)
         physics = {}
         for i in worlds:
             world = self.worlds[i]
@@ -129,6 +163,57 @@ class BatchedPhysics:
                 self._running.append(future)
                 physics[i] = partial(_take, future, world._simulate)
         return physics
+
+    def _start_compiled(self, worlds: Sequence[int]) -> dict[int, Callable[[], bool]]:
+        """`_start` in the compiled mode: the helpers' shares (the last worlds) first, each
+        handed over as soon as its actions are applied, then the calling thread's share (the
+        first worlds), whose physics it runs before returning."""
+        order = list(worlds)
+        n, helpers = len(order), self.nthread - 1
+        own = n if helpers == 0 else min(n, max(0, round(self._own_share * n)))
+        bounds = [own + (n - own) * h // helpers for h in range(helpers + 1)] if helpers else []
+        models, datas, flags, nsteps, done = (
+            self._models,
+            self._datas,
+            self._flags,
+            self._nsteps,
+            self._done,
+        )
+        expected = {}
+        for k, i in enumerate(order):
+            world = self.worlds[i]
+            models[k], datas[k] = world.model._address, world.data._address
+            own_flags = world.model.opt.disableflags
+            flags[k] = own_flags if world._sensors_every_step else own_flags | SENSORS_OFF
+            flags[k, 1] = own_flags
+            nsteps[k] = world.n_substeps
+            done[k] = 0
+        args = (models, datas, flags, nsteps, done)
+        shares = []
+        for start, stop in zip(bounds[:-1], bounds[1:], strict=False):
+            for k in range(start, stop):
+                expected[k] = self._apply(order[k])
+            if stop > start:
+                started = threading.Event()
+                future = self._pool.submit(_run_share, started, *args, start, stop)
+                self._running.append(future)
+                started.wait()  # the helper's share runs without the GIL from here
+                shares.append(future)
+        for k in range(own):
+            expected[k] = self._apply(order[k])
+        run_control_periods(*args, 0, own)
+        balance = _Balance(self, shares, len(order) - 1)
+        physics = {}
+        for k, i in enumerate(order):
+            stable = partial(self.worlds[i]._stayed_stable_to, expected[k])
+            physics[i] = stable if k < own else partial(balance.wait, k, stable)
+        return physics
+
+    def _apply(self, i: int) -> float:
+        """Apply world `i`'s action; the time [s] its control period must reach."""
+        world = self.worlds[i]
+        world._apply_action(world._action)
+        return world.data.time + world.control_dt
 
     def close(self) -> None:
         if self._pool is not None:
@@ -194,6 +279,60 @@ class BatchedVectorEnv(SyncVectorEnv):
     def close_extras(self, **kwargs: Any) -> None:
         super().close_extras(**kwargs)
         self.physics.close()
+
+
+class _Balance:
+    """The calling thread's waits for the helpers' worlds in a compiled step, which move the
+    split: helpers already done when the calling thread reaches their first world waited
+    idle (the calling thread takes a smaller share next step); the last world not done when
+    the calling thread needs it kept the calling thread waiting (a larger one).
+
+    Where stores reach other cores in program order (x86-64), a world's flag in
+    ``BatchedPhysics._done`` says that its physics is done and its data visible, so the calling
+    thread goes on with it while the helper steps the rest of its share; elsewhere the calling
+    thread waits for the helpers' whole shares (the futures' locks order the memory)."""
+
+    def __init__(self, physics: BatchedPhysics, shares: list[Future], last: int):
+        self._physics, self._shares, self._last, self._reached = physics, shares, last, False
+
+    def wait(self, k: int, stable: Callable[[], bool]) -> bool:
+        physics, done = self._physics, self._physics._done
+        step = 1.0 / len(physics.worlds)
+        if not self._reached:
+            self._reached = True
+            if all(share.done() for share in self._shares):
+                physics._own_share = max(0.0, physics._own_share - step)
+        if not (_STORES_IN_ORDER and done[k]):
+            if k == self._last:
+                physics._own_share = min(1.0, physics._own_share + step)
+            while _STORES_IN_ORDER and not done[k] and not all(s.done() for s in self._shares):
+                time.sleep(0)  # lets another thread run; the helpers need no GIL
+            if not (_STORES_IN_ORDER and done[k]):
+                for share in self._shares:
+                    share.result()  # a helper's error reaches the caller here
+        return stable()
+
+
+_STORES_IN_ORDER = platform.machine().lower() in ("x86_64", "amd64")
+"""Other cores see a thread's stores in the order it made them (x86-64's memory model)."""
+
+
+def _run_share(started: threading.Event, *args) -> None:
+    """A helper's share of a compiled step: signal that it runs, then step its worlds."""
+    started.set()
+    run_control_periods(*args)
+
+
+def _plain_periods(world: HexapodEnv) -> bool:
+    """The world's control period is `HexapodEnv`'s plain MuJoCo steps (no override of the
+    period's physics, on its class or replacing it on the instance)."""
+    cls = type(world)
+    return (
+        cls._simulate is HexapodEnv._simulate
+        and cls._run_physics is HexapodEnv._run_physics
+        and cls._step_sensing_last is HexapodEnv._step_sensing_last
+        and not {"_simulate", "_run_physics", "_step_sensing_last"} & world.__dict__.keys()
+    )
 
 
 def _take(future: Future, simulate: Callable[[], bool]) -> bool:

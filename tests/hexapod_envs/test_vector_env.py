@@ -204,3 +204,38 @@ def test_an_error_applying_an_action_leaves_no_physics_running():
     envs.reset(seed=1)
     envs.step(np.zeros((3, 18), dtype=np.float32))
     envs.close()
+
+
+def test_plain_control_periods_run_compiled():
+    """The heavy-duty and UPU worlds' periods are plain MuJoCo steps (the compiled mode where
+    the machine has it); ATHENA's contact checks keep the pool of `_simulate` calls."""
+    from hexapod_envs.vector.compiled_steps import compiled_steps_available
+
+    for env_id, plain in (
+        ("HexapodCliffWalk-v1", True),
+        ("HexapodStewartTilt-v1", True),
+        ("HexapodDitchCrossing-v1", True),
+        ("HexapodIrregularTerrain-v1", False),
+    ):
+        envs = gym.make_vec(env_id, 2, vectorization_mode="vector_entry_point", nthread=2)
+        assert envs.physics.compiled == (plain and compiled_steps_available()), env_id
+        envs.close()
+    envs = gym.make_vec(
+        "HexapodCliffWalk-v1", 2, vectorization_mode="vector_entry_point", nthread=0
+    )
+    assert not envs.physics.compiled  # no threads: the plain SyncVectorEnv step
+    envs.close()
+
+
+@pytest.mark.parametrize("share", [0.0, 0.5, 1.0])
+def test_the_split_between_the_threads_does_not_change_results(share):
+    """The calling thread's share of the worlds in the compiled mode, held at each extreme."""
+    batched, sync = _pair("HexapodCliffWalk-v1", 5, nthread=3, max_episode_steps=20)
+    assert_same(batched.reset(seed=5), sync.reset(seed=5), "reset")
+    rng = np.random.default_rng(5)
+    for k in range(45):
+        batched.physics._own_share = share
+        actions = rng.uniform(-1.0, 1.0, (5, 18)).astype(np.float32)
+        assert_same(batched.step(actions), sync.step(actions), f"step {k}")
+    batched.close()
+    sync.close()

@@ -70,7 +70,7 @@ def test_sensing_in_the_last_substep_only_leaves_every_step_unchanged(env_id, kw
     """The envs skip the sensors in all but the last physics step of a control period (ATHENA:
     of each contact check); observations, rewards and infos equal those of sensing every step."""
     skipping = _random_rollout(env_id, **kwargs)
-    monkeypatch.setattr(physics, "_SENSORS_OFF", 0)  # "disable nothing": sensors at every step
+    monkeypatch.setattr(physics, "SENSORS_OFF", 0)  # "disable nothing": sensors at every step
     np.testing.assert_array_equal(skipping, _random_rollout(env_id, **kwargs))
 
 
@@ -259,6 +259,13 @@ def test_step_before_reset_says_call_reset_first(env_id):
     env = gym.make(env_id).unwrapped
     with pytest.raises(RuntimeError, match=r"call reset\(\) first"):
         env.step(env.action_space.sample())
+
+
+def test_reset_options_are_refused_not_ignored():
+    env = gym.make("HexapodCliffWalk-v1")
+    env.reset(seed=0, options={})  # None and an empty dict are no options
+    with pytest.raises(ValueError, match=r"takes no options, got \['task'\].*'paper', 'train'"):
+        env.reset(seed=0, options={"task": {"cliff_x": 1.0}})
 
 
 @pytest.mark.parametrize("env_id", ENV_IDS)
