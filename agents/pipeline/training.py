@@ -31,6 +31,7 @@ from ..run_files.artifacts import (
     MODEL_FILE,
     WARM_START,
     command_line,
+    is_complete,
     prepare_new_dir,
     read_meta,
     run_name,
@@ -331,7 +332,8 @@ def resume_training(
     trust_pickle: bool = False,
     after_eval: Any = None,
 ) -> TrainResult:
-    """Continue a run from its newest loadable checkpoint (model, statistics, timestep count).
+    """Continue a run from its newest loadable checkpoint (model, statistics, timestep count);
+    a warm-started run stopped before its first checkpoint starts PPO again from its clone.
 
     Overrides may change the budget, PPO hyperparameters, evaluation/checkpoint frequencies,
     the number of envs and how they run (``env.vectorization``), but not the env, the policy
@@ -356,6 +358,10 @@ def resume_training(
     config = load_train_config(data=data, overrides=overrides)
     _check_eval_tasks_kept(run_dir, saved, config)
     candidates = saved_model_dirs(run_dir)
+    if not candidates and is_complete(run_dir / WARM_START):
+        # Stopped (killed) after its warm start, before PPO saved a checkpoint: PPO starts
+        # again from the clone, as it did then.
+        candidates = [run_dir / WARM_START]
     if not candidates:
         raise UserError(f"{run_dir} holds no checkpoint to resume from")
     spec = env_spec(config)

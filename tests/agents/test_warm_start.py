@@ -2,6 +2,7 @@
 ditch's clear-stride rule (`agents.upu_stride`) that teaches the stride action."""
 
 import json
+import shutil
 
 import gymnasium as gym
 import numpy as np
@@ -14,6 +15,7 @@ from stable_baselines3.common.policies import ActorCriticPolicy
 import hexapod_envs  # noqa: F401  (registers the ids)
 from agents.pipeline import training
 from agents.pipeline.callbacks import CriticFirst
+from agents.pipeline.cli import train_main
 from agents.ppo import PPOPolicy
 from agents.run_files.artifacts import WARM_START, read_meta
 from agents.run_files.step0 import write_step0_model
@@ -120,6 +122,17 @@ def test_a_warm_started_run_saves_its_clone_as_its_step_0(tmp_path):
     obs, _ = env.reset(seed=0)
     assert start(obs).shape == trained(obs).shape == (10,)
     json.dumps(record)  # the summary is plain data
+
+
+def test_a_run_killed_after_its_warm_start_resumes_from_the_clone(tmp_path):
+    warm = "warm_start={teacher: clear_stride, episodes: 1, epochs: 1, dagger_rounds: 0}"
+    assert train_tiny(WARM_CONFIG, tmp_path, warm) == 0
+    run_dir = tmp_path / "run"
+    for saved in ("checkpoints", "final", "best"):  # as if killed before PPO saved anything
+        shutil.rmtree(run_dir / saved, ignore_errors=True)
+    assert train_main(["--resume", str(run_dir)]) == 0
+    meta = read_meta(run_dir / "final")
+    assert meta["num_timesteps"] == 64 and (run_dir / WARM_START).is_dir()
 
 
 def test_the_critic_learns_alone_until_its_steps_are_collected():
