@@ -108,11 +108,10 @@ class EnvConfig:
     vectorization: Literal["vec_env", "batched"] = "vec_env"
     """How the ``vec_env.n_envs`` training envs run: "vec_env", the SB3 vec env that
     ``vec_env.type`` picks (SubprocVecEnv or DummyVecEnv); "batched", one process whose envs'
-    physics runs on ``vec_env.physics_threads`` threads while the process runs the rest of each
-    env's step (`agents.pipeline.batched_vec_env`, on `hexapod_envs.vector.BatchedPhysics`):
-    the same transitions as DummyVecEnv, for hexapod env ids whose learner acts at every step
-    without a hybrid policy (those wrappers change the action between the learner and the
-    env)."""
+    physics runs on ``vec_env.physics_threads`` threads beside the rest of each env's step
+    (`agents.pipeline.batched_vec_env`, on `hexapod_envs.vector.BatchedPhysics`): the same
+    transitions as DummyVecEnv, for hexapod env ids whose learner acts at every step without a
+    hybrid policy (those wrappers change the action between the learner and the env)."""
 
 
 @dataclass
@@ -121,8 +120,9 @@ class VecEnvConfig:
     type: Literal["auto", "subprocess", "dummy"] = "auto"  # auto: subprocess when n_envs > 1
     start_method: Literal["forkserver", "spawn", "fork"] | None = None  # None: SB3's default
     physics_threads: int | None = None
-    """With ``env.vectorization: batched``: the threads that run the envs' physics (None: the
-    CPUs, at most ``n_envs``; 0: none, the physics runs in the main thread)."""
+    """With ``env.vectorization: batched``: the threads that step the envs' physics, the main
+    thread among them where the envs' periods run compiled (`hexapod_envs.vector.BatchedPhysics`;
+    None: the CPUs, at most ``n_envs``; 0: the main thread steps each env within its step)."""
 
     def __post_init__(self):
         _require("vec_env.n_envs", self.n_envs, ">= 1", self.n_envs >= 1)

@@ -5,9 +5,9 @@
 >>> envs = gym.make_vec("HexapodCliffWalk-v1", num_envs=8, vectorization_mode="vector_entry_point")
 
 The entry points below build the worlds as ``gym.make`` does (the env class with the id's
-keyword arguments, under its time limit); ``nthread`` (the threads of the physics, default: the
-CPUs) and ``autoreset_mode`` go to `BatchedVectorEnv`, the other keyword arguments to each
-world.
+keyword arguments, under its time limit); ``nthread`` (the threads that step the physics, the
+calling thread among them where the periods run compiled; default: the CPUs) and
+``autoreset_mode`` go to `BatchedVectorEnv`, the other keyword arguments to each world.
 """
 
 from __future__ import annotations

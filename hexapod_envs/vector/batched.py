@@ -98,8 +98,10 @@ class BatchedPhysics:
         if not isinstance(nthread, int | np.integer) or isinstance(nthread, bool) or nthread < 0:
             raise ValueError(f"nthread must be an integer >= 0, got {nthread!r}")
         self.nthread = int(nthread)
-        """Threads that run the worlds' physics (0: the calling thread runs it with the rest of
-        each world's step; see `compiled`)."""
+        """Threads that step the worlds' physics. With `compiled` periods the calling thread is
+        one of them (it steps a share between its Python, so 1 runs all physics on the calling
+        thread, after the actions); otherwise a pool of ``nthread`` threads beside the calling
+        thread. 0: the calling thread steps each world within the world's own step."""
         self.compiled = (
             self.nthread > 0
             and all(_plain_periods(world) for world in self.worlds)
@@ -121,6 +123,8 @@ class BatchedPhysics:
         self._flags = np.zeros((n, 2), np.int32)
         self._nsteps = np.zeros(n, np.int64)
         self._done = np.zeros(n, np.int8)
+        self._compiled_worlds = 0
+        """Worlds of the step in progress run compiled (their flags are ``_done[:n]``)."""
 
     @contextmanager
     def step(self, stepping: Sequence[int], actions: Sequence[np.ndarray]) -> Iterator[None]:
@@ -134,16 +138,26 @@ class BatchedPhysics:
                 _replace_once(worlds[i], "_apply_action", partial(_check_action, i, applied[i]))
                 _replace_once(worlds[i], "_simulate", physics[i])
             yield
+            if not self._physics_over():  # a world's step did not wait for its physics
+                wait(self._running)
         except BaseException:
             wait(self._running)  # no world's physics may run on after an error
             for i in stepping:  # some worlds ran physics without their step's bookkeeping
                 worlds[i]._needs_reset = True
             raise
         finally:
-            self._running = []
+            self._running, self._compiled_worlds = [], 0
             for i in stepping:
                 for name in ("_apply_action", "_simulate"):
                     worlds[i].__dict__.pop(name, None)
+
+    def _physics_over(self) -> bool:
+        """Whether every world's physics of this step is over (the compiled worlds' flags: a
+        helper may still be taking the GIL back to finish its future), so that the next step
+        may rewrite what the threads read."""
+        if self._compiled_worlds:
+            return bool(self._done[: self._compiled_worlds].all())
+        return all(future.done() for future in self._running)
 
     def _start(self, worlds: Sequence[int]) -> dict[int, Callable[[], bool]]:
         """Apply each of `worlds`' action and queue its control period of physics (its own
@@ -170,7 +184,11 @@ class BatchedPhysics:
         first worlds), whose physics it runs before returning."""
         order = list(worlds)
         n, helpers = len(order), self.nthread - 1
-        own = n if helpers == 0 else min(n, max(0, round(self._own_share * n)))
+        if n == 0:  # every world autoresets this step
+            return {}
+        self._compiled_worlds = n
+        # At least one world for the helpers: their timing is what tunes the split.
+        own = n if helpers == 0 else min(n - 1, max(0, round(self._own_share * n)))
         bounds = [own + (n - own) * h // helpers for h in range(helpers + 1)] if helpers else []
         models, datas, flags, nsteps, done = (
             self._models,
@@ -189,7 +207,7 @@ class BatchedPhysics:
             nsteps[k] = world.n_substeps
             done[k] = 0
         args = (models, datas, flags, nsteps, done)
-        shares = []
+        shares = {}
         for start, stop in zip(bounds[:-1], bounds[1:], strict=False):
             for k in range(start, stop):
                 expected[k] = self._apply(order[k])
@@ -198,11 +216,11 @@ class BatchedPhysics:
                 future = self._pool.submit(_run_share, started, *args, start, stop)
                 self._running.append(future)
                 started.wait()  # the helper's share runs without the GIL from here
-                shares.append(future)
+                shares[range(start, stop)] = future
         for k in range(own):
             expected[k] = self._apply(order[k])
         run_control_periods(*args, 0, own)
-        balance = _Balance(self, shares, len(order) - 1)
+        balance = _Balance(self, shares, own, len(order))
         physics = {}
         for k, i in enumerate(order):
             stable = partial(self.worlds[i]._stayed_stable_to, expected[k])
@@ -224,8 +242,8 @@ class BatchedPhysics:
 class BatchedVectorEnv(SyncVectorEnv):
     """N hexapod worlds stepped together, the physics on ``nthread`` threads (see the module
     docstring). The constructor takes `SyncVectorEnv`'s arguments and ``nthread``: the threads
-    that run the worlds' physics while the calling thread runs the rest of the step (default:
-    the CPUs, at most N; 0 runs everything on the calling thread, as `SyncVectorEnv`).
+    that step the worlds' physics (default: the CPUs, at most N; 0 runs everything on the
+    calling thread, as `SyncVectorEnv`; see `BatchedPhysics.nthread`).
     ``gym.make_vec(id, num_envs=N, vectorization_mode="vector_entry_point", nthread=...)``
     builds one for a registered id (`hexapod_envs.vector.make_batched`)."""
 
@@ -282,36 +300,51 @@ class BatchedVectorEnv(SyncVectorEnv):
 
 
 class _Balance:
-    """The calling thread's waits for the helpers' worlds in a compiled step, which move the
-    split: helpers already done when the calling thread reaches their first world waited
-    idle (the calling thread takes a smaller share next step); the last world not done when
-    the calling thread needs it kept the calling thread waiting (a larger one).
+    """The calling thread's waits for the helpers' worlds in a compiled step, and the split
+    they move by one world a step: the helpers all done when the calling thread reaches their
+    first world waited idle (a smaller own share next step); the calling thread waiting for
+    them (for the last world, or for the whole shares where flags are not trusted) means a
+    larger one.
 
     Where stores reach other cores in program order (x86-64), a world's flag in
     ``BatchedPhysics._done`` says that its physics is done and its data visible, so the calling
-    thread goes on with it while the helper steps the rest of its share; elsewhere the calling
-    thread waits for the helpers' whole shares (the futures' locks order the memory)."""
+    thread goes on with it while the helper steps the rest of its share; elsewhere it waits for
+    the helpers' whole shares (the futures' locks order the memory). A wait for a world spins
+    for 0.1 ms, then sleeps between looks."""
 
-    def __init__(self, physics: BatchedPhysics, shares: list[Future], last: int):
-        self._physics, self._shares, self._last, self._reached = physics, shares, last, False
+    def __init__(self, physics: BatchedPhysics, shares: dict[range, Future], first: int, stop: int):
+        self._physics, self._shares = physics, shares
+        self._first, self._stop = first, stop
+        self._reached = False
 
     def wait(self, k: int, stable: Callable[[], bool]) -> bool:
         physics, done = self._physics, self._physics._done
         step = 1.0 / len(physics.worlds)
         if not self._reached:
             self._reached = True
-            if all(share.done() for share in self._shares):
+            if done[self._first : self._stop].all():
                 physics._own_share = max(0.0, physics._own_share - step)
-        if not (_STORES_IN_ORDER and done[k]):
-            if k == self._last:
+            elif not _STORES_IN_ORDER:
                 physics._own_share = min(1.0, physics._own_share + step)
-            while _STORES_IN_ORDER and not done[k] and not all(s.done() for s in self._shares):
-                time.sleep(0)  # lets another thread run; the helpers need no GIL
-            if not (_STORES_IN_ORDER and done[k]):
-                for share in self._shares:
-                    share.result()  # a helper's error reaches the caller here
+        share = next(future for worlds, future in self._shares.items() if k in worlds)
+        if _STORES_IN_ORDER:
+            if k == self._stop - 1 and not done[k]:
+                physics._own_share = min(1.0, physics._own_share + step)
+            spin_until = time.perf_counter() + _SPIN_S
+            while not done[k] and not share.done():
+                # sleep(0) lets another thread run; later sleeps free the core too
+                time.sleep(0.0 if time.perf_counter() < spin_until else _POLL_S)
+            if done[k]:
+                return stable()
+        share.result()  # a helper's error reaches the caller here
         return stable()
 
+
+_SPIN_S = 1e-4
+"""How long a wait for a helper's world spins before it sleeps between looks [s]."""
+
+_POLL_S = 5e-5
+"""The sleep between looks after the spin [s] (a world's physics takes 0.1-1 ms)."""
 
 _STORES_IN_ORDER = platform.machine().lower() in ("x86_64", "amd64")
 """Other cores see a thread's stores in the order it made them (x86-64's memory model)."""

@@ -73,9 +73,14 @@ def _kernel():
     """The compiled kernel and the flags' offset, or None where they are not available. Built
     on first use (compiling takes about a second; numba cannot cache a function that calls
     ctypes pointers)."""
-    library = _library()
-    offset = _disableflags_offset()
-    if library is None or offset is None or not hasattr(library, "mju_copyInt"):
+    try:  # the binding's private addresses and the library's symbols may change
+        library = _library()
+        offset = _disableflags_offset()
+    except (AttributeError, OSError, ValueError):
+        return None
+    if library is None or offset is None:
+        return None
+    if not (hasattr(library, "mj_step") and hasattr(library, "mju_copyInt")):
         return None
     step = library.mj_step
     step.argtypes = [ctypes.c_int64, ctypes.c_int64]

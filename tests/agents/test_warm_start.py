@@ -124,13 +124,15 @@ def test_a_warm_started_run_saves_its_clone_as_its_step_0(tmp_path):
     json.dumps(record)  # the summary is plain data
 
 
-def test_a_run_killed_after_its_warm_start_resumes_from_the_clone(tmp_path):
+def test_a_run_killed_after_its_warm_start_resumes_from_the_clone(tmp_path, capsys):
     warm = "warm_start={teacher: clear_stride, episodes: 1, epochs: 1, dagger_rounds: 0}"
     assert train_tiny(WARM_CONFIG, tmp_path, warm) == 0
     run_dir = tmp_path / "run"
     for saved in ("checkpoints", "final", "best"):  # as if killed before PPO saved anything
         shutil.rmtree(run_dir / saved, ignore_errors=True)
+    capsys.readouterr()
     assert train_main(["--resume", str(run_dir)]) == 0
+    assert f"resuming {run_dir} from {WARM_START} at 0 steps" in capsys.readouterr().out
     meta = read_meta(run_dir / "final")
     assert meta["num_timesteps"] == 64 and (run_dir / WARM_START).is_dir()
 

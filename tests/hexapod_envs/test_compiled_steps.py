@@ -35,34 +35,32 @@ def test_the_flags_offset_points_at_the_models_disableflags():
 
 @pytest.mark.parametrize("env_id", ["HexapodCliffWalk-v1", "HexapodDitchCrossing-v1"])
 def test_compiled_periods_equal_the_envs_own_physics(env_id):
-    compiled, reference = gym.make(env_id).unwrapped, gym.make(env_id).unwrapped
-    for env in (compiled, reference):
+    """Two copies of one env in one call (as a helper's share), each a whole control period,
+    against a third stepped by its own `_simulate`."""
+    worlds = [gym.make(env_id).unwrapped for _ in range(3)]
+    for env in worlds:
         env.reset(seed=3)
+    *compiled, reference = worlds
     rng = np.random.default_rng(0)
-    n = 2
-    models, datas = np.zeros(n, np.int64), np.zeros(n, np.int64)
-    flags, nsteps, done = np.zeros((n, 2), np.int32), np.zeros(n, np.int64), np.zeros(n, np.int8)
+    own = reference.model.opt.disableflags
+    flags = np.array([[own | SENSORS_OFF, own]] * 2, np.int32)
+    nsteps = np.array([reference.n_substeps] * 2)
+    done = np.zeros(2, np.int8)
     for step in range(40):
-        action = rng.uniform(-1, 1, compiled.action_space.shape).astype(np.float32)
-        for env in (compiled, reference):
+        action = rng.uniform(-1, 1, reference.action_space.shape).astype(np.float32)
+        for env in worlds:
             env._apply_action(env._validate_action(action))
-        own = compiled.model.opt.disableflags
-        # world 0 and world 1 are the same env: one period run twice over, split in two calls
-        models[:] = compiled.model._address
-        datas[:] = compiled.data._address
-        flags[:] = (own | SENSORS_OFF, own)
-        nsteps[:] = (compiled.n_substeps - 1, 1)
+        models = np.array([env.model._address for env in compiled])  # a reset may rebuild
+        datas = np.array([env.data._address for env in compiled])
         done[:] = 0
-        run_control_periods(models, datas, flags, nsteps, done, 0, 1)
-        assert compiled.model.opt.disableflags == own  # the last step's flags are the model's
-        assert done.tolist() == [1, 0]
-        run_control_periods(models, datas, flags, nsteps, done, 1, 2)
+        run_control_periods(models, datas, flags, nsteps, done, 0, 2)
         assert done.tolist() == [1, 1]
         assert reference._simulate()
-        for field in FIELDS:
-            got, expected = getattr(compiled.data, field), getattr(reference.data, field)
-            assert np.array_equal(got, expected), (step, field)
-    assert compiled.model.opt.disableflags == reference.model.opt.disableflags
+        for env in compiled:
+            assert env.model.opt.disableflags == own  # the model's own flags are left
+            for field in FIELDS:
+                got, expected = getattr(env.data, field), getattr(reference.data, field)
+                assert np.array_equal(got, expected), (step, field)
 
 
 def test_a_control_period_of_one_step_evaluates_the_sensors():

@@ -239,3 +239,47 @@ def test_the_split_between_the_threads_does_not_change_results(share):
         assert_same(batched.step(actions), sync.step(actions), f"step {k}")
     batched.close()
     sync.close()
+
+
+@pytest.mark.parametrize("stores_in_order", [True, False])
+def test_the_split_comes_back_from_either_end(stores_in_order, monkeypatch):
+    """The calling thread's share moves by one world a step, down when the helper waited idle
+    and up when the calling thread waited for it; from all of the worlds (capped so that the
+    helper keeps one) or none it comes back inside, on machines where the done flags are
+    trusted and where the whole shares are waited for."""
+    import hexapod_envs.vector.batched as batched_module
+
+    monkeypatch.setattr(batched_module, "_STORES_IN_ORDER", stores_in_order)
+    envs = gym.make_vec(
+        "HexapodStewartTilt-v1", 4, vectorization_mode="vector_entry_point", nthread=2
+    )
+    if not envs.physics.compiled:
+        pytest.skip("compiled control periods not available here")
+    envs.reset(seed=0)
+    zeros = np.zeros((4, 18), dtype=np.float32)
+    shares = {}
+    for start in (1.0, 0.0):
+        envs.physics._own_share = start
+        shares[start] = []
+        for _ in range(30):
+            envs.step(zeros)
+            shares[start].append(envs.physics._own_share)
+    envs.close()
+    assert min(shares[1.0]) < 0.75  # the helper kept 1 world of 4 and waited for the rest
+    assert max(shares[0.0]) > 0.0  # the helper stepped all 4 and the calling thread waited
+    assert all(0.0 <= share <= 1.0 for share in shares[1.0] + shares[0.0])
+
+
+def test_a_step_on_which_every_world_autoresets():
+    """Worlds that all reach the time limit together all autoreset on the next step: a step
+    in which no world's physics runs."""
+    batched, sync = _pair("HexapodStewartTilt-v1", 2, nthread=2, max_episode_steps=3)
+    assert_same(batched.reset(seed=0), sync.reset(seed=0), "reset")
+    zeros = np.zeros((2, 18), dtype=np.float32)
+    for k in range(8):
+        got = batched.step(zeros)
+        assert_same(got, sync.step(zeros), f"step {k}")
+        if k == 2:
+            assert got[3].all()  # both truncated: the next step resets both
+    batched.close()
+    sync.close()
