@@ -411,16 +411,6 @@ class TrainConfig:
                 "so it needs env.decision: step and no hybrid section (both change the action "
                 "between the learner and the env); use env.vectorization: vec_env"
             )
-        if self.env.vectorization == "batched" and self.policy.critic_privileged:
-            raise ValueError(
-                "policy.critic_privileged appends the task to each env's observation, which "
-                "env.vectorization: batched does not do; use env.vectorization: vec_env"
-            )
-        if self.env.vectorization == "batched" and self.env.stability_penalty:
-            raise ValueError(
-                "env.stability_penalty wraps each env, which env.vectorization: batched does "
-                "not do; use env.vectorization: vec_env"
-            )
         if not (self.env.stability_penalty >= 0 and math.isfinite(self.env.stability_penalty)):
             raise ValueError(
                 f"env.stability_penalty must be a number >= 0 (0: off), got "

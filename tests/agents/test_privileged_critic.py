@@ -19,7 +19,6 @@ from agents.privileged_critic import (
     task_code,
 )
 from agents.privileged_critic_policy import PrivilegedCriticPolicy
-from agents.run_files.train_config import load_train_config
 
 
 def _cliff(limit=1500):
@@ -88,14 +87,12 @@ def test_the_actor_ignores_the_privileged_values_and_the_critic_reads_them():
     assert padded.shape == obs.shape and np.all(padded[-PRIVILEGED_DIM:] == 0.0)
 
 
-def test_the_batched_vector_env_refuses_a_privileged_critic():
-    with pytest.raises(ValueError, match="critic_privileged"):
-        load_train_config(
-            data={
-                "env": {"id": "HexapodCliffWalk-v1", "vectorization": "batched"},
-                "policy": {"critic_privileged": True},
-            }
-        )
+def test_a_run_with_the_privileged_critic_trains_on_the_batched_env(tmp_path):
+    """The task is appended inside each env's wrappers, which the batched adapter steps as
+    DummyVecEnv does (their transitions compared: tests/agents/pipeline)."""
+    batched = ["env.vectorization=batched", "vec_env.n_envs=2", "vec_env.physics_threads=2"]
+    assert train(tmp_path, "run", overrides=[*TINY, "policy.critic_privileged=true", *batched]) == 0
+    assert (tmp_path / "run" / "final" / "model.zip").is_file()
 
 
 def test_a_run_trains_resumes_loads_and_exports_with_the_privileged_critic(tmp_path):

@@ -115,11 +115,8 @@ def test_the_training_config_wraps_the_env_and_checks_the_weight():
     assert "StabilityRulePenalty" in wrappers
     with pytest.raises((ConfigError, ValueError), match="stability_penalty must be a number >= 0"):
         load_train_config(CONFIG, ["env.stability_penalty=-1"])
-    with pytest.raises((ConfigError, ValueError), match="batched does not do"):
-        load_train_config(
-            CONFIG,
-            ["env.vectorization=batched", "policy.critic_privileged=false"],
-        )
+    batched = load_train_config(CONFIG, ["env.vectorization=batched"])  # each env is wrapped
+    assert batched.env.stability_penalty == 2.0
 
 
 def _cliff_return(progress_weight, stop_at):

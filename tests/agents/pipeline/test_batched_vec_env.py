@@ -45,9 +45,23 @@ def _same(a, b, where):
         assert a == b or (a != a and b != b), where
 
 
-def test_adapter_returns_what_dummy_vec_env_returns():
-    batched = make_batched_vec_env(TIPPING, 3, seed=5, nthread=2)
-    dummy = DummyVecEnv([EnvFactory(TIPPING) for _ in range(3)])
+WALKING = EnvSpec(
+    "HexapodCliffWalk-v1",
+    {"task_distribution": "train"},
+    max_episode_steps=60,
+    gym_packages=["hexapod_envs"],
+    privileged_critic=True,
+    stability_penalty=0.5,
+    progress_penalty=0.2,
+)
+"""The v1 PPO configs' wrappers: the task appended for the critic, the stability rule's
+penalties (a reward wrapper that reads each step's info)."""
+
+
+@pytest.mark.parametrize("spec", [TIPPING, WALKING], ids=["tipping", "privileged_penalised"])
+def test_adapter_returns_what_dummy_vec_env_returns(spec):
+    batched = make_batched_vec_env(spec, 3, seed=5, nthread=2)
+    dummy = DummyVecEnv([EnvFactory(spec) for _ in range(3)])
     dummy.seed(5)
     _same(batched.reset(), dummy.reset(), "reset")
     rng = np.random.default_rng(0)
