@@ -333,7 +333,7 @@ def resume_training(
     after_eval: Any = None,
 ) -> TrainResult:
     """Continue a run from its newest loadable checkpoint (model, statistics, timestep count);
-    a warm-started run with none starts PPO again from its clone (``warm_start/``).
+    a warm-started run that saved none starts PPO again from its clone (``warm_start/``).
 
     Overrides may change the budget, PPO hyperparameters, evaluation/checkpoint frequencies,
     the number of envs and how they run (``env.vectorization``), but not the env, the policy
@@ -358,10 +358,11 @@ def resume_training(
     config = load_train_config(data=data, overrides=overrides)
     _check_eval_tasks_kept(run_dir, saved, config)
     candidates = saved_model_dirs(run_dir)
-    if is_complete(run_dir / WARM_START):
-        # The last resort of a warm-started run (killed before PPO saved a checkpoint, or every
-        # checkpoint damaged): PPO starts from the clone again, on freshly seeded envs.
-        candidates.append(run_dir / WARM_START)
+    if not candidates and is_complete(run_dir / WARM_START):
+        # Killed after its warm start, before PPO saved a checkpoint: PPO starts from the clone
+        # again, on freshly seeded envs. (Damaged checkpoints stay an error: falling back to
+        # the clone would drop the training done.)
+        candidates = [run_dir / WARM_START]
     if not candidates:
         raise UserError(f"{run_dir} holds no checkpoint to resume from")
     spec = env_spec(config)

@@ -41,7 +41,7 @@ single env's warm start from one control period to the next. `mujoco.batch` keep
 every step, and ATHENA's contact checks within a period would be reimplemented.
 
 What the threads buy, and what caps it (the calling thread's share of a step, two cores that
-together run physics only 1.4-1.9 x as fast as one): benchmarks/README.md,
+together run physics only 1.3-1.9 x as fast as one): benchmarks/README.md,
 ``bench_vector_env.py``.
 """
 
@@ -138,7 +138,7 @@ class BatchedPhysics:
                 _replace_once(worlds[i], "_apply_action", partial(_check_action, i, applied[i]))
                 _replace_once(worlds[i], "_simulate", physics[i])
             yield
-            if not self._physics_over():  # a world's step did not wait for its physics
+            if not (_STORES_IN_ORDER and self._physics_over()):  # flags alone prove it here
                 wait(self._running)
         except BaseException:
             wait(self._running)  # no world's physics may run on after an error
@@ -310,7 +310,7 @@ class _Balance:
     ``BatchedPhysics._done`` says that its physics is done and its data visible, so the calling
     thread goes on with it while the helper steps the rest of its share; elsewhere it waits for
     the helpers' whole shares (the futures' locks order the memory). A wait for a world spins
-    for 0.1 ms, then sleeps between looks."""
+    for 0.5 ms, then sleeps between looks."""
 
     def __init__(self, physics: BatchedPhysics, shares: dict[range, Future], first: int, stop: int):
         self._physics, self._shares = physics, shares
@@ -340,11 +340,12 @@ class _Balance:
         return stable()
 
 
-_SPIN_S = 1e-4
-"""How long a wait for a helper's world spins before it sleeps between looks [s]."""
+_SPIN_S = 5e-4
+"""How long a wait for a helper's world spins (yielding the core at each look) before it
+sleeps between looks [s]: a world's physics takes 0.1-1 ms."""
 
 _POLL_S = 5e-5
-"""The sleep between looks after the spin [s] (a world's physics takes 0.1-1 ms)."""
+"""The sleep between looks after the spin [s] (Linux's timer slack makes it about 0.1 ms)."""
 
 _STORES_IN_ORDER = platform.machine().lower() in ("x86_64", "amd64")
 """Other cores see a thread's stores in the order it made them (x86-64's memory model)."""

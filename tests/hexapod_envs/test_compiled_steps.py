@@ -35,8 +35,8 @@ def test_the_flags_offset_points_at_the_models_disableflags():
 
 @pytest.mark.parametrize("env_id", ["HexapodCliffWalk-v1", "HexapodDitchCrossing-v1"])
 def test_compiled_periods_equal_the_envs_own_physics(env_id):
-    """Two copies of one env in one call (as a helper's share), each a whole control period,
-    against a third stepped by its own `_simulate`."""
+    """Two copies of one env, each a whole control period in its own share, against a third
+    stepped by its own `_simulate`."""
     worlds = [gym.make(env_id).unwrapped for _ in range(3)]
     for env in worlds:
         env.reset(seed=3)
@@ -53,7 +53,9 @@ def test_compiled_periods_equal_the_envs_own_physics(env_id):
         models = np.array([env.model._address for env in compiled])  # a reset may rebuild
         datas = np.array([env.data._address for env in compiled])
         done[:] = 0
-        run_control_periods(models, datas, flags, nsteps, done, 0, 2)
+        run_control_periods(models, datas, flags, nsteps, done, 0, 1)  # one share ...
+        assert done.tolist() == [1, 0]
+        run_control_periods(models, datas, flags, nsteps, done, 1, 2)  # ... then the next
         assert done.tolist() == [1, 1]
         assert reference._simulate()
         for env in compiled:

@@ -267,7 +267,6 @@ def test_the_split_comes_back_from_either_end(stores_in_order, monkeypatch):
     envs.close()
     assert min(shares[1.0]) < 0.75  # the helper kept 1 world of 4 and waited for the rest
     assert max(shares[0.0]) > 0.0  # the helper stepped all 4 and the calling thread waited
-    assert all(0.0 <= share <= 1.0 for share in shares[1.0] + shares[0.0])
 
 
 def test_a_step_on_which_every_world_autoresets():
