@@ -190,13 +190,8 @@ class BatchedPhysics:
         # At least one world for the helpers: their timing is what tunes the split.
         own = n if helpers == 0 else min(n - 1, max(0, round(self._own_share * n)))
         bounds = [own + (n - own) * h // helpers for h in range(helpers + 1)] if helpers else []
-        models, datas, flags, nsteps, done = (
-            self._models,
-            self._datas,
-            self._flags,
-            self._nsteps,
-            self._done,
-        )
+        args = (self._models, self._datas, self._flags, self._nsteps, self._done)
+        models, datas, flags, nsteps, done = args
         expected = {}
         for k, i in enumerate(order):
             world = self.worlds[i]
@@ -206,7 +201,6 @@ class BatchedPhysics:
             flags[k, 1] = own_flags
             nsteps[k] = world.n_substeps
             done[k] = 0
-        args = (models, datas, flags, nsteps, done)
         shares = {}
         for start, stop in zip(bounds[:-1], bounds[1:], strict=False):
             for k in range(start, stop):
