@@ -241,32 +241,59 @@ def test_the_split_between_the_threads_does_not_change_results(share):
     sync.close()
 
 
-@pytest.mark.parametrize("stores_in_order", [True, False])
-def test_the_split_comes_back_from_either_end(stores_in_order, monkeypatch):
-    """The calling thread's share moves by one world a step, down when the helper waited idle
-    and up when the calling thread waited for it; from all of the worlds (capped so that the
-    helper keeps one) or none it comes back inside, on machines where the done flags are
-    trusted and where the whole shares are waited for."""
+def _balance(stores_in_order, monkeypatch, done, share=0.5):
+    """A `_Balance` over 4 worlds whose last 2 are one helper's share (already finished: its
+    future is done), with the done flags `done`."""
+    from concurrent.futures import Future
+    from types import SimpleNamespace
+
     import hexapod_envs.vector.batched as batched_module
 
     monkeypatch.setattr(batched_module, "_STORES_IN_ORDER", stores_in_order)
+    physics = SimpleNamespace(worlds=[None] * 4, _done=np.array(done, np.int8), _own_share=share)
+    future = Future()
+    future.set_result(None)
+    return physics, batched_module._Balance(physics, {range(2, 4): future}, 2, 4)
+
+
+@pytest.mark.parametrize("stores_in_order", [True, False])
+def test_the_split_moves_toward_the_thread_that_waited(stores_in_order, monkeypatch):
+    """The calling thread's share moves by one world a step: down when the helper had
+    finished before the calling thread reached its first world, up when the calling thread
+    had to wait for it (for the last world where the flags are trusted, for the share where
+    they are not). Each world's wait returns its stability check."""
+    physics, balance = _balance(stores_in_order, monkeypatch, [1, 1, 1, 1])
+    assert balance.wait(2, lambda: True) and balance.wait(3, lambda: False) is False
+    assert physics._own_share == 0.25  # the helper waited idle
+    physics, balance = _balance(stores_in_order, monkeypatch, [1, 1, 0, 0])
+    balance.wait(2, lambda: True)
+    balance.wait(3, lambda: True)
+    assert physics._own_share == 0.75  # the calling thread waited
+    physics, balance = _balance(stores_in_order, monkeypatch, [1, 1, 1, 0])
+    balance.wait(2, lambda: True)
+    balance.wait(3, lambda: True)  # the last world only
+    assert physics._own_share == 0.75
+    physics, balance = _balance(stores_in_order, monkeypatch, [1, 1, 0, 0], share=1.0)
+    balance.wait(2, lambda: True)
+    balance.wait(3, lambda: True)
+    assert physics._own_share == 1.0  # within [0, 1] (the step keeps the helpers a world)
+
+
+def test_the_helpers_keep_a_world_at_any_split():
     envs = gym.make_vec(
         "HexapodStewartTilt-v1", 4, vectorization_mode="vector_entry_point", nthread=2
     )
     if not envs.physics.compiled:
         pytest.skip("compiled control periods not available here")
     envs.reset(seed=0)
-    zeros = np.zeros((4, 18), dtype=np.float32)
-    shares = {}
-    for start in (1.0, 0.0):
-        envs.physics._own_share = start
-        shares[start] = []
-        for _ in range(30):
-            envs.step(zeros)
-            shares[start].append(envs.physics._own_share)
+    envs.physics._own_share = 1.0
+    submitted = []
+    pool = envs.physics._pool
+    original = pool.submit
+    pool.submit = lambda *args: submitted.append(args[-2:]) or original(*args)
+    envs.step(np.zeros((4, 18), dtype=np.float32))
+    assert submitted == [(3, 4)]  # the calling thread steps worlds 0-2, the helper world 3
     envs.close()
-    assert min(shares[1.0]) < 0.75  # the helper kept 1 world of 4 and waited for the rest
-    assert max(shares[0.0]) > 0.0  # the helper stepped all 4 and the calling thread waited
 
 
 def test_a_step_on_which_every_world_autoresets():
