@@ -320,9 +320,11 @@ class _Balance:
                 physics._own_share = max(0.0, physics._own_share - step)
             elif not _STORES_IN_ORDER:
                 physics._own_share = min(1.0, physics._own_share + step)
+        if _STORES_IN_ORDER and done[k]:
+            return stable()
         share = next(future for worlds, future in self._shares.items() if k in worlds)
         if _STORES_IN_ORDER:
-            if k == self._stop - 1 and not done[k]:
+            if k == self._stop - 1:
                 physics._own_share = min(1.0, physics._own_share + step)
             spin_until = time.perf_counter() + _SPIN_S
             while not done[k] and not share.done():

@@ -70,8 +70,8 @@ def _disableflags_offset() -> int | None:
 
 @functools.cache
 def _kernel():
-    """The compiled kernel and the flags' offset, or None where they are not available. Built
-    on first use (compiling takes about a second; numba cannot cache a function that calls
+    """The compiled kernel (the flags' offset built in), or None where it is not available.
+    Built on first use (compiling takes about a second; numba cannot cache a function that calls
     ctypes pointers)."""
     try:  # the binding's private addresses and the library's symbols may change
         library = _library()
