@@ -17,6 +17,11 @@ same terrain, from the same state (common random numbers). On a block bed the te
 feet moves a cycle's reward far more than the gains do, so the plain reward ranks gain settings
 only at noise level; the difference cancels the terrain and leaves the gains' effect.
 
+The ditch crossing's stride action (``stride_action=True``) with the residuals off
+(``residual_limb_m=0``, ``residual_leg_m=0``) is read the same way, once per platform step (its
+first control step, `stride_due`), so the wrapper makes one step of each platform step there:
+the learner chooses each stride, and its reward is the platform step's sum (~51 control steps).
+
 A policy trained through it acts identically without it: the env reads the action only at the
 cycle starts, and the wrapped env returns exactly the observation that the unwrapped env returns
 before each cycle start. Evaluation (which needs every step's info for its metrics) therefore
@@ -69,13 +74,12 @@ class GainsPerCycle(gym.Wrapper):
                     f"baseline_action {baseline_action!r} is not in the action space "
                     f"{env.action_space}"
                 )
-        _require_gains_mode(env, type(self).__name__)
+        self._due = _decision_due(env, type(self).__name__)
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        base = self.env.unwrapped
         twin = None if self.baseline_action is None else copy.deepcopy(self.env)
         (obs, _, terminated, truncated, info), total, steps = _play(
-            self.env, action, lambda _: base.gains_due
+            self.env, action, lambda _: self._due()
         )
         info["cycle_steps"] = steps
         if twin is None:
@@ -239,6 +243,31 @@ def _has_time_limit(env: gym.Env) -> bool:
             return True
         env = env.env
     return False
+
+
+def _decision_due(env: gym.Env, wrapper: str) -> Callable[[], bool]:
+    """Whether `env`'s next step reads its action, for an env that reads it once per gait cycle
+    and ignores it in between: ATHENA's "gains" mode (`gains_due`), or the ditch crossing's
+    stride action with the residuals off (`stride_due`: once per platform step). ValueError
+    for any other env or mode, naming what would do."""
+    base = env.unwrapped
+    if getattr(base, "stride_action", False):
+        if np.any(base.residual_gain):
+            raise ValueError(
+                f"{wrapper} on the ditch crossing's stride action needs residual_limb_m=0 and "
+                "residual_leg_m=0: the residuals are read at every step, so a policy acting "
+                "once per platform step would act differently on the plain env (got "
+                f"{base.settings.residual_limb_m} and {base.settings.residual_leg_m})"
+            )
+        return lambda: base.stride_due
+    if not hasattr(type(base), "gains_due"):
+        raise ValueError(
+            f"{wrapper} needs an env that reads its action once per gait cycle: "
+            "HexapodIrregularTerrain-* with action_mode='gains', or HexapodDitchCrossing-* with "
+            f"stride_action=True and the residuals off; got {type(base).__name__}"
+        )
+    _require_gains_mode(env, wrapper)
+    return lambda: base.gains_due
 
 
 def _require_gains_mode(env: gym.Env, wrapper: str) -> None:

@@ -76,7 +76,8 @@ class EnvSpec:
     `ExcludeRewardTerms`); empty: the env's reward."""
     decision: str = "step"
     """"step": the learner acts at every env step; "gait_cycle": once per gait cycle, through
-    `hexapod_envs.wrappers.GainsPerCycle` (the irregular terrain's "gains" mode); "episode":
+    `hexapod_envs.wrappers.GainsPerCycle` (the irregular terrain's "gains" mode; the ditch
+    crossing's stride action with the residuals off, once per platform step); "episode":
     once per episode, through `hexapod_envs.wrappers.GainsPerEpisode`."""
     cycle_baseline: str = "none"
     """With decision "gait_cycle": "zero_action" rewards each cycle relative to the zero action

@@ -75,12 +75,13 @@ class EnvConfig:
     (`agents.pipeline.envs.ExcludeRewardTerms`); the evaluation reports the env's own return."""
     decision: Literal["step", "gait_cycle", "episode"] = "step"
     """When the learner acts: every env step, once per gait cycle (`gait_cycle`: the
-    irregular terrain's "gains" mode through `hexapod_envs.wrappers.GainsPerCycle`; training
-    steps then count gait cycles, and the training episodes' TensorBoard statistics see each
-    cycle's last step only; evaluations still run every env step, see the wrapper), or once
-    per episode (`episode`: the gains mode with one setting held over the whole episode,
-    `hexapod_envs.wrappers.GainsPerEpisode`; training steps and evaluations count episodes,
-    rewarded as ``episode_reward`` says)."""
+    irregular terrain's "gains" mode, or once per platform step the ditch crossing's stride
+    action with the residuals off, through `hexapod_envs.wrappers.GainsPerCycle`; training
+    steps then count gait cycles (platform steps), and the training episodes' TensorBoard
+    statistics see each cycle's last step only; evaluations still run every env step, see the
+    wrapper), or once per episode (`episode`: the gains mode with one setting held over the
+    whole episode, `hexapod_envs.wrappers.GainsPerEpisode`; training steps and evaluations
+    count episodes, rewarded as ``episode_reward`` says)."""
     episode_reward: EpisodeReward = "success"
     """With ``decision: episode``: the learner's reward per episode, "success" (1 when it meets
     the env's success rule, else 0), "stable_success" (a success graded by its largest tilt,

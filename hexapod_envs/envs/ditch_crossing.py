@@ -598,7 +598,7 @@ class DitchCrossingEnv(HexapodEnv):
         return self.schedule.command(self._step_count if tick is None else tick)
 
     def _apply_action(self, action: np.ndarray) -> None:
-        if self.stride_action and self._step_count == self._decide_at:
+        if self.stride_due:
             self.online_gait.advance(self.online_gait.stride_for(action[STRIDE_ACTION]))
             self._set_online_schedule()
         if self.action_mode == "joint":
@@ -696,12 +696,17 @@ class DitchCrossingEnv(HexapodEnv):
             return {}
         return {STRIDE_ACTION: self.observation_layout.slices["stride_decision"].start + 1}
 
+    @property
+    def stride_due(self) -> bool:
+        """True when the next `step` reads its stride value (action 9): with `stride_action`,
+        on each platform step's first control step. `hexapod_envs.wrappers.GainsPerCycle`
+        makes one env step of each platform step with it (when the residuals are off)."""
+        return self.stride_action and self._step_count == self._decide_at
+
     def _stride_decision(self) -> np.ndarray:
         """With `stride_action`: (1 if the upper platform moves next, 1 if the next action's
         stride value decides that step)."""
-        return np.array(
-            [float(self.online_gait.moving == "upper"), float(self._step_count == self._decide_at)]
-        )
+        return np.array([float(self.online_gait.moving == "upper"), float(self.stride_due)])
 
     def _reference_action(self) -> np.ndarray:
         """The reference gait's command now, normalised like a "joint" action."""

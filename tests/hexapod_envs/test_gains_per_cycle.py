@@ -58,7 +58,7 @@ def test_the_gains_read_at_a_cycle_start_are_the_decision():
 def test_other_action_modes_and_envs_are_refused_by_name():
     with pytest.raises(ValueError, match="action_mode='gains'.*'residual'"):
         GainsPerCycle(gym.make(ENV_ID))
-    with pytest.raises(ValueError, match="gains action mode.*CliffWalkEnv"):
+    with pytest.raises(ValueError, match="action_mode='gains'.*CliffWalkEnv"):
         GainsPerCycle(gym.make("HexapodCliffWalk-v0"))
 
 

@@ -1,0 +1,96 @@
+"""One learner step per platform step: the ditch crossing's stride action with the residuals off,
+through `GainsPerCycle` (``env.decision: gait_cycle``)."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from helpers.paths import REPO
+
+import hexapod_envs  # noqa: F401  (registers the env ids)
+from agents.upu_stride import ClearStridePolicy
+from hexapod_envs.envs.ditch_crossing import STRIDE_ACTION
+from hexapod_envs.wrappers import GainsPerCycle
+
+ENV_ID = "HexapodDitchCrossing-v1"
+STRIDES = {
+    "task_distribution": "train",
+    "stride_action": True,
+    "residual_limb_m": 0.0,
+    "residual_leg_m": 0.0,
+    "max_episode_steps": 400,
+}
+
+
+def _rule_with_noise(env: gym.Env):
+    """The clear-stride rule, its nine ignored residual values random: a policy whose stride
+    depends on the observation and whose other values differ at every step."""
+    rule, rng = ClearStridePolicy(env), np.random.default_rng(0)
+
+    def act(obs: np.ndarray) -> np.ndarray:
+        action = np.asarray(rule(obs), dtype=np.float32).copy()
+        action[:STRIDE_ACTION] = rng.uniform(-1, 1, STRIDE_ACTION)
+        return action
+
+    return act
+
+
+def _run(env: gym.Env, seed: int) -> tuple[np.ndarray, float, list[int], dict]:
+    policy = _rule_with_noise(env)
+    obs, _ = env.reset(seed=seed)
+    total, steps = 0.0, []
+    while True:
+        obs, reward, terminated, truncated, info = env.step(policy(obs))
+        total += reward
+        steps.append(info.get("cycle_steps", 1))
+        if terminated or truncated:
+            return obs, total, steps, info
+
+
+def test_a_stride_policy_acts_the_same_per_platform_step_and_per_control_step():
+    """The env reads only the stride, on a platform step's first control step: the wrapped and
+    the plain env follow the same trajectory, with the same summed reward."""
+    obs_w, return_w, steps, info_w = _run(GainsPerCycle(gym.make(ENV_ID, **STRIDES)), seed=3)
+    obs_p, return_p, _, info_p = _run(gym.make(ENV_ID, **STRIDES), seed=3)
+    np.testing.assert_array_equal(obs_w, obs_p)
+    assert return_w == pytest.approx(return_p, rel=1e-12)
+    assert info_w["distance"] == info_p["distance"] > 0.3
+    # 5.1 s a platform step at 10 Hz: 51 control steps, the last one cut by the time limit.
+    assert steps[:-1] == [51] * (len(steps) - 1) and sum(steps) == 400
+
+
+def test_the_stride_is_read_on_a_platform_steps_first_control_step_only():
+    env = gym.make(ENV_ID, **STRIDES).unwrapped
+    env.reset(seed=0)
+    flag = env.observation_layout.slices["stride_decision"].start + 1
+    short = np.zeros(env.action_space.shape, dtype=np.float32)
+    short[STRIDE_ACTION] = -0.5
+    assert env.stride_due
+    obs, *_ = env.step(short)
+    assert not env.stride_due and obs[flag] == 0.0
+    for _ in range(50):
+        obs, *_ = env.step(np.zeros_like(short))  # a full stride, ignored: not a decision
+    assert env.stride_due and obs[flag] == 1.0
+    assert env.online_gait.steps[-1].stride == pytest.approx(0.08)
+
+
+def test_residuals_and_other_envs_are_refused_by_name():
+    residuals = "residual_limb_m=0 and residual_leg_m=0.*got 0.05 and 0.16"
+    with pytest.raises(ValueError, match=residuals):
+        GainsPerCycle(gym.make(ENV_ID, task_distribution="train", stride_action=True))
+    with pytest.raises(ValueError, match="stride_action=True and the residuals off.*DitchCrossing"):
+        GainsPerCycle(gym.make(ENV_ID))
+
+
+def test_the_config_builds_one_learner_step_per_platform_step():
+    from agents.pipeline.envs import EnvSpec
+    from agents.run_files.train_config import load_train_config
+
+    config = load_train_config(REPO / "configs" / "ditch_crossing_v1_ppo_stride_decisions.yaml")
+    section = config.env
+    spec = EnvSpec(
+        section.id, dict(section.kwargs), gym_packages=["hexapod_envs"], decision=section.decision
+    )
+    env = spec.make()
+    env.reset(seed=0)
+    *_, info = env.step(np.zeros(env.action_space.shape, dtype=np.float32))
+    assert info["cycle_steps"] == 51
