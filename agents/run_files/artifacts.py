@@ -180,16 +180,20 @@ def checkpoint_note(model_dir: Path) -> str:
 
 def learner_step_unit(config: dict | None) -> str:
     """What a run's learner steps count, from its resolved config: "env steps", "gait cycles"
-    (``env.decision: gait_cycle``), "episodes" (``env.decision: episode``) or "tipping events"
-    (a recovery ``knobs`` run, one step per episode at the controller's tipping judgment; a
-    planner ``knobs`` run counts episodes)."""
+    (``env.decision: gait_cycle``; "platform steps" on the ditch crossing's stride action),
+    "episodes" (``env.decision: episode``) or "tipping events" (a recovery ``knobs`` run, one
+    step per episode at the controller's tipping judgment; a planner ``knobs`` run counts
+    episodes)."""
     config = config or {}
     if config.get("knobs") is not None:
         from ..knobs import settings_from_config
 
         planner = settings_from_config(config["knobs"]).controller == "planner"
         return "episodes" if planner else "tipping events"
-    decision = (config.get("env") or {}).get("decision")
+    env = config.get("env") or {}
+    decision = env.get("decision")
+    if decision == "gait_cycle" and (env.get("kwargs") or {}).get("stride_action"):
+        return "platform steps"
     return {"gait_cycle": "gait cycles", "episode": "episodes"}.get(decision, "env steps")
 
 

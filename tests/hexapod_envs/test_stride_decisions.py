@@ -83,6 +83,8 @@ def test_residuals_and_other_envs_are_refused_by_name():
 
 def test_the_config_builds_one_learner_step_per_platform_step():
     from agents.pipeline.envs import EnvSpec
+    from agents.run_files.artifacts import learner_step_unit
+    from agents.run_files.configtools import to_mapping
     from agents.run_files.train_config import load_train_config
 
     config = load_train_config(REPO / "configs" / "ditch_crossing_v1_ppo_stride_decisions.yaml")
@@ -94,3 +96,4 @@ def test_the_config_builds_one_learner_step_per_platform_step():
     env.reset(seed=0)
     *_, info = env.step(np.zeros(env.action_space.shape, dtype=np.float32))
     assert info["cycle_steps"] == 51
+    assert learner_step_unit(to_mapping(config)) == "platform steps"
