@@ -51,12 +51,13 @@ from . import info_keys as keys
 
 
 class GainsPerCycle(gym.Wrapper):
-    """One step per gait cycle of a "gains"-mode env (see the module docstring).
+    """One step per gait cycle of a "gains"-mode env, or per platform step of the ditch
+    crossing's stride action with the residuals off (see the module docstring).
 
     ``step`` returns the last control step's observation, termination, truncation and info, with
     the reward summed over the cycle's control steps; ``info["cycle_steps"]`` is how many control
-    steps it ran (a cycle's, with the ground-search waits at its start; fewer when the episode
-    ended inside the cycle).
+    steps it ran (a cycle's, with the ground-search waits at its start on the irregular terrain;
+    fewer when the episode ended inside the cycle).
 
     With ``baseline_action`` (an action of the wrapped env) the reward is that sum minus the sum
     over as many control steps (fewer if it ends first) of a copy of the wrapped env taken before
@@ -260,24 +261,22 @@ def _decision_due(env: gym.Env, wrapper: str) -> Callable[[], bool]:
                 f"{base.settings.residual_limb_m} and {base.settings.residual_leg_m})"
             )
         return lambda: base.stride_due
-    if not hasattr(type(base), "gains_due"):
-        raise ValueError(
-            f"{wrapper} needs an env that reads its action once per gait cycle: "
-            "HexapodIrregularTerrain-* with action_mode='gains', or HexapodDitchCrossing-* with "
-            f"stride_action=True and the residuals off; got {type(base).__name__}"
-        )
-    _require_gains_mode(env, wrapper)
+    envs = (
+        "HexapodIrregularTerrain-* with action_mode='gains', or HexapodDitchCrossing-* with "
+        "stride_action=True and the residuals off"
+    )
+    _require_gains_mode(env, wrapper, envs)
     return lambda: base.gains_due
 
 
-def _require_gains_mode(env: gym.Env, wrapper: str) -> None:
-    """ValueError unless `env` is in a gains action mode (which reads its action per cycle)."""
+def _require_gains_mode(
+    env: gym.Env, wrapper: str, envs: str = "a gains action mode (HexapodIrregularTerrain-*)"
+) -> None:
+    """ValueError unless `env` is in a gains action mode (which reads its action per cycle);
+    `envs` names the envs the wrapper takes."""
     base = env.unwrapped
     if not hasattr(type(base), "gains_due"):
-        raise ValueError(
-            f"{wrapper} needs an env with a gains action mode (HexapodIrregularTerrain-*), "
-            f"got {type(base).__name__}"
-        )
+        raise ValueError(f"{wrapper} needs an env with {envs}, got {type(base).__name__}")
     if getattr(base, "action_mode", None) != "gains":
         raise ValueError(
             f"{wrapper} needs action_mode='gains', got {base.action_mode!r}; the other "

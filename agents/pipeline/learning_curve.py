@@ -31,7 +31,8 @@ class LearningCurve:
     successes: np.ndarray | None  # (n, episodes) 0/1; None if the env reports no is_success
     unit: str = "env steps"
     """What ``timesteps`` counts: the learner's steps, "env steps", "gait cycles" for a run
-    whose learner acts once per gait cycle (``env.decision: gait_cycle`` in its config),
+    whose learner acts once per gait cycle (``env.decision: gait_cycle`` in its config;
+    "platform steps" on the ditch crossing's stride action),
     "episodes" for one that acts once per episode (``env.decision: episode``) or
     "tipping events" for a recovery knobs run (one learner step per episode, at the event,
     `agents.knobs`); a planner knobs run counts "episodes" (`agents.plan_knobs`)."""

@@ -75,8 +75,8 @@ class EnvConfig:
     (`agents.pipeline.envs.ExcludeRewardTerms`); the evaluation reports the env's own return."""
     decision: Literal["step", "gait_cycle", "episode"] = "step"
     """When the learner acts: every env step, once per gait cycle (`gait_cycle`: the
-    irregular terrain's "gains" mode, or once per platform step the ditch crossing's stride
-    action with the residuals off, through `hexapod_envs.wrappers.GainsPerCycle`; training
+    irregular terrain's "gains" mode, or, on the ditch crossing's stride action with the
+    residuals off, once per platform step, through `hexapod_envs.wrappers.GainsPerCycle`; training
     steps then count gait cycles (platform steps), and the training episodes' TensorBoard
     statistics see each cycle's last step only; evaluations still run every env step, see the
     wrapper), or once per episode (`episode`: the gains mode with one setting held over the

@@ -17,18 +17,21 @@ STRIDES = {
     "stride_action": True,
     "residual_limb_m": 0.0,
     "residual_leg_m": 0.0,
-    "max_episode_steps": 400,
+    "max_episode_steps": 500,
 }
 
 
 def _rule_with_noise(env: gym.Env):
-    """The clear-stride rule, its nine ignored residual values random: a policy whose stride
-    depends on the observation and whose other values differ at every step."""
+    """The clear-stride rule where the observation says the stride is read, random values
+    everywhere else (the nine residual values always, the stride value on the other control
+    steps): the plain env must ignore all of those to follow the wrapped env."""
     rule, rng = ClearStridePolicy(env), np.random.default_rng(0)
+    flag = env.unwrapped.observation_layout.slices["stride_decision"].start + 1
 
     def act(obs: np.ndarray) -> np.ndarray:
-        action = np.asarray(rule(obs), dtype=np.float32).copy()
-        action[:STRIDE_ACTION] = rng.uniform(-1, 1, STRIDE_ACTION)
+        action = rng.uniform(-1, 1, STRIDE_ACTION + 1).astype(np.float32)
+        if obs[flag] == 1.0:
+            action[STRIDE_ACTION] = rule(obs)[STRIDE_ACTION]
         return action
 
     return act
@@ -48,14 +51,20 @@ def _run(env: gym.Env, seed: int) -> tuple[np.ndarray, float, list[int], dict]:
 
 def test_a_stride_policy_acts_the_same_per_platform_step_and_per_control_step():
     """The env reads only the stride, on a platform step's first control step: the wrapped and
-    the plain env follow the same trajectory, with the same summed reward."""
-    obs_w, return_w, steps, info_w = _run(GainsPerCycle(gym.make(ENV_ID, **STRIDES)), seed=3)
-    obs_p, return_p, _, info_p = _run(gym.make(ENV_ID, **STRIDES), seed=3)
+    the plain env follow the same trajectory, with the same summed reward. On training task 2
+    the rule shortens strides near the ditch within the first 10 platform steps."""
+    wrapped, plain = GainsPerCycle(gym.make(ENV_ID, **STRIDES)), gym.make(ENV_ID, **STRIDES)
+    obs_w, return_w, steps, info_w = _run(wrapped, seed=2)
+    obs_p, return_p, _, info_p = _run(plain, seed=2)
     np.testing.assert_array_equal(obs_w, obs_p)
     assert return_w == pytest.approx(return_p, rel=1e-12)
     assert info_w["distance"] == info_p["distance"] > 0.3
+    strides = [
+        [step.stride for step in env.unwrapped.online_gait.steps] for env in (wrapped, plain)
+    ]
+    assert strides[0] == strides[1] and min(strides[0]) < 0.15
     # 5.1 s a platform step at 10 Hz: 51 control steps, the last one cut by the time limit.
-    assert steps[:-1] == [51] * (len(steps) - 1) and sum(steps) == 400
+    assert len(steps) == 10 and steps[:-1] == [51] * 9 and sum(steps) == 500
 
 
 def test_the_stride_is_read_on_a_platform_steps_first_control_step_only():
