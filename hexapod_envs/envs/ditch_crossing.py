@@ -89,6 +89,12 @@ Crossing the default ditch takes 20 steps, 102 s (1017 control steps); the time 
 | reward_success | on crossing: (horizon_steps - steps taken) x the largest reward of a step |
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
 | reward_effort | -effort_weight x min(sum of |actuator power| / (robot weight x 0.1 m/s), 10) |
+| reward_foothold | -foothold_weight x sum over the feet landing now of max(1 - gap / band, 0) |
+
+The foothold term's gap is a landing foot's centre's x distance to the nearer ditch edge, band
+the foot radius plus the planner's edge clearance (the clear-stride rule's margin); a foot
+lands on the step its contact switch turns on. It is off by default and, unlike the others, not
+in the alive term's bound.
 
 Every term is bounded: an episode that ends by tipping over returns less than staying up, and
 one that stands still on the near side until the time limit returns less than crossing.
@@ -211,6 +217,10 @@ class DitchCrossingRewardScales(RewardScales):
     stability_weight: float = number(0.05)
     tip_over_penalty: float = number(100.0)
     effort_weight: float = number(0.02)
+    foothold_weight: float = number(0.0)
+    """Per foot that lands near a ditch edge (term ``foothold``); 0 in v0 and v1, whose
+    returns it leaves as they are. A shaping term for learners of the stride action: it pays
+    on the step a foot lands, where a tip-over at the edge may come only strides later."""
 
 
 REFERENCE_PLANS = ("course", "flat")
@@ -322,6 +332,7 @@ class DitchCrossingEnv(HexapodEnv):
             "stability": r.stability_weight,
             "tip_over": r.tip_over_penalty,
             "effort": r.effort_weight,
+            "foothold": r.foothold_weight,
         }
         self.horizon_steps = int(s.horizon_steps)
         self.task_ranges = {"train": s.train_ranges, "test": s.test_ranges}
@@ -565,6 +576,9 @@ class DitchCrossingEnv(HexapodEnv):
 
     def _start_episode(self) -> None:
         self._residual = np.zeros(len(COMMAND_NAMES))
+        self._was_loaded = np.ones(len(LEG_NAMES), dtype=bool)
+        """Each foot's contact switch on the previous step (the settled robot stands on all
+        six): a foot loaded now and not then has landed (the ``foothold`` term)."""
         self._min_static_margin = np.inf
         if self.stride_action:
             ditch = self.ditch if self.terrain == "ditch" else None
@@ -747,7 +761,21 @@ class DitchCrossingEnv(HexapodEnv):
             "success": remaining * self.step_reward_bound() if self._new_success else 0.0,
             "tip_over": -w["tip_over"] if tipped else 0.0,
             "effort": -w["effort"] * min(self._power / self._reference_power, EFFORT_CAP),
+            "foothold": -w["foothold"] * self._landing_near_edges() if w["foothold"] else 0.0,
         }
+
+    def _landing_near_edges(self) -> float:
+        """The feet that landed this step, each counted by how far inside the planner's band
+        (foot radius + edge clearance) of the nearer ditch edge its centre is: 1 on the edge,
+        0 at the band or beyond, linear between (0 on flat ground)."""
+        landed = self._loaded & ~self._was_loaded
+        self._was_loaded = self._loaded.copy()
+        if self.terrain != "ditch" or not landed.any():
+            return 0.0
+        x = self.data.xpos[self._foot_body[landed], 0]
+        gap = np.minimum(np.abs(x - self.ditch.start_x), np.abs(x - self.ditch.end_x))
+        band = self.params.foot_radius + self.gait_settings.edge_clearance
+        return float(np.clip(1.0 - gap / band, 0.0, None).sum())
 
     def _extra_info(self, unstable: bool) -> dict:
         step, phase = self.schedule.phase(self._step_count)
