@@ -55,7 +55,8 @@ class GainsPerCycle(gym.Wrapper):
     crossing's stride action with the residuals off (see the module docstring).
 
     ``step`` returns the last control step's observation, termination, truncation and info, with
-    the reward summed over the cycle's control steps; ``info["cycle_steps"]`` is how many control
+    the reward and the info's reward terms (``reward_<term>``) summed over the cycle's control
+    steps; ``info["cycle_steps"]`` is how many control
     steps it ran (a cycle's, with the ground-search waits at its start on the irregular terrain;
     fewer when the episode ended inside the cycle).
 
@@ -93,14 +94,18 @@ class GainsPerCycle(gym.Wrapper):
 
 def _play(env: gym.Env, action: Any, done: Callable[[int], bool]) -> tuple[tuple, float, int]:
     """Step ``env`` with ``action`` until the episode ends or ``done(steps so far)``; returns
-    the last step's result, the summed reward and the number of steps."""
-    total, steps = 0.0, 0
+    the last step's result, its info's reward terms (``reward_<term>``) summed over the steps,
+    the summed reward and the number of steps."""
+    total, steps, terms = 0.0, 0, {}
     while True:
-        result = env.step(action)
-        total += float(result[1])
+        obs, reward, terminated, truncated, info = env.step(action)
+        total += float(reward)
         steps += 1
-        if result[2] or result[3] or done(steps):
-            return result, total, steps
+        for key, value in info.items():
+            if key.startswith(keys.REWARD_PREFIX):
+                terms[key] = terms.get(key, 0.0) + float(value)
+        if terminated or truncated or done(steps):
+            return (obs, reward, terminated, truncated, {**info, **terms}), total, steps
 
 
 EpisodeReward = Literal["success", "stable_success", "margin_success", "return"]

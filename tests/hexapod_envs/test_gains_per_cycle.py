@@ -44,6 +44,27 @@ def test_a_policy_acts_the_same_per_cycle_and_per_step():
     assert len(cycle_steps) == pytest.approx(200 / ticks, abs=1)
 
 
+def test_a_cycles_info_sums_the_reward_terms_of_its_control_steps():
+    """The reward terms in a cycle's info are the sums over its control steps (training logs
+    each episode's terms from them), not the last step's values."""
+
+    def term_totals(env: gym.Env) -> dict[str, float]:
+        obs, _ = env.reset(seed=4)
+        totals: dict[str, float] = {}
+        while True:
+            obs, _, terminated, truncated, info = env.step(_policy(obs))
+            for key in (k for k in info if k.startswith("reward_")):
+                totals[key] = totals.get(key, 0.0) + info[key]
+            if terminated or truncated:
+                return totals
+
+    per_cycle = term_totals(GainsPerCycle(gym.make(ENV_ID, **GAINS)))
+    per_step = term_totals(gym.make(ENV_ID, **GAINS))
+    assert per_cycle.keys() == per_step.keys() and len(per_step) >= 3
+    for key, total in per_step.items():
+        assert per_cycle[key] == pytest.approx(total, rel=1e-9, abs=1e-9), key
+
+
 def test_the_gains_read_at_a_cycle_start_are_the_decision():
     """Changing the action between cycle starts changes nothing; at a cycle start it does."""
     env = gym.make(ENV_ID, **GAINS).unwrapped
