@@ -56,9 +56,10 @@ class GainsPerCycle(gym.Wrapper):
 
     ``step`` returns the last control step's observation, termination, truncation and info, with
     the reward and the info's reward terms (``reward_<term>``) summed over the cycle's control
-    steps; ``info["cycle_steps"]`` is how many control
-    steps it ran (a cycle's, with the ground-search waits at its start on the irregular terrain;
-    fewer when the episode ended inside the cycle).
+    steps (with ``baseline_action`` below, the terms stay the chosen action's sums);
+    ``info["cycle_steps"]`` is how many control steps it ran (a cycle's, with the ground-search
+    waits at its start on the irregular terrain; fewer when the episode ended inside the
+    cycle).
 
     With ``baseline_action`` (an action of the wrapped env) the reward is that sum minus the sum
     over as many control steps (fewer if it ends first) of a copy of the wrapped env taken before
@@ -94,8 +95,8 @@ class GainsPerCycle(gym.Wrapper):
 
 def _play(env: gym.Env, action: Any, done: Callable[[int], bool]) -> tuple[tuple, float, int]:
     """Step ``env`` with ``action`` until the episode ends or ``done(steps so far)``; returns
-    the last step's result, its info's reward terms (``reward_<term>``) summed over the steps,
-    the summed reward and the number of steps."""
+    the last step's result (its info's reward terms, ``reward_<term>``, replaced by their sums
+    over the steps), the summed reward and the number of steps."""
     total, steps, terms = 0.0, 0, {}
     while True:
         obs, reward, terminated, truncated, info = env.step(action)
@@ -216,10 +217,11 @@ def _env_name(env: gym.Env) -> str:
 
 class GainsPerEpisode(gym.Wrapper):
     """One step per episode of a "gains"-mode env (see the module docstring): ``step(action)``
-    holds `action` until the episode ends and returns its last observation, info and
-    ``terminated=True`` (the episode is the decision's whole consequence: nothing to bootstrap),
-    with ``info["episode_steps"]`` the control steps it ran and ``info["episode_truncated"]``
-    whether the env's time limit ended it.
+    holds `action` until the episode ends and returns its last observation, info (its reward
+    terms, ``reward_<term>``, summed over the episode) and ``terminated=True`` (the episode is
+    the decision's whole consequence: nothing to bootstrap), with ``info["episode_steps"]`` the
+    control steps it ran and ``info["episode_truncated"]`` whether the env's time limit ended
+    it.
 
     The reward is `episode_reward` of kind `reward` ("success", "stable_success" or
     "return")."""

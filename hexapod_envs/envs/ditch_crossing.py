@@ -93,11 +93,13 @@ Crossing the default ditch takes 20 steps, 102 s (1017 control steps); the time 
 
 The foothold term's gap is a landing foot's centre's x distance to the nearer ditch edge, band
 the foot radius plus the planner's edge clearance (the clear-stride rule's margin); a foot
-lands on the step its contact switch turns on. It is off by default and, unlike the others, not
-in the alive term's bound.
+lands on every step its contact switch turns on, so a foot that rocks on an edge (or a stance
+foot whose load flickers there) pays again. It is off by default and, like the success and
+tip-over terms, not in the alive term's bound.
 
-Every term is bounded: an episode that ends by tipping over returns less than staying up, and
-one that stands still on the near side until the time limit returns less than crossing.
+Every term is bounded. With the foothold term off (the default), an episode that ends by
+tipping over returns less than staying up, and one that stands still on the near side until the
+time limit returns less than crossing.
 
 ## Episode End
 The episode ends (terminated) when the robot tips over (body tilt > tip_over_angle_deg) or
@@ -577,8 +579,8 @@ class DitchCrossingEnv(HexapodEnv):
     def _start_episode(self) -> None:
         self._residual = np.zeros(len(COMMAND_NAMES))
         self._was_loaded = np.ones(len(LEG_NAMES), dtype=bool)
-        """Each foot's contact switch on the previous step (the settled robot stands on all
-        six): a foot loaded now and not then has landed (the ``foothold`` term)."""
+        """With a ``foothold`` weight: each foot's contact switch on the previous step (the
+        settled robot stands on all six); a foot loaded now and not then has landed."""
         self._min_static_margin = np.inf
         if self.stride_action:
             ditch = self.ditch if self.terrain == "ditch" else None
