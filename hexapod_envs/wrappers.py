@@ -81,8 +81,9 @@ class GainsPerCycle(gym.Wrapper):
 
     def step(self, action: Any) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         twin = None if self.baseline_action is None else copy.deepcopy(self.env)
+        base = self.env.unwrapped
         (obs, _, terminated, truncated, info), total, steps = _play(
-            self.env, action, lambda _: self._due()
+            self.env, action, lambda _: getattr(base, self._due)
         )
         info["cycle_steps"] = steps
         if twin is None:
@@ -253,11 +254,13 @@ def _has_time_limit(env: gym.Env) -> bool:
     return False
 
 
-def _decision_due(env: gym.Env, wrapper: str) -> Callable[[], bool]:
-    """Whether `env`'s next step reads its action, for an env that reads it once per gait cycle
-    and ignores it in between: ATHENA's "gains" mode (`gains_due`), or the ditch crossing's
-    stride action with the residuals off (`stride_due`: once per platform step). ValueError
-    for any other env or mode, naming what would do."""
+def _decision_due(env: gym.Env, wrapper: str) -> str:
+    """The name of the property of `env.unwrapped` that says whether its next step reads its
+    action, for an env that reads it once per gait cycle and ignores it in between: ATHENA's
+    "gains" mode (``gains_due``), or the ditch crossing's stride action with the residuals off
+    (``stride_due``: once per platform step). A name rather than a bound check, so that a deep
+    copy of the wrapper asks its own env. ValueError for any other env or mode, naming what
+    would do."""
     base = env.unwrapped
     if getattr(base, "stride_action", False):
         if np.any(base.residual_gain):
@@ -267,13 +270,13 @@ def _decision_due(env: gym.Env, wrapper: str) -> Callable[[], bool]:
                 "once per platform step would act differently on the plain env (got "
                 f"{base.settings.residual_limb_m} and {base.settings.residual_leg_m})"
             )
-        return lambda: base.stride_due
+        return "stride_due"
     envs = (
         "HexapodIrregularTerrain-* with action_mode='gains', or HexapodDitchCrossing-* with "
         "stride_action=True and the residuals off"
     )
     _require_gains_mode(env, wrapper, envs)
-    return lambda: base.gains_due
+    return "gains_due"
 
 
 def _require_gains_mode(

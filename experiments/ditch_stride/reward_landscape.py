@@ -19,7 +19,6 @@ from __future__ import annotations
 import argparse
 import copy
 
-import gymnasium as gym
 import numpy as np
 
 from agents.pipeline.training import env_spec
@@ -32,19 +31,15 @@ GRID = (0.0, -0.1, -0.2, -0.3, -0.4, -0.5, -0.6, -0.7)
 """Stride values tried at each decision: the full stride (160 mm) down to 30 % of it."""
 
 
-def platform_step_reward(env: gym.Env, stride_value: float) -> float:
+def platform_step_reward(env: GainsPerCycle, stride_value: float) -> float:
     """The learner's reward of the next platform step with `stride_value`, played on a copy of
-    `env` (the env below `GainsPerCycle`, at a decision); `env` itself does not move."""
+    `env` (at a decision); `env` itself does not move."""
     twin = copy.deepcopy(env)
     action = np.zeros(twin.action_space.shape, dtype=twin.action_space.dtype)
     action[STRIDE_ACTION] = stride_value
-    total = 0.0
-    while True:
-        _, reward, terminated, truncated, _ = twin.step(action)
-        total += float(reward)
-        if terminated or truncated or twin.unwrapped.stride_due:
-            twin.close()
-            return total
+    reward = twin.step(action)[1]
+    twin.close()
+    return float(reward)
 
 
 def landscape(config: str, seed: int) -> list[tuple[int, float, float, list[float]]]:
@@ -59,7 +54,7 @@ def landscape(config: str, seed: int) -> list[tuple[int, float, float, list[floa
     obs, _ = env.reset(seed=seed)
     rows = []
     while True:
-        grid = [platform_step_reward(env.env, value) for value in GRID]
+        grid = [platform_step_reward(env, value) for value in GRID]
         action = rule(obs)
         obs, reward, terminated, truncated, _ = env.step(action)
         rows.append((len(rows), float(action[STRIDE_ACTION]), float(reward), grid))

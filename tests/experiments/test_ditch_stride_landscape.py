@@ -16,7 +16,7 @@ def test_a_replayed_stride_earns_what_the_learner_is_paid_and_leaves_the_env_alo
     env = spec.make()
     env.reset(seed=101)
     before = env.unwrapped.data.qpos.copy()
-    grid = [platform_step_reward(env.env, value) for value in GRID]
+    grid = [platform_step_reward(env, value) for value in GRID]
     np.testing.assert_array_equal(env.unwrapped.data.qpos, before)
     assert env.unwrapped.stride_due
     # Far from the ditch the longer stride walks farther in the same time: it earns more.

@@ -1,6 +1,8 @@
 """One learner step per platform step: the ditch crossing's stride action with the residuals off,
 through `GainsPerCycle` (``env.decision: gait_cycle``)."""
 
+import copy
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -106,3 +108,15 @@ def test_the_config_builds_one_learner_step_per_platform_step():
     *_, info = env.step(np.zeros(env.action_space.shape, dtype=np.float32))
     assert info["cycle_steps"] == 51
     assert learner_step_unit(to_mapping(config)) == "platform steps"
+
+
+def test_a_deep_copy_of_the_wrapper_steps_its_own_env_to_its_own_next_decision():
+    """A copy (e.g. for a look-ahead) plays one whole platform step of its own env; the original
+    does not move."""
+    env = GainsPerCycle(gym.make(ENV_ID, **STRIDES))
+    env.reset(seed=1)
+    before = env.unwrapped.data.qpos.copy()
+    twin = copy.deepcopy(env)
+    _, _, _, _, info = twin.step(np.zeros(STRIDE_ACTION + 1, dtype=np.float32))
+    assert info["cycle_steps"] > 40 and twin.unwrapped.stride_due
+    np.testing.assert_array_equal(env.unwrapped.data.qpos, before)
