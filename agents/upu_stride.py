@@ -45,7 +45,7 @@ class ClearStridePolicy:
         self.env = base
         self.read = ObservationReader(base.observation_structure)
         params = base.params
-        self.band = params.foot_radius + base.gait_settings.edge_clearance
+        self.band = base.edge_band
         """How far from an edge a foot must land [m]."""
         self.reach = params.leg_extend
         """The deepest ditch a foot can stand in [m]."""

@@ -396,8 +396,7 @@ class DitchCrossingEnv(HexapodEnv):
     # --- geometry, model, plan -----------------------------------------------------------------
     def _check_geometry(self, ditch_start_x: float, ditch_width: float, ditch_depth: float):
         Ditch(ditch_start_x, ditch_width, ditch_depth)  # finite, width and depth > 0
-        # The planner needs every foot a foot radius plus the edge clearance from the ditch.
-        band = self.params.foot_radius + self.gait_settings.edge_clearance
+        band = self.edge_band  # the planner needs every foot this far from the ditch
         front = self.start_x + self.params.leg_circle_radius
         if ditch_start_x - band < front:
             raise ValueError(
@@ -405,6 +404,13 @@ class DitchCrossingEnv(HexapodEnv):
                 f"the robot: its front feet stand at x = {front} m, so the ditch must start at "
                 f"x >= {front + band:.3f} m"
             )
+
+    @property
+    def edge_band(self) -> float:
+        """How far from a ditch edge a foot's centre must land [m]: the foot radius plus the
+        planner's edge clearance (the planner's, the clear-stride rule's and the foothold
+        term's margin)."""
+        return self.params.foot_radius + self.gait_settings.edge_clearance
 
     @property
     def finish_x(self) -> float:
@@ -767,17 +773,16 @@ class DitchCrossingEnv(HexapodEnv):
         }
 
     def _landing_near_edges(self) -> float:
-        """The feet that landed this step, each counted by how far inside the planner's band
-        (foot radius + edge clearance) of the nearer ditch edge its centre is: 1 on the edge,
-        0 at the band or beyond, linear between (0 on flat ground)."""
+        """The feet that landed this step, each counted by how far inside `edge_band` of the
+        nearer ditch edge its centre is: 1 on the edge, 0 at the band or beyond, linear between
+        (0 on flat ground)."""
         landed = self._loaded & ~self._was_loaded
         self._was_loaded = self._loaded.copy()
         if self.terrain != "ditch" or not landed.any():
             return 0.0
         x = self.data.xpos[self._foot_body[landed], 0]
         gap = np.minimum(np.abs(x - self.ditch.start_x), np.abs(x - self.ditch.end_x))
-        band = self.params.foot_radius + self.gait_settings.edge_clearance
-        return float(np.clip(1.0 - gap / band, 0.0, None).sum())
+        return float(np.clip(1.0 - gap / self.edge_band, 0.0, None).sum())
 
     def _extra_info(self, unstable: bool) -> dict:
         step, phase = self.schedule.phase(self._step_count)
