@@ -21,6 +21,7 @@ import gymnasium as gym
 import numpy as np
 
 from hexapod_envs.envs.ditch_crossing import STRIDE_ACTION
+from hexapod_envs.robots.upu.gait_plan import edge_clearance
 from hexapod_envs.robots.upu.params import PLATFORM_LEGS
 
 from .policy import ObservationReader
@@ -78,12 +79,8 @@ class ClearStridePolicy:
         grid = gait.min_stride
         strides = np.arange(max(room, grid), grid - 1e-9, -grid)
         feet = strides[:, None] + feet0[None, :]  # foot x in the frame of the edges
-        gap = np.minimum(np.abs(feet - near), np.abs(feet - far))
-        if depth <= self.reach:
-            clear = gap.min(axis=1)
-        else:  # too deep to stand in: a foot may not land in the ditch at all
-            inside = (feet > near - self.band) & (feet < far + self.band)
-            clear = np.where(inside, -gap, gap).min(axis=1)
+        # Too deep to stand in (depth > reach): a foot may not land in the ditch at all.
+        clear = edge_clearance(feet, near, far, self.band, depth <= self.reach).min(axis=1)
         ok = np.flatnonzero(clear >= self.band)
         best = ok[0] if ok.size else int(np.argmax(clear))
         return stride_value(float(strides[best]), gait.max_stride)

@@ -90,16 +90,21 @@ Crossing the default ditch takes 20 steps, 102 s (1017 control steps); the time 
 | reward_tip_over | -tip_over_penalty on the step the robot tips over (episode ends) |
 | reward_effort | -effort_weight x min(sum of |actuator power| / (robot weight x 0.1 m/s), 10) |
 | reward_foothold | -foothold_weight x sum over the feet landing now of max(1 - gap / band, 0) |
+| reward_landing | -landing_weight x sum over the moving feet of clip(1 - clear / band, 0, 1) |
 
 The foothold term's gap is a landing foot's centre's x distance to the nearer ditch edge, band
 the foot radius plus the planner's edge clearance (the clear-stride rule's margin); a foot
 lands on every step its contact switch turns on, so a foot that rocks on an edge (or a stance
-foot whose load flickers there) pays again. It is off by default and, like the success and
+foot whose load flickers there) pays again. The landing term (``stride_action`` only) charges
+the stride a step decides, on the step it is decided: clear is each moving foot's planned
+landing x's clearance from the edges (`gait_plan.edge_clearance`: the distance to the nearer
+edge, negative over a ditch too deep to stand in), where the nominal gait puts it; the planner
+and the clear-stride rule want clear >= band. Both are off by default and, like the success and
 tip-over terms, not in the alive term's bound.
 
-Every term is bounded. With the foothold term off (the default), an episode that ends by
-tipping over returns less than staying up, and one that stands still on the near side until the
-time limit returns less than crossing.
+Every term is bounded. With the foothold and landing terms off (the default), an episode that
+ends by tipping over returns less than staying up, and one that stands still on the near side
+until the time limit returns less than crossing.
 
 ## Episode End
 The episode ends (terminated) when the robot tips over (body tilt > tip_over_angle_deg) or
@@ -137,6 +142,8 @@ from ..robots.upu.gait_plan import (
     Ditch,
     GaitPlan,
     GaitSettings,
+    PlatformStep,
+    edge_clearance,
     plan_ditch_crossing,
     plan_flat_past,
 )
@@ -149,7 +156,7 @@ from ..robots.upu.gait_schedule import (
 )
 from ..robots.upu.model import add_upu
 from ..robots.upu.online_gait import OnlineGait
-from ..robots.upu.params import LEG_NAMES, UpuParams
+from ..robots.upu.params import LEG_NAMES, PLATFORM_LEGS, UpuParams
 from ..stability import _compiled as _stability
 from ..terrain.ditch import add_ditch
 from ..terrain.flat import add_flat
@@ -223,6 +230,10 @@ class DitchCrossingRewardScales(RewardScales):
     """Per foot that lands near a ditch edge (term ``foothold``); 0 in v0 and v1, whose
     returns it leaves as they are. A shaping term for learners of the stride action: it pays
     on the step a foot lands, where a tip-over at the edge may come only strides later."""
+    landing_weight: float = number(0.0)
+    """Per moving foot whose planned landing is near a ditch edge (term ``landing``, with
+    ``stride_action``); 0 in v0 and v1. A shaping term for learners of the stride action: it
+    charges a stride on the step that decides it, from the nominal gait (no contact noise)."""
 
 
 REFERENCE_PLANS = ("course", "flat")
@@ -335,6 +346,7 @@ class DitchCrossingEnv(HexapodEnv):
             "tip_over": r.tip_over_penalty,
             "effort": r.effort_weight,
             "foothold": r.foothold_weight,
+            "landing": r.landing_weight,
         }
         self.horizon_steps = int(s.horizon_steps)
         self.task_ranges = {"train": s.train_ranges, "test": s.test_ranges}
@@ -588,6 +600,8 @@ class DitchCrossingEnv(HexapodEnv):
         """With a ``foothold`` weight: each foot's contact switch on the previous step (the
         settled robot stands on all six); a foot loaded now and not then has landed."""
         self._min_static_margin = np.inf
+        self._landing_cost = 0.0
+        """With `stride_action`: the landing term's count for the stride decided this step."""
         if self.stride_action:
             ditch = self.ditch if self.terrain == "ditch" else None
             self.online_gait = OnlineGait(self.params, self.gait_settings, self.start_x, ditch)
@@ -621,7 +635,8 @@ class DitchCrossingEnv(HexapodEnv):
 
     def _apply_action(self, action: np.ndarray) -> None:
         if self.stride_due:
-            self.online_gait.advance(self.online_gait.stride_for(action[STRIDE_ACTION]))
+            step = self.online_gait.advance(self.online_gait.stride_for(action[STRIDE_ACTION]))
+            self._landing_cost = self._planned_landing_near_edges(step)
             self._set_online_schedule()
         if self.action_mode == "joint":
             target = self._center + self._half * action
@@ -770,7 +785,24 @@ class DitchCrossingEnv(HexapodEnv):
             "tip_over": -w["tip_over"] if tipped else 0.0,
             "effort": -w["effort"] * min(self._power / self._reference_power, EFFORT_CAP),
             "foothold": -w["foothold"] * self._landing_near_edges() if w["foothold"] else 0.0,
+            "landing": -w["landing"] * self._take_landing_cost(),
         }
+
+    def _planned_landing_near_edges(self, step: PlatformStep) -> float:
+        """The moving feet of `step` (just decided), each counted by how far inside `edge_band`
+        its planned landing's clearance is: 0 at the band or beyond, 1 on an edge or over a
+        ditch too deep to stand in, linear between (0 on flat ground)."""
+        if self.terrain != "ditch":
+            return 0.0
+        p, d = self.params, self.ditch
+        feet = step.end_x + np.array([p.foot_offset(leg)[0] for leg in PLATFORM_LEGS[step.moving]])
+        clear = edge_clearance(feet, d.start_x, d.end_x, self.edge_band, d.depth <= p.leg_extend)
+        return float(np.clip(1.0 - clear / self.edge_band, 0.0, 1.0).sum())
+
+    def _take_landing_cost(self) -> float:
+        """The landing term's count of this step's decision, once."""
+        cost, self._landing_cost = self._landing_cost, 0.0
+        return cost
 
     def _landing_near_edges(self) -> float:
         """The feet that landed this step, each counted by how far inside `edge_band` of the

@@ -458,6 +458,21 @@ def landing_extensions(
     return landing
 
 
+def edge_clearance(feet_x, near: float, far: float, band: float, can_stand: bool) -> np.ndarray:
+    """Each foot's clearance from a ditch's edges [m], signed: the distance of its centre `feet_x`
+    [m] to the nearer edge (`near`, `far`: the ditch's edges in the same frame [m]); where no
+    foot can stand on the bottom (`can_stand` False: too deep), a foot within `band` [m] of the
+    ditch or over it counts that distance negative. A foothold is clear at `band` or more: the
+    planner's criterion (foot radius + edge clearance), the clear-stride rule's and the ditch
+    env's landing term's."""
+    feet_x = np.asarray(feet_x, dtype=float)
+    gap = np.minimum(np.abs(feet_x - near), np.abs(feet_x - far))
+    if can_stand:
+        return gap
+    inside = (feet_x > near - band) & (feet_x < far + band)
+    return np.where(inside, -gap, gap)
+
+
 def plan_flat_walk(
     params: UpuParams,
     n_cycles: int,

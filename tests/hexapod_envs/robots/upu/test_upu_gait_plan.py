@@ -12,6 +12,7 @@ from hexapod_envs.robots.upu.gait_plan import (
     QuadraticPath,
     case_study_path,
     combined_cog,
+    edge_clearance,
     foot_positions,
     margin_profile,
     max_stride,
@@ -327,3 +328,19 @@ def test_compiled_search_finds_the_plan_a_fifo_search_finds(seed):
         if not (crossing.can_stand or crossing.can_step_over):
             continue
         assert _fewest_steps(crossing) == _fifo_search(crossing), ditch
+
+
+def test_edge_clearance_is_the_distance_to_the_nearer_edge_where_feet_may_stand():
+    # A ditch from 1.0 to 1.3 m: feet before, near the near edge, in the middle, past it.
+    feet = [0.9, 0.99, 1.15, 1.32]
+    clear = edge_clearance(feet, 1.0, 1.3, band=0.04, can_stand=True)
+    np.testing.assert_allclose(clear, [0.1, 0.01, 0.15, 0.02], atol=1e-12)
+
+
+def test_edge_clearance_is_negative_over_a_ditch_too_deep_to_stand_in():
+    feet = [0.9, 0.99, 1.15, 1.32, 1.4]
+    clear = edge_clearance(feet, 1.0, 1.3, band=0.04, can_stand=False)
+    # Within the band before the ditch, over it, or within the band past it: negative.
+    np.testing.assert_allclose(clear, [0.1, -0.01, -0.15, -0.02, 0.1], atol=1e-12)
+    # A foot just at the band counts as clear, as the planner's footholds_ok has it.
+    assert edge_clearance([0.96], 1.0, 1.3, band=0.04, can_stand=False)[0] > 0
