@@ -4,13 +4,18 @@ Some envs read part of the action only now and then: the ditch crossing's stride
 a platform step on the step's first control step and is ignored on the other 50 of 51
 (`hexapod_envs.envs.ditch_crossing`, ``stride_action``). Such an env says which values these
 are and which observation value flags the steps that read them (``env.action_read_flags``:
-action index -> observation index of a 0/1 flag).
+action index -> observation index of a 0/1 flag), and which values it never reads
+(``env.inert_actions``: the ditch's residuals when their range is 0, as when a learner chooses
+the stride alone, one decision per platform step).
 
 PPO's likelihood ratio multiplies the likelihoods of all action values. An ignored value's
 sample changes nothing that follows, so its term carries no signal; but its scores (for the
 mean ``(a - mu) / sigma^2``, for the log standard deviation ``(a - mu)^2 / sigma^2 - 1``),
 weighted by the step's advantage, still enter the gradient: zero-mean noise, from 50 of every
-51 steps for the stride against the one step whose sample matters. Leaving an ignored value
+51 steps for the stride against the one step whose sample matters. An inert value's do on every
+step, and its drift also moves the likelihood ratio that PPO clips: with the nine inert
+residuals in it, a stride learner's updates had 40 % of their samples clipped and an approximate
+KL of 0.06. Leaving an ignored value
 out of the log-likelihood removes that noise and no signal, as invalid-action masking does for
 discrete actions: the policy gradient stays unbiased because the value's sample is independent
 of the rest of the episode. The entropy bonus (``ent_coef``) counts the value on the same steps
@@ -23,7 +28,7 @@ are SB3's ``MlpPolicy`` and the asymmetric `PrivilegedCriticPolicy` with that sc
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import torch
@@ -36,9 +41,10 @@ from .privileged_critic_policy import PrivilegedCriticPolicy
 class ScoresReadActions:
     """Mixin for an SB3 `ActorCriticPolicy` with a diagonal Gaussian action distribution:
     `forward` and `evaluate_actions` count the action values of `action_read_flags` only where
-    their flag in the observation is set. The flag is read from the observation the policy is
-    given, which VecNormalize may have standardised: an affine map that keeps 1 above 0 and 0
-    at or below it, so a flag counts as set when its value is > 0."""
+    their flag in the observation is set, and the `inert_actions` nowhere. The flag is read
+    from the observation the policy is given, which VecNormalize may have standardised: an
+    affine map that keeps 1 above 0 and 0 at or below it, so a flag counts as set when its
+    value is > 0."""
 
     def __init__(self, *args: Any, **kwargs: Any):
         super().__init__(*args, **kwargs)
@@ -48,10 +54,12 @@ class ScoresReadActions:
                 f"distribution (a Box action without gSDE), got {type(self.action_dist).__name__}"
             )
         self.action_read_flags: dict[int, int] = {}
+        self.inert_actions: tuple[int, ...] = ()
 
-    def set_action_read_flags(self, flags: Mapping[int, int]) -> None:
+    def set_action_read_flags(self, flags: Mapping[int, int], inert: Sequence[int] = ()) -> None:
         """Which action values are read only when a flag is set: action index -> observation
-        index (`hexapod_envs.envs.base.HexapodEnv.action_read_flags`)."""
+        index (`hexapod_envs.envs.base.HexapodEnv.action_read_flags`), and which never
+        (`HexapodEnv.inert_actions`)."""
         n_actions = self.action_space.shape[0]
         n_obs = self.observation_space.shape[0]
         for action, flag in flags.items():
@@ -60,7 +68,18 @@ class ScoresReadActions:
                     f"action read flag {action} -> {flag} lies outside the {n_actions} action "
                     f"values or the {n_obs} observation values"
                 )
+        inert = tuple(int(a) for a in inert)
+        if not all(0 <= a < n_actions for a in inert) or len(set(inert)) >= n_actions:
+            raise ValueError(
+                f"inert action values {inert} must be among the {n_actions} action values and "
+                "leave at least one that is read"
+            )
+        if set(inert) & set(flags):
+            raise ValueError(
+                f"action values {sorted(set(inert) & set(flags))} are both flagged and inert"
+            )
         self.action_read_flags = {int(a): int(f) for a, f in flags.items()}
+        self.inert_actions = inert
 
     def _latents(self, obs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
         features = self.extract_features(obs)
@@ -77,6 +96,7 @@ class ScoresReadActions:
         weights = torch.ones_like(like)
         for action, flag in self.action_read_flags.items():
             weights[:, action] = (obs[:, flag] > 0).to(like.dtype)
+        weights[:, list(self.inert_actions)] = 0.0
         return weights
 
     def _scored(

@@ -116,15 +116,16 @@ def _probe(
     accumulators for the training and evaluation callbacks, and the env's resolved settings
     (recorded with the run, see `agents.run_files.env_settings`); with ``reward_exclude``, one
     step checks that the terms exist; with `score_read_actions_only`, that the env has action
-    values it reads only on some steps."""
+    values it reads only on some steps or never."""
     env = spec.make()
     try:
-        if score_read_actions_only and not env.unwrapped.action_read_flags:
+        base = env.unwrapped
+        if score_read_actions_only and not (base.action_read_flags or base.inert_actions):
             raise UserError(
                 f"policy.score_read_actions_only: {spec.id} with env.kwargs {spec.kwargs} "
-                "reads every action value on every step (no action_read_flags), so there is "
-                "nothing to leave out; the option applies to HexapodDitchCrossing-v1 with "
-                "stride_action: true, or set it to false"
+                "reads every action value on every step (no action_read_flags or "
+                "inert_actions), so there is nothing to leave out; the option applies to "
+                "HexapodDitchCrossing-v1 with stride_action: true, or set it to false"
             )
         if spec.reward_exclude:  # a term missing from the info is named at the first step
             env.reset(seed=0)
@@ -222,9 +223,14 @@ def new_model(config: TrainConfig, venv: Any) -> Any:
 
 def _set_action_read_flags(config: TrainConfig, model: Any, venv: Any) -> None:
     """With ``policy.score_read_actions_only``: tell the policy which action values the env
-    reads only on some steps (`_probe` has checked that it has some)."""
+    reads only on some steps and which never (`_probe` has checked that it has some)."""
     if config.policy.score_read_actions_only:
-        model.policy.set_action_read_flags(venv.get_attr("action_read_flags", indices=[0])[0])
+        flags, inert = (venv.get_attr(name, indices=[0])[0] for name in _READS)
+        model.policy.set_action_read_flags(flags, inert)
+
+
+_READS = ("action_read_flags", "inert_actions")
+"""The env's attributes that say which action values it reads only on some steps, or never."""
 
 
 def _masks_overridden(config: TrainConfig) -> bool:

@@ -175,7 +175,8 @@ class PolicyConfig:
     score_read_actions_only: bool = False
     """PPO's likelihood counts an action value only on the steps where the env reads it (an env
     that reads some values only on some steps names them in ``action_read_flags``, such as the
-    ditch's stride value): an ignored value's sample adds noise and no signal to the gradient
+    ditch's stride value, and those it never reads in ``inert_actions``, such as its residuals
+    with a range of 0): an ignored value's sample adds noise and no signal to the gradient
     (`agents.read_actions`). Training only; a trained model acts as any other."""
 
     def __post_init__(self):
@@ -455,14 +456,14 @@ class TrainConfig:
         if self.policy.score_read_actions_only and (
             self.hybrid is not None
             or self.knobs is not None
-            or self.env.decision != "step"
+            or self.env.decision == "episode"
             or self.ppo.use_sde
         ):
             raise ValueError(
                 "policy.score_read_actions_only scores the env's own action values, one per "
-                "control step, with a diagonal Gaussian; it needs no hybrid or knobs section, "
-                "env.decision: step (the others change the action and the observation) and "
-                "ppo.use_sde: false"
+                "control step or gait cycle, with a diagonal Gaussian; it needs no hybrid or "
+                "knobs section, env.decision: step or gait_cycle (the others change the action "
+                "and the observation) and ppo.use_sde: false"
             )
         if self.warm_start is not None and (
             self.hybrid is not None or self.knobs is not None or self.env.decision != "step"

@@ -243,6 +243,14 @@ class HexapodEnv(SafetyFigures, gym.Env):
         (`agents.read_actions`)."""
         return {}
 
+    @property
+    def inert_actions(self) -> tuple[int, ...]:
+        """Action values the env as configured never reads: whatever they are, nothing changes
+        (the ditch crossing's residuals with a residual range of 0). Empty (every env's
+        default): every value acts. A learner can leave them out of its action's likelihood
+        (`agents.read_actions`)."""
+        return ()
+
     def _observation(self) -> np.ndarray:
         self.observation_layout.write(self._obs_buffer)
         if self.sensor_noise:

@@ -734,6 +734,14 @@ class DitchCrossingEnv(HexapodEnv):
         return {STRIDE_ACTION: self.observation_layout.slices["stride_decision"].start + 1}
 
     @property
+    def inert_actions(self) -> tuple[int, ...]:
+        """In residual mode, the residuals whose range is 0 (``residual_limb_m`` or
+        ``residual_leg_m`` = 0): their filter state decays to 0 whatever they are."""
+        if self.action_mode != "residual":
+            return ()
+        return tuple(int(i) for i in np.flatnonzero(self.residual_gain == 0.0))
+
+    @property
     def stride_due(self) -> bool:
         """True when the next `step` reads its stride value (action 9): with `stride_action`,
         on each platform step's first control step. `hexapod_envs.wrappers.GainsPerCycle`

@@ -4,7 +4,7 @@ import gymnasium as gym
 import numpy as np
 import pytest
 import torch
-from helpers.ditch_stride_runs import READ_CONFIG, train_tiny
+from helpers.ditch_stride_runs import CONFIGS, READ_CONFIG, train_tiny
 from stable_baselines3.common.policies import ActorCriticPolicy
 
 import hexapod_envs  # noqa: F401  (registers the ids)
@@ -18,6 +18,7 @@ from agents.read_actions import ReadActionsMlpPolicy, ReadActionsPrivilegedPolic
 from agents.run_files.errors import UserError
 from agents.run_files.train_config import load_train_config
 
+STRIDE_LANDING_CONFIG = CONFIGS / "ditch_crossing_v1_ppo_stride_landing.yaml"
 OBS = gym.spaces.Box(-np.inf, np.inf, shape=(4,), dtype=np.float32)
 ACT = gym.spaces.Box(-1.0, 1.0, shape=(3,), dtype=np.float32)
 
@@ -94,10 +95,30 @@ def test_the_privileged_critic_form_matches_its_plain_policy_where_the_values_ar
     torch.testing.assert_close(log_prob[1:], per_value[1:, :2].sum(dim=1))
 
 
+def test_an_inert_value_counts_nowhere():
+    scoring, plain = _policies()
+    scoring.set_action_read_flags({2: 3}, inert=[0])
+    obs, actions = _batch()
+    _, log_prob, entropy = scoring.evaluate_actions(obs, actions)
+    normal = plain.get_distribution(obs).distribution
+    per_value = normal.log_prob(actions)
+    torch.testing.assert_close(log_prob[0], per_value[0, 1:].sum())  # flag set: values 1, 2
+    torch.testing.assert_close(log_prob[1:], per_value[1:, 1])  # flag unset: value 1 alone
+    torch.testing.assert_close(entropy[1:], normal.entropy()[1:, 1])
+    (-log_prob.sum()).backward()
+    assert scoring.log_std.grad[0] == 0.0 and scoring.log_std.grad[1] != 0.0
+
+
 def test_flags_outside_the_spaces_and_a_state_dependent_noise_are_refused():
     scoring, _ = _policies()
     with pytest.raises(ValueError, match="outside the 3 action values or the 4 observation"):
         scoring.set_action_read_flags({3: 0})
+    with pytest.raises(ValueError, match="inert action values"):
+        scoring.set_action_read_flags({2: 3}, inert=[3])
+    with pytest.raises(ValueError, match="leave at least one"):
+        scoring.set_action_read_flags({}, inert=[0, 1, 2])
+    with pytest.raises(ValueError, match="both flagged and inert"):
+        scoring.set_action_read_flags({2: 3}, inert=[2])
     with pytest.raises(ValueError, match="diagonal Gaussian"):
         ReadActionsMlpPolicy(OBS, ACT, lambda _: 1e-3, use_sde=True)
 
@@ -125,9 +146,9 @@ def test_a_run_trains_and_resumes_with_the_flags_and_loads_as_a_plain_policy(tmp
     told = []
     original = ReadActionsPrivilegedPolicy.set_action_read_flags
 
-    def spy(self, flags):
-        told.append(dict(flags))
-        original(self, flags)
+    def spy(self, flags, inert=()):
+        told.append((dict(flags), tuple(inert)))
+        original(self, flags, inert)
 
     monkeypatch.setattr(ReadActionsPrivilegedPolicy, "set_action_read_flags", spy)
     assert train_tiny(READ_CONFIG, tmp_path) == 0
@@ -135,7 +156,7 @@ def test_a_run_trains_and_resumes_with_the_flags_and_loads_as_a_plain_policy(tmp
     assert train_main(["--resume", str(run_dir), "--set", "train.total_timesteps=128"]) == 0
     env = gym.make("HexapodDitchCrossing-v1", stride_action=True)
     flag = env.unwrapped.observation_structure["stride_decision"].start + 1
-    assert told == [{9: flag}, {9: flag}]
+    assert told == [({9: flag}, ()), ({9: flag}, ())]  # the residuals act: none inert
     policy = PPOPolicy.load(run_dir, env)
     obs, _ = env.reset(seed=0)
     assert policy(obs).shape == (10,)
@@ -147,6 +168,15 @@ def test_a_new_model_is_told_the_envs_flags():
     flag = model.get_env().get_attr("observation_structure")[0]["stride_decision"].start + 1
     assert isinstance(model.policy, ReadActionsPrivilegedPolicy)
     assert model.policy.action_read_flags == {9: flag}
+    assert model.policy.inert_actions == ()
+    model.get_env().close()
+
+
+def test_a_stride_learner_per_platform_step_leaves_the_inert_residuals_out():
+    config = load_train_config(STRIDE_LANDING_CONFIG, ["policy.pi=[16]", "policy.vf=[16]"])
+    assert config.env.decision == "gait_cycle" and config.policy.score_read_actions_only
+    model, _ = untrained_model(config)
+    assert model.policy.inert_actions == tuple(range(9))  # residual ranges of 0
     model.get_env().close()
 
 

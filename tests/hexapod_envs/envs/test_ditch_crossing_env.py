@@ -292,6 +292,22 @@ def test_stride_action_needs_the_residual_mode_and_the_flat_reference():
 
 def test_without_the_stride_action_every_action_value_is_read_on_every_step():
     assert gym.make("HexapodDitchCrossing-v1").unwrapped.action_read_flags == {}
+    assert gym.make("HexapodDitchCrossing-v1").unwrapped.inert_actions == ()
+
+
+def test_residuals_with_a_range_of_0_are_inert():
+    env = gym.make("HexapodDitchCrossing-v1", residual_leg_m=0.0)
+    assert env.unwrapped.inert_actions == tuple(range(3, 9))  # the six legs
+    # Whatever an inert value is, the trajectory is the same.
+    trajectories = []
+    for value in (-1.0, 1.0):
+        action = np.zeros(9, dtype=np.float32)
+        action[3:] = value
+        env.reset(seed=0)
+        trajectories.append([env.step(action)[0] for _ in range(20)])
+    np.testing.assert_array_equal(trajectories[0], trajectories[1])
+    joint = gym.make("HexapodDitchCrossing-v1", action_mode="joint", residual_leg_m=0.0)
+    assert joint.unwrapped.inert_actions == ()  # joint mode has no residuals
 
 
 def test_full_strides_walk_the_flat_reference_bit_for_bit_on_flat_ground():
