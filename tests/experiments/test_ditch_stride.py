@@ -3,6 +3,8 @@
 import gymnasium as gym
 import numpy as np
 
+from agents.upu_stride import ClearStridePolicy
+from experiments.ditch_stride.policy_strides import STRIDE_ENV, compare, summary
 from experiments.ditch_stride.rules import ENV_ID, StrideRule, run
 
 
@@ -24,3 +26,15 @@ def test_a_rule_sets_the_stride_value_only_when_a_step_is_decided():
         assert (action[9] != 0) == bool(obs[decision][1])  # a random value is never exactly 0
         obs, *_ = env.step(action)
     assert np.all([-1 <= s.stride / 0.16 - 1 <= 0 for s in env.unwrapped.online_gait.steps])
+
+
+def test_policy_strides_compares_a_policy_with_the_rule_at_the_rules_decisions():
+    env = gym.make(ENV_ID, **STRIDE_ENV)
+    rule = compare(ClearStridePolicy(env), env, [101])
+    assert len(rule.rule_short) >= 3 and len(rule.full) >= 5
+    np.testing.assert_array_equal(rule.policy_short, rule.rule_short)  # the rule against itself
+    np.testing.assert_allclose(rule.full, 0.0, atol=1e-12)  # the rule's full strides, rounded
+    zero = compare(lambda obs: np.zeros(10, dtype=np.float32), env, [101])
+    np.testing.assert_array_equal(zero.rule_short, rule.rule_short)  # the same decisions
+    assert (zero.policy_short == 0.0).all()
+    assert "policy shortens 0" in summary(zero)
