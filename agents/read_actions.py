@@ -9,14 +9,12 @@ action index -> observation index of a 0/1 flag), and which values it never read
 the stride alone, one decision per platform step).
 
 PPO's likelihood ratio multiplies the likelihoods of all action values. An ignored value's
-sample changes nothing that follows, so its term carries no signal; but its scores (for the
-mean ``(a - mu) / sigma^2``, for the log standard deviation ``(a - mu)^2 / sigma^2 - 1``),
-weighted by the step's advantage, still enter the gradient: zero-mean noise, from 50 of every
-51 steps for the stride against the one step whose sample matters. An inert value's do on every
-step, and its drift also moves the likelihood ratio that PPO clips: with the nine inert
-residuals in it, a stride learner's updates had 40 % of their samples clipped and an approximate
-KL of 0.06. Leaving an ignored value
-out of the log-likelihood removes that noise and no signal, as invalid-action masking does for
+sample changes nothing that follows, so its term carries no signal; but its scores (for the mean
+``(a - mu) / sigma^2``, for the log standard deviation ``(a - mu)^2 / sigma^2 - 1``), weighted
+by the step's advantage, still enter the gradient: zero-mean noise, from 50 of every 51 steps
+for the stride against the one step whose sample matters. An inert value's scores enter on every
+step, and its drift also moves the likelihood ratio that PPO clips. Leaving an ignored value out
+of the log-likelihood removes that noise and no signal, as invalid-action masking does for
 discrete actions: the policy gradient stays unbiased because the value's sample is independent
 of the rest of the episode. The entropy bonus (``ent_coef``) counts the value on the same steps
 only. Sampling and acting are unchanged; only training differs, so a deployed model is an

@@ -59,7 +59,7 @@ def compare(policy: Callable[[np.ndarray], np.ndarray], env: gym.Env, seeds: Ite
         while not done:
             action = rule(obs)
             if env.unwrapped.stride_due:
-                ours = min(float(np.asarray(policy(obs))[STRIDE_ACTION]), 0.0)
+                ours = float(np.clip(np.asarray(policy(obs))[STRIDE_ACTION], -1.0, 0.0))
                 if action[STRIDE_ACTION] > FULL:
                     full.append(ours)
                 else:

@@ -634,9 +634,11 @@ class DitchCrossingEnv(HexapodEnv):
         return self.schedule.command(self._step_count if tick is None else tick)
 
     def _apply_action(self, action: np.ndarray) -> None:
+        self._landing_cost = 0.0  # an unstable step never paid the last decision's
         if self.stride_due:
             step = self.online_gait.advance(self.online_gait.stride_for(action[STRIDE_ACTION]))
-            self._landing_cost = self._planned_landing_near_edges(step)
+            if self.weights["landing"]:
+                self._landing_cost = self._planned_landing_near_edges(step)
             self._set_online_schedule()
         if self.action_mode == "joint":
             target = self._center + self._half * action
@@ -793,7 +795,7 @@ class DitchCrossingEnv(HexapodEnv):
             "tip_over": -w["tip_over"] if tipped else 0.0,
             "effort": -w["effort"] * min(self._power / self._reference_power, EFFORT_CAP),
             "foothold": -w["foothold"] * self._landing_near_edges() if w["foothold"] else 0.0,
-            "landing": -w["landing"] * self._take_landing_cost(),
+            "landing": -w["landing"] * self._take_landing_cost() if w["landing"] else 0.0,
         }
 
     def _planned_landing_near_edges(self, step: PlatformStep) -> float:
