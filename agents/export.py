@@ -88,6 +88,12 @@ def actor_module(model: Any, stats: NormalizationStats | None) -> Any:
     from .privileged_critic_policy import SensorOnly
 
     policy = model.policy
+    space_name = type(model.action_space).__name__
+    if space_name != "Box":
+        raise UserError(
+            f"cannot export a model of a {space_name} action space (e.g. env.stride_choices): "
+            "only a Gaussian (Box) action is supported"
+        )
     if getattr(policy, "squash_output", False) or not hasattr(policy, "action_net"):
         raise UserError(
             f"cannot export {type(policy).__name__}: only SB3's MlpPolicy with a Gaussian "

@@ -86,6 +86,9 @@ class PPOPolicy:
         if privileged:
             observation_space = privileged_space(observation_space)
         action_space = env.action_space if knobs is None else knobs.action_space
+        choices = _stride_choices(env, config, files)
+        if choices is not None:
+            action_space = choices.action_space
         for what, key, env_space in (
             ("observation", "observation_shape", observation_space),
             ("action", "action_shape", action_space),
@@ -106,6 +109,8 @@ class PPOPolicy:
         stats = load_stats(files.directory, trust_pickle, train_config.normalize.observation)
         train_kwargs = (config.get("env") or {}).get("kwargs") or {}
         policy = cls(model, stats, files, deterministic, train_kwargs, privileged)
+        if choices is not None:
+            return ChosenStride(policy, choices)
         return _as_trained(policy, env, config, knobs)
 
     def reset(self) -> None:
@@ -155,6 +160,40 @@ def _as_trained(
         return from_run_config(learned, env, config)
     except ValueError as exc:
         raise UserError(f"cannot use the model at {policy.files.model}: {exc}") from None
+
+
+def _stride_choices(env: gym.Env, config: dict[str, Any], files: ModelFiles) -> Any:
+    """A model trained with ``env.stride_choices``: `hexapod_envs.wrappers.StrideChoices` on
+    `env`, which turns its choices into `env`'s actions; None for any other model."""
+    values = (config.get("env") or {}).get("stride_choices")
+    if values is None:
+        return None
+    from hexapod_envs.wrappers import StrideChoices
+
+    try:
+        return StrideChoices(env, values)
+    except ValueError as exc:
+        raise UserError(f"cannot use the model at {files.model}: {exc}") from None
+
+
+class ChosenStride:
+    """A learned `Policy` of stride choices (a model trained with ``env.stride_choices``) as a
+    policy of the plain ditch env: each choice becomes the env's action through `choices` (a
+    `hexapod_envs.wrappers.StrideChoices`). Attributes it lacks are the learned policy's."""
+
+    def __init__(self, learned: Policy, choices: Any):
+        self.learned, self.choices = learned, choices
+
+    def __getattr__(self, name: str) -> Any:
+        if name in ("learned", "choices"):
+            raise AttributeError(name)
+        return getattr(self.learned, name)
+
+    def reset(self) -> None:
+        self.learned.reset()
+
+    def __call__(self, observation: np.ndarray) -> np.ndarray:
+        return self.choices.action(self.learned(observation))
 
 
 class HeldPerEpisode:

@@ -8,20 +8,25 @@ time; the 10th action value sets each step's stride as it begins (read when the 
 which platform moves next) and the robot's constants: the longest stride, on the grid of the
 paper's planner, that lands every foot of the moving platform at least the planner's band (the
 foot radius plus the edge clearance) from both edges; where none does, the one that lands them
-farthest from an edge. A ditch deeper than a leg reaches is stepped over: no foot may land in
-it. The nine residuals stay 0. It crosses 19 of 20 training and 18 of 20 test ditches of the
-benchmark (``experiments/ditch_stride``), the paper's planner's strides 18 and 17, and it is a
+farthest from an edge (with ``values``, among those stride values only: the choices of a
+categorical learner, `hexapod_envs.wrappers.StrideChoices`). A ditch deeper than a leg reaches
+is stepped over: no foot may land in it. The nine residuals stay 0. It crosses 19 of 20 training
+and 18 of 20 test ditches of the benchmark (``experiments/ditch_stride``; among the five values
+full, 80, 60, 40 and 20 % of it, 20 and 20), the paper's planner's strides 18 and 17, and it is a
 function of the observation, which makes it a teacher for a learner's warm start
 (`agents.warm_start`).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import gymnasium as gym
 import numpy as np
 
 from hexapod_envs.envs.ditch_crossing import STRIDE_ACTION
 from hexapod_envs.robots.upu.gait_plan import edge_clearance
+from hexapod_envs.robots.upu.online_gait import STRIDE_TOLERANCE
 from hexapod_envs.robots.upu.params import PLATFORM_LEGS
 
 from .policy import ObservationReader
@@ -36,7 +41,7 @@ class ClearStridePolicy:
     """The clear-stride rule (module docstring) as a `Policy` of a ditch-crossing env with
     ``stride_action=True``."""
 
-    def __init__(self, env: gym.Env):
+    def __init__(self, env: gym.Env, values: Sequence[float] | None = None):
         base = env.unwrapped
         if not getattr(base, "stride_action", False):
             raise ValueError(
@@ -56,6 +61,8 @@ class ClearStridePolicy:
         }
         """Each platform's feet, x relative to its centre [m]."""
         self.n_actions = base.action_space.shape[0]
+        self.values = None if values is None else np.asarray(values, dtype=np.float64)
+        """The stride values it chooses among (None: every stride on the planner's grid)."""
 
     def reset(self) -> None:
         pass
@@ -77,10 +84,14 @@ class ClearStridePolicy:
         near, far = (near_u, far_u) if upper_next else (near_l, far_l)
         feet0 = self.offsets["upper" if upper_next else "lower"]
         grid = gait.min_stride
-        strides = np.arange(max(room, grid), grid - 1e-9, -grid)
+        if self.values is None:
+            strides = np.arange(max(room, grid), grid - 1e-9, -grid)
+        else:  # as `OnlineGait.stride_for` takes them
+            wanted = np.maximum(gait.max_stride * (1.0 + np.minimum(self.values, 0.0)), grid)
+            strides = np.where(wanted <= room + STRIDE_TOLERANCE, wanted, max(room, 0.0))
         feet = strides[:, None] + feet0[None, :]  # foot x in the frame of the edges
         # Too deep to stand in (depth > reach): a foot may not land in the ditch at all.
         clear = edge_clearance(feet, near, far, self.band, depth <= self.reach).min(axis=1)
         ok = np.flatnonzero(clear >= self.band)
-        best = ok[0] if ok.size else int(np.argmax(clear))
+        best = ok[np.argmax(strides[ok])] if ok.size else int(np.argmax(clear))
         return stride_value(float(strides[best]), gait.max_stride)

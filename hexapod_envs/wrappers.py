@@ -32,6 +32,11 @@ contextual bandit of "one setting per terrain", for knobs whose best value hardl
 an episode (ATHENA's body height: the height control reaches a new reference over several
 cycles, so per-cycle rewards credit little of it). The step's reward is the episode's outcome.
 
+`StrideChoices`: the ditch crossing's stride action as a choice among a few stride values (a
+`gymnasium.spaces.Discrete` action), the residuals off. A Gaussian policy that starts at the full
+stride moves its mean by small steps, and on the way to a stride that clears an edge it meets
+strides that land a foot on it; a categorical policy weighs each value apart.
+
 `StabilityRulePenalty`: per-step penalties that mirror a ``-v1`` success rule's bounds on the
 time spent tipping and the largest tilt (and, on the cliff walk, its pace), for learners that
 act at every step.
@@ -292,6 +297,53 @@ def _require_gains_mode(
             f"{wrapper} needs action_mode='gains', got {base.action_mode!r}; the other "
             "modes read their action at every step"
         )
+
+
+class StrideChoices(gym.ActionWrapper):
+    """The ditch crossing's stride action (``stride_action=True``, residuals off) as
+    ``Discrete(len(values))``: action k sets the stride value ``values[k]`` (0: the full stride,
+    -0.5: half of it; `OnlineGait.stride_for`) and the nine residuals, whose range is 0, to 0.
+
+    Action 0 is the first value; put the zero action's (0.0, full strides) first so that a
+    policy with equal preferences (an untrained one, acting deterministically) walks the zero
+    action. Like the env, the wrapped env reads the choice only on a platform step's first
+    control step. A ValueError names the problem for another env, residuals that are not off,
+    or values outside [-1, 0] or repeated."""
+
+    def __init__(self, env: gym.Env, values: Any):
+        super().__init__(env)
+        base = env.unwrapped
+        if not getattr(base, "stride_action", False):
+            raise ValueError(
+                f"StrideChoices needs HexapodDitchCrossing-* with stride_action=True, got "
+                f"{_env_name(env)}"
+            )
+        if len(base.inert_actions) != env.action_space.shape[0] - 1:
+            raise ValueError(
+                "StrideChoices sets only the stride value; it needs residual_limb_m=0 and "
+                f"residual_leg_m=0 (got {base.settings.residual_limb_m} and "
+                f"{base.settings.residual_leg_m})"
+            )
+        values = np.asarray(values, dtype=np.float64)
+        if values.ndim != 1 or values.size < 2:
+            raise ValueError(f"StrideChoices needs a list of at least 2 values, got {values!r}")
+        if not (np.all(np.isfinite(values)) and np.all((values >= -1.0) & (values <= 0.0))):
+            raise ValueError(
+                f"stride values must lie in [-1, 0] (0: the full stride), got {values.tolist()}"
+            )
+        if np.unique(values).size != values.size:
+            raise ValueError(f"stride values must differ, got {values.tolist()}")
+        self.values = values
+        (self.stride_index,) = base.action_read_flags
+        self.action_space = gym.spaces.Discrete(values.size)
+
+    def action(self, action: Any) -> np.ndarray:
+        choice = int(np.asarray(action).reshape(()))
+        if not 0 <= choice < self.values.size:
+            raise ValueError(f"stride choice {choice} is not in 0..{self.values.size - 1}")
+        full = np.zeros(self.env.action_space.shape, dtype=self.env.action_space.dtype)
+        full[self.stride_index] = self.values[choice]
+        return full
 
 
 class StabilityRulePenalty(gym.Wrapper):

@@ -101,6 +101,9 @@ class EnvSpec:
     one sees its penalised rewards); 0: none."""
     progress_penalty: float = 0.0
     """`StabilityRulePenalty`'s ``progress_weight`` (walking heavy-duty envs); 0: none."""
+    stride_choices: list[float] | None = None
+    """The ditch crossing's stride action as a choice among these stride values
+    (`hexapod_envs.wrappers.StrideChoices`, inside the decision wrappers); None: the env's."""
 
     def make(self, **extra: Any) -> gym.Env:
         """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
@@ -142,6 +145,11 @@ class EnvSpec:
             env = _wrapped(env, lambda e: wrap(e, self.hybrid), where)
         if self.reward_exclude:
             env = ExcludeRewardTerms(env, self.reward_exclude)
+        if self.stride_choices is not None:
+            from hexapod_envs.wrappers import StrideChoices
+
+            choices, where = self.stride_choices, f"env.stride_choices on {self.id}"
+            env = _wrapped(env, lambda e: StrideChoices(e, choices), where)
         if self.decision == "gait_cycle":
             from hexapod_envs.wrappers import GainsPerCycle
 

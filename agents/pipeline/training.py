@@ -104,6 +104,7 @@ def env_spec(config: TrainConfig) -> EnvSpec:
         env.min_task_difficulty,
         env.stability_penalty,
         env.progress_penalty,
+        None if env.stride_choices is None else list(env.stride_choices),
     )
 
 

@@ -106,6 +106,11 @@ class EnvConfig:
     """With ``decision: gait_cycle``: "zero_action" makes each cycle's reward the difference to
     the same cycle replayed from the same state with the zero action (a hybrid run's paper
     gains), see `hexapod_envs.wrappers.GainsPerCycle`; every cycle is then simulated twice."""
+    stride_choices: list[float] | None = None
+    """The ditch crossing's stride action (``stride_action: true``, residuals off) as a choice
+    among these stride values (`hexapod_envs.wrappers.StrideChoices`: 0 the full stride, -0.5
+    half of it), learnt by a categorical policy; the first is what an untrained model does
+    deterministically, so list the full stride (0.0) first. None: the env's own action."""
     vectorization: Literal["vec_env", "batched"] = "vec_env"
     """How the ``vec_env.n_envs`` training envs run: "vec_env", the SB3 vec env that
     ``vec_env.type`` picks (SubprocVecEnv or DummyVecEnv); "batched", one process whose envs'
@@ -452,6 +457,21 @@ class TrainConfig:
                 "the ditch crossing, whose planner's settings a knobs section learns "
                 '(knobs.reward); with env.decision: episode use "success", "stable_success" or '
                 '"return"'
+            )
+        if self.env.stride_choices is not None and (
+            self.hybrid is not None
+            or self.knobs is not None
+            or self.env.decision == "episode"
+            or self.env.vectorization == "batched"
+            or self.policy.score_read_actions_only
+            or self.ppo.use_sde
+            or self.warm_start is not None
+        ):
+            raise ValueError(
+                "env.stride_choices replaces the env's action with one categorical choice: it "
+                "needs no hybrid, knobs or warm_start section, env.decision: step or gait_cycle, "
+                "env.vectorization: vec_env, policy.score_read_actions_only: false (the choice "
+                "is the only value) and ppo.use_sde: false (gSDE is for continuous actions)"
             )
         if self.policy.score_read_actions_only and (
             self.hybrid is not None

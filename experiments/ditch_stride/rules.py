@@ -15,6 +15,7 @@ action (the nine residuals stay 0):
   (`agents.upu_stride.ClearStridePolicy`).
 
     python experiments/ditch_stride/rules.py [--distribution train] [--tasks 10] [--rules greedy]
+        [--values 0 -0.2 -0.4 -0.6 -0.8]   # greedy among these stride values only
 
 Prints one line per rule and task distribution (successes, tip-overs, CoG advance) and the
 per-task outcomes. Findings: README.md.
@@ -43,8 +44,8 @@ class StrideRule(ClearStridePolicy):
     """A policy of the stride action: residuals 0, the stride value of `rule` (``greedy``: the
     clear-stride rule it extends)."""
 
-    def __init__(self, env: gym.Env, rule: str, seed: int = 0):
-        super().__init__(env)
+    def __init__(self, env: gym.Env, rule: str, seed: int = 0, values=None):
+        super().__init__(env, values)
         self.rule = rule
         self.rng = np.random.default_rng(seed)
         self.plan = None
@@ -70,9 +71,9 @@ class StrideRule(ClearStridePolicy):
         return super().stride(ahead, upper_next)
 
 
-def run(rule: str, distribution: str, tasks: int) -> list[dict]:
+def run(rule: str, distribution: str, tasks: int, values=None) -> list[dict]:
     env = gym.make(ENV_ID, stride_action=True, task_distribution=distribution)
-    policy = StrideRule(env, rule)
+    policy = StrideRule(env, rule, values=values)
     rows = []
     for seed in range(tasks):
         obs, info = env.reset(seed=seed)
@@ -100,9 +101,16 @@ def main() -> None:
     ap.add_argument("--distribution", choices=("train", "test"), default="train")
     ap.add_argument("--tasks", type=count_argument(), default=10)
     ap.add_argument("--rules", nargs="+", choices=RULES, default=list(RULES))
+    ap.add_argument(
+        "--values",
+        nargs="+",
+        type=float,
+        help="the stride values greedy chooses among (default: every stride on the planner's "
+        "5 mm grid), e.g. a categorical learner's env.stride_choices",
+    )
     args = ap.parse_args()
     for rule in args.rules:
-        rows = run(rule, args.distribution, args.tasks)
+        rows = run(rule, args.distribution, args.tasks, args.values)
         wins = sum(r["success"] for r in rows)
         tips = sum(r["tipped"] for r in rows)
         print(

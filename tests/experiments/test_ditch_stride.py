@@ -15,6 +15,22 @@ def test_the_greedy_rule_reads_the_observation_and_crosses_where_full_strides_ti
     assert [r["tipped"] for r in full] == [True, True]
 
 
+def test_the_greedy_rule_among_a_few_values_chooses_only_those_and_crosses():
+    """Among a categorical learner's five values (env.stride_choices): training ditches 0 and
+    1 crossed; on ditch 1 every stride is one of the values' (full, 80 % and 60 % of it)."""
+    values = [0.0, -0.2, -0.4, -0.6, -0.8]
+    assert [r["success"] for r in run("greedy", "train", 2, values)] == [True, True]
+    env = gym.make(ENV_ID, stride_action=True, task_distribution="train")
+    policy = StrideRule(env, "greedy", values=values)
+    obs, _ = env.reset(seed=1)
+    done = False
+    while not done:
+        obs, _, terminated, truncated, _ = env.step(policy(obs))
+        done = terminated or truncated
+    strides = np.array([s.stride for s in env.unwrapped.online_gait.steps])
+    np.testing.assert_allclose(np.unique(strides.round(9)), [0.096, 0.128, 0.16], atol=1e-9)
+
+
 def test_a_rule_sets_the_stride_value_only_when_a_step_is_decided():
     env = gym.make(ENV_ID, stride_action=True, task_distribution="train")
     policy = StrideRule(env, "random", seed=1)

@@ -1,5 +1,5 @@
 """Tiny train.py runs of the ditch's stride-action configs (64 PPO steps, short episodes): what
-the read-actions and warm-start tests share."""
+the read-actions, warm-start and stride-choice tests share."""
 
 from pathlib import Path
 
@@ -9,6 +9,15 @@ from helpers.paths import REPO
 CONFIGS = REPO / "configs"
 READ_CONFIG = CONFIGS / "ditch_crossing_v1_ppo_stride_read.yaml"
 WARM_CONFIG = CONFIGS / "ditch_crossing_v1_ppo_stride_warm.yaml"
+CHOICES_CONFIG = CONFIGS / "ditch_crossing_v1_ppo_stride_choices.yaml"
+STRIDES_OFF = {
+    "task_distribution": "train",
+    "stride_action": True,
+    "residual_limb_m": 0.0,
+    "residual_leg_m": 0.0,
+    "max_episode_steps": 500,
+}
+"""The ditch env's stride action with the residuals off, 500-step episodes."""
 TINY = [
     "ppo.n_steps=64",
     "ppo.batch_size=32",

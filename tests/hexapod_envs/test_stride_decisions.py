@@ -6,6 +6,7 @@ import copy
 import gymnasium as gym
 import numpy as np
 import pytest
+from helpers.ditch_stride_runs import STRIDES_OFF
 from helpers.paths import REPO
 
 import hexapod_envs  # noqa: F401  (registers the env ids)
@@ -14,13 +15,7 @@ from hexapod_envs.envs.ditch_crossing import STRIDE_ACTION
 from hexapod_envs.wrappers import GainsPerCycle
 
 ENV_ID = "HexapodDitchCrossing-v1"
-STRIDES = {
-    "task_distribution": "train",
-    "stride_action": True,
-    "residual_limb_m": 0.0,
-    "residual_leg_m": 0.0,
-    "max_episode_steps": 500,
-}
+STRIDES = STRIDES_OFF
 
 
 def _rule_with_noise(env: gym.Env):

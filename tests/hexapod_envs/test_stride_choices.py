@@ -1,0 +1,71 @@
+"""The ditch crossing's stride action as a choice among stride values (`StrideChoices`)."""
+
+import gymnasium as gym
+import numpy as np
+import pytest
+from helpers.ditch_stride_runs import STRIDES_OFF
+
+import hexapod_envs  # noqa: F401  (registers the env ids)
+from hexapod_envs.envs.ditch_crossing import STRIDE_ACTION
+from hexapod_envs.wrappers import GainsPerCycle, StrideChoices
+
+ENV_ID = "HexapodDitchCrossing-v1"
+STRIDES = STRIDES_OFF
+VALUES = [0.0, -0.2, -0.4, -0.6, -0.8]
+
+
+def test_a_choice_walks_as_its_stride_value_on_the_plain_env():
+    """Choices 3, 0, 1, 4, 2, ... per platform step through the wrapper (one learner step per
+    platform step) and the same stride values as Box actions on the plain env: one trajectory."""
+    chosen = GainsPerCycle(StrideChoices(gym.make(ENV_ID, **STRIDES), VALUES))
+    plain = gym.make(ENV_ID, **STRIDES)
+    assert chosen.action_space == gym.spaces.Discrete(5)
+    chosen.reset(seed=4)
+    obs_p, _ = plain.reset(seed=4)
+    flag = plain.unwrapped.observation_layout.slices["stride_decision"].start + 1
+    done, k, decided = False, 0, []
+    while not done:
+        choice = [3, 0, 1, 4, 2][k % 5]
+        obs_c, _, term, trunc, _ = chosen.step(choice)
+        k += 1
+        done = term or trunc
+    k, done = 0, False
+    while not done:
+        action = np.zeros(STRIDE_ACTION + 1, dtype=np.float32)
+        if obs_p[flag] == 1.0:
+            action[STRIDE_ACTION] = VALUES[[3, 0, 1, 4, 2][k % 5]]
+            decided.append(action[STRIDE_ACTION])
+            k += 1
+        obs_p, _, term, trunc, _ = plain.step(action)
+        done = term or trunc
+    np.testing.assert_array_equal(obs_c, obs_p)
+    strides = [s.stride for s in chosen.unwrapped.online_gait.steps]
+    assert strides == [s.stride for s in plain.unwrapped.online_gait.steps]
+    assert len(decided) >= 7 and len(set(np.round(strides, 6))) >= 3  # the room caps some
+
+
+def test_the_first_choice_is_what_the_action_maps_it_to():
+    env = StrideChoices(gym.make(ENV_ID, **STRIDES), VALUES)
+    expected = np.zeros(STRIDE_ACTION + 1, dtype=np.float32)
+    expected[STRIDE_ACTION] = -0.6
+    np.testing.assert_array_equal(env.action(np.int64(3)), expected)
+    np.testing.assert_array_equal(env.action(np.array([0])), np.zeros_like(expected))
+    with pytest.raises(ValueError, match=r"stride choice 5 is not in 0\.\.4"):
+        env.action(5)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "values", "match"),
+    [
+        ({}, VALUES, "stride_action=True, got HexapodDitchCrossing-v1"),
+        ({"stride_action": True}, VALUES, "residual_limb_m=0 and residual_leg_m=0"),
+        (STRIDES, [0.0, 0.5], r"lie in \[-1, 0\]"),
+        (STRIDES, [0.0, float("nan")], r"lie in \[-1, 0\]"),
+        (STRIDES, [0.0, -0.2, 0.0], "must differ"),
+        (STRIDES, [0.0], "at least 2 values"),
+    ],
+)
+def test_other_envs_residuals_and_bad_values_are_refused_by_name(kwargs, values, match):
+    env = gym.make(ENV_ID, **kwargs)
+    with pytest.raises(ValueError, match=match):
+        StrideChoices(env, values)
