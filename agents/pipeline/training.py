@@ -128,6 +128,12 @@ def _probe(
                 "inert_actions), so there is nothing to leave out; the option applies to "
                 "HexapodDitchCrossing-v1 with stride_action: true, or set it to false"
             )
+        if score_read_actions_only and len(base.inert_actions) == base.action_space.shape[0]:
+            raise UserError(
+                f"policy.score_read_actions_only: {spec.id} with env.kwargs {spec.kwargs} "
+                f"reads none of its action values (all inert: {list(base.inert_actions)}), so "
+                "there is nothing to learn; give the residuals a range or add stride_action: true"
+            )
         if spec.reward_exclude:  # a term missing from the info is named at the first step
             env.reset(seed=0)
             env.step(np.zeros(env.action_space.shape, env.action_space.dtype))

@@ -187,3 +187,6 @@ def test_an_env_that_reads_every_value_is_refused_by_name_before_a_run_starts(tm
     config = load_train_config(READ_CONFIG, ["env.kwargs={task_distribution: train}"])
     with pytest.raises(UserError, match="nothing to leave out"):
         check_env(config)  # what a sweep runs before it starts Ray
+    inert = "env.kwargs={task_distribution: train, residual_limb_m: 0.0, residual_leg_m: 0.0}"
+    with pytest.raises(UserError, match=r"reads none of its action values \(all inert"):
+        check_env(load_train_config(READ_CONFIG, [inert]))
