@@ -37,6 +37,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import gymnasium as gym
 import numpy as np
 
 from .knobs import KNOB_RANGES, PLANNER_KNOB_RANGES, settings_from_config
@@ -88,11 +89,10 @@ def actor_module(model: Any, stats: NormalizationStats | None) -> Any:
     from .privileged_critic_policy import SensorOnly
 
     policy = model.policy
-    space_name = type(model.action_space).__name__
-    if space_name != "Box":
+    if not isinstance(model.action_space, gym.spaces.Box):
         raise UserError(
-            f"cannot export a model of a {space_name} action space (e.g. env.stride_choices): "
-            "only a Gaussian (Box) action is supported"
+            f"cannot export a model of a {type(model.action_space).__name__} action space (e.g. "
+            "env.stride_choices): only a Gaussian (Box) action is supported"
         )
     if getattr(policy, "squash_output", False) or not hasattr(policy, "action_net"):
         raise UserError(
@@ -493,6 +493,12 @@ def load_actor(path: str | Path, trust_pickle: bool = False) -> tuple[Any, Any, 
             "which env it was trained for"
         )
     section = config["env"]
+    if section.get("stride_choices") is not None:
+        raise UserError(
+            f"cannot export the model at {files.model}: it chooses among stride values "
+            "(env.stride_choices, a Discrete action); the ONNX export takes Gaussian (Box) "
+            "actions only"
+        )
     spec = EnvSpec(
         id=section["id"],
         kwargs=dict(section.get("kwargs") or {}),

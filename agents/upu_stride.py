@@ -26,7 +26,7 @@ import numpy as np
 
 from hexapod_envs.envs.ditch_crossing import STRIDE_ACTION
 from hexapod_envs.robots.upu.gait_plan import edge_clearance
-from hexapod_envs.robots.upu.online_gait import STRIDE_TOLERANCE
+from hexapod_envs.robots.upu.online_gait import stride_of
 from hexapod_envs.robots.upu.params import PLATFORM_LEGS
 
 from .policy import ObservationReader
@@ -62,6 +62,10 @@ class ClearStridePolicy:
         """Each platform's feet, x relative to its centre [m]."""
         self.n_actions = base.action_space.shape[0]
         self.values = None if values is None else np.asarray(values, dtype=np.float64)
+        if self.values is not None and not (
+            self.values.ndim == 1 and self.values.size and np.all(np.abs(self.values + 0.5) <= 0.5)
+        ):
+            raise ValueError(f"stride values must be a non-empty list in [-1, 0], got {values!r}")
         """The stride values it chooses among (None: every stride on the planner's grid)."""
 
     def reset(self) -> None:
@@ -86,9 +90,8 @@ class ClearStridePolicy:
         grid = gait.min_stride
         if self.values is None:
             strides = np.arange(max(room, grid), grid - 1e-9, -grid)
-        else:  # as `OnlineGait.stride_for` takes them
-            wanted = np.maximum(gait.max_stride * (1.0 + np.minimum(self.values, 0.0)), grid)
-            strides = np.where(wanted <= room + STRIDE_TOLERANCE, wanted, max(room, 0.0))
+        else:
+            strides = np.array([stride_of(v, gait.max_stride, grid, room) for v in self.values])
         feet = strides[:, None] + feet0[None, :]  # foot x in the frame of the edges
         # Too deep to stand in (depth > reach): a foot may not land in the ditch at all.
         clear = edge_clearance(feet, near, far, self.band, depth <= self.reach).min(axis=1)

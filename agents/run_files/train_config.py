@@ -109,8 +109,9 @@ class EnvConfig:
     stride_choices: list[float] | None = None
     """The ditch crossing's stride action (``stride_action: true``, residuals off) as a choice
     among these stride values (`hexapod_envs.wrappers.StrideChoices`: 0 the full stride, -0.5
-    half of it), learnt by a categorical policy; the first is what an untrained model does
-    deterministically, so list the full stride (0.0) first. None: the env's own action."""
+    half of it), learnt by a categorical policy once per platform step (``decision:
+    gait_cycle``); the first must be the full stride (0.0): an untrained model takes it
+    deterministically, its step 0. None: the env's own action."""
     vectorization: Literal["vec_env", "batched"] = "vec_env"
     """How the ``vec_env.n_envs`` training envs run: "vec_env", the SB3 vec env that
     ``vec_env.type`` picks (SubprocVecEnv or DummyVecEnv); "batched", one process whose envs'
@@ -401,6 +402,34 @@ class TrainConfig:
         knobs = self.knobs is not None and self.knobs.zero_init_action_net
         return hybrid or knobs or self.policy.zero_init_action_net
 
+    def _check_stride_choices(self) -> None:
+        """``env.stride_choices`` replaces the env's action with one categorical choice, taken
+        once per platform step, whose first value is the untrained model's (its step 0)."""
+        choices = self.env.stride_choices
+        if not choices or choices[0] != 0.0:
+            raise ValueError(
+                "env.stride_choices must start with 0.0, the full stride: an untrained model "
+                f"takes the first choice, its step 0 (the zero action); got {choices}"
+            )
+        conflicts = {
+            "a hybrid section": self.hybrid is not None,
+            "a knobs section": self.knobs is not None,
+            "a warm_start section": self.warm_start is not None,
+            f"env.decision: {self.env.decision} (use gait_cycle)": self.env.decision
+            != "gait_cycle",
+            "env.vectorization: batched": self.env.vectorization == "batched",
+            "policy.score_read_actions_only: true (the choice is the only value)": (
+                self.policy.score_read_actions_only
+            ),
+            "ppo.use_sde: true (gSDE is for continuous actions)": self.ppo.use_sde,
+        }
+        found = [name for name, present in conflicts.items() if present]
+        if found:
+            raise ValueError(
+                "env.stride_choices replaces the env's action with one categorical choice per "
+                f"platform step; it does not go with {'; '.join(found)}"
+            )
+
     def __post_init__(self):
         rollout = self.ppo.n_steps * self.vec_env.n_envs
         if rollout < 2:
@@ -458,21 +487,8 @@ class TrainConfig:
                 '(knobs.reward); with env.decision: episode use "success", "stable_success" or '
                 '"return"'
             )
-        if self.env.stride_choices is not None and (
-            self.hybrid is not None
-            or self.knobs is not None
-            or self.env.decision == "episode"
-            or self.env.vectorization == "batched"
-            or self.policy.score_read_actions_only
-            or self.ppo.use_sde
-            or self.warm_start is not None
-        ):
-            raise ValueError(
-                "env.stride_choices replaces the env's action with one categorical choice: it "
-                "needs no hybrid, knobs or warm_start section, env.decision: step or gait_cycle, "
-                "env.vectorization: vec_env, policy.score_read_actions_only: false (the choice "
-                "is the only value) and ppo.use_sde: false (gSDE is for continuous actions)"
-            )
+        if self.env.stride_choices is not None:
+            self._check_stride_choices()
         if self.policy.score_read_actions_only and (
             self.hybrid is not None
             or self.knobs is not None

@@ -105,10 +105,12 @@ def main() -> None:
         "--values",
         nargs="+",
         type=float,
-        help="the stride values greedy chooses among (default: every stride on the planner's "
-        "5 mm grid), e.g. a categorical learner's env.stride_choices",
+        help="greedy only: the stride values it chooses among (default: every stride on the "
+        "planner's 5 mm grid), e.g. a categorical learner's env.stride_choices",
     )
     args = ap.parse_args()
+    if args.values is not None and args.rules != ["greedy"]:
+        ap.error("--values applies to the greedy rule only: add --rules greedy")
     for rule in args.rules:
         rows = run(rule, args.distribution, args.tasks, args.values)
         wins = sum(r["success"] for r in rows)

@@ -2,6 +2,7 @@
 
 import gymnasium as gym
 import numpy as np
+import pytest
 
 from agents.upu_stride import ClearStridePolicy
 from experiments.ditch_stride.policy_strides import STRIDE_ENV, compare, summary
@@ -29,6 +30,9 @@ def test_the_greedy_rule_among_a_few_values_chooses_only_those_and_crosses():
         done = terminated or truncated
     strides = np.array([s.stride for s in env.unwrapped.online_gait.steps])
     np.testing.assert_allclose(np.unique(strides.round(9)), [0.096, 0.128, 0.16], atol=1e-9)
+    for bad in ([], [0.0, 0.5]):
+        with pytest.raises(ValueError, match=r"a non-empty list in \[-1, 0\]"):
+            ClearStridePolicy(env, bad)
 
 
 def test_a_rule_sets_the_stride_value_only_when_a_step_is_decided():

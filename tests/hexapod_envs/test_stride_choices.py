@@ -44,7 +44,7 @@ def test_a_choice_walks_as_its_stride_value_on_the_plain_env():
     assert len(decided) >= 7 and len(set(np.round(strides, 6))) >= 3  # the room caps some
 
 
-def test_the_first_choice_is_what_the_action_maps_it_to():
+def test_a_choice_maps_to_the_stride_value_with_the_residuals_at_0():
     env = StrideChoices(gym.make(ENV_ID, **STRIDES), VALUES)
     expected = np.zeros(STRIDE_ACTION + 1, dtype=np.float32)
     expected[STRIDE_ACTION] = -0.6

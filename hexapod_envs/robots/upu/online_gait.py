@@ -32,6 +32,14 @@ STRIDE_TOLERANCE = 1e-12
 strides keep the flat gait's exact positions despite rounding in the centres' difference."""
 
 
+def stride_of(action: float, max_stride: float, min_stride: float, room: float) -> float:
+    """The stride of a normalised action a [m]: `max_stride` for a >= 0, shortened in
+    proportion below, at least `min_stride`; a stride beyond `room` (what the other platform
+    leaves) becomes `room` (0 if none is left)."""
+    wanted = max(max_stride * (1.0 + min(float(action), 0.0)), min_stride)
+    return wanted if wanted <= room + STRIDE_TOLERANCE else max(room, 0.0)
+
+
 class OnlineGait:
     """The gait's state between platform steps and the step a stride makes (SI units).
 
@@ -73,9 +81,7 @@ class OnlineGait:
         """The stride of a normalised action a in [-1, 1] [m]: the full stride for a >= 0,
         shortened in proportion below (a = -0.5: half of it), at least `min_stride`, and
         within `room`."""
-        wanted = max(self.max_stride * (1.0 + min(float(action), 0.0)), self.min_stride)
-        room = self.room
-        return wanted if wanted <= room + STRIDE_TOLERANCE else max(room, 0.0)
+        return stride_of(action, self.max_stride, self.min_stride, self.room)
 
     def next_step(self, stride: float) -> PlatformStep:
         """The step of `stride` [m] from the current state (not taken: see `advance`)."""

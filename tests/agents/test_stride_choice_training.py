@@ -7,7 +7,7 @@ import pytest
 from helpers.ditch_stride_runs import CHOICES_CONFIG, train_tiny
 
 import hexapod_envs  # noqa: F401  (registers the ids)
-from agents.export import actor_module
+from agents.export import actor_module, export_model
 from agents.pipeline.training import untrained_model
 from agents.ppo import ChosenStride, PPOPolicy
 from agents.run_files.errors import UserError
@@ -18,17 +18,23 @@ SMALL = ["policy.pi=[16]", "policy.vf=[16]"]
 
 
 @pytest.mark.parametrize(
-    "overrides",
+    ("overrides", "named"),
     [
-        ["policy.score_read_actions_only=true"],
-        ["ppo.use_sde=true"],
-        ["env.decision=episode"],
-        ["hybrid={}"],
+        (["policy.score_read_actions_only=true"], "policy.score_read_actions_only: true"),
+        (["ppo.use_sde=true"], "ppo.use_sde: true"),
+        (["env.decision=step"], "env.decision: step (use gait_cycle)"),
+        (["hybrid={}"], "a hybrid section"),
     ],
 )
-def test_configs_that_need_the_envs_own_action_are_refused(overrides):
-    with pytest.raises(ValueError, match="stride_choices replaces the env's action"):
+def test_configs_that_need_the_envs_own_action_are_refused_by_name(overrides, named):
+    with pytest.raises(ValueError, match="does not go with") as error:
         load_train_config(CHOICES_CONFIG, overrides)
+    assert named in str(error.value)
+
+
+def test_choices_that_do_not_start_at_the_full_stride_are_refused():
+    with pytest.raises(ValueError, match=r"must start with 0.0, the full stride.*\[-0.5, 0.0\]"):
+        load_train_config(CHOICES_CONFIG, ["env.stride_choices=[-0.5, 0.0]"])
 
 
 def test_an_untrained_model_chooses_the_full_stride_and_samples_every_value():
@@ -54,7 +60,10 @@ def test_a_run_trains_and_loads_as_a_policy_of_the_plain_env_only(tmp_path):
     obs, _ = env.reset(seed=0)
     action = policy(obs)
     assert action.shape == (STRIDE_ACTION + 1,) and not np.any(action[:STRIDE_ACTION])
-    assert action[STRIDE_ACTION] in config.env.stride_choices
+    assert np.isclose(config.env.stride_choices, action[STRIDE_ACTION]).sum() == 1
+    with pytest.raises(UserError, match=r"chooses among stride values \(env.stride_choices"):
+        export_model(tmp_path / "run", tmp_path / "actor.onnx")
+    assert not (tmp_path / "actor.onnx").exists()
     residuals = gym.make("HexapodDitchCrossing-v1", task_distribution="train", stride_action=True)
     with pytest.raises(UserError, match="residual_limb_m=0 and residual_leg_m=0"):
         PPOPolicy.load(tmp_path / "run", residuals)
