@@ -58,3 +58,18 @@ def test_policy_strides_compares_a_policy_with_the_rule_at_the_rules_decisions()
     np.testing.assert_array_equal(zero.rule_short, rule.rule_short)  # the same decisions
     assert (zero.policy_short == 0.0).all()
     assert "policy shortens 0" in summary(zero)
+
+
+def test_held_out_factors_changes_one_range_and_plays_both_policies(tmp_path):
+    from helpers.ditch_stride_runs import CHOICES_CONFIG, train_tiny
+
+    from experiments.ditch_stride.held_out_factors import factor_rows, ranges_with
+    from hexapod_envs.envs.ditch_crossing import DITCH_TEST, DITCH_TRAIN
+
+    wide = ranges_with("width")
+    assert wide["width"] == DITCH_TEST.width and wide["depth"] == DITCH_TRAIN.depth
+    assert ranges_with("none")["width"] == DITCH_TRAIN.width
+    assert train_tiny(CHOICES_CONFIG, tmp_path) == 0
+    (row,) = factor_rows(str(tmp_path / "run"), ["width"], 1)
+    assert row["factor"] == "width" and len(row["policy"]) == len(row["full"]) == 2
+    assert row["full"] == (0, 1)  # full strides tip over on this task (a test-range width)
