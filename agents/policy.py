@@ -54,18 +54,30 @@ def settings_from_section(cls: type, section: Any) -> Any:
     return cls(**{name: section[name] for name in names if name in section})
 
 
-class LearnedWithController:
-    """Base of a learned policy combined with an analytical controller: ``learned`` (a `Policy`)
-    and ``core`` (what owns the controller). Attributes it lacks are the learned policy's (a
-    loaded model's files, train_env_kwargs...); ``reset`` resets both."""
+class AroundLearned:
+    """Base of a policy built around a learned `Policy`, ``learned``: attributes it lacks are
+    the learned policy's (a loaded model's files, train_env_kwargs...); ``reset`` resets it.
+    `_OWN` names the instance attributes a subclass sets itself (never looked up in
+    ``learned``, so a half-built copy raises AttributeError instead of recursing)."""
 
     learned: Policy
-    core: Any
+    _OWN: tuple[str, ...] = ("learned",)
 
     def __getattr__(self, name: str) -> Any:
-        if name in ("learned", "core"):
+        if name in self._OWN:
             raise AttributeError(name)
         return getattr(self.learned, name)
+
+    def reset(self) -> None:
+        self.learned.reset()
+
+
+class LearnedWithController(AroundLearned):
+    """Base of a learned policy combined with an analytical controller: ``learned`` (a `Policy`)
+    and ``core`` (what owns the controller); ``reset`` resets both."""
+
+    core: Any
+    _OWN = ("learned", "core")
 
     def reset(self) -> None:
         self.learned.reset()

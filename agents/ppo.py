@@ -20,7 +20,7 @@ from .hybrid import from_run_config
 from .knob_wiring import knobs_observation_space, knobs_policy
 from .knobs import KnobSettings
 from .knobs import settings_from_config as knob_settings
-from .policy import Policy
+from .policy import AroundLearned, Policy
 from .privileged_critic import pad_observation, privileged_space
 from .run_files.artifacts import ModelFiles, find_model, other_env_error, read_meta
 from .run_files.errors import UserError
@@ -176,39 +176,30 @@ def _stride_choices(env: gym.Env, config: dict[str, Any], files: ModelFiles) -> 
         raise UserError(f"cannot use the model at {files.model}: {exc}") from None
 
 
-class ChosenStride:
+class ChosenStride(AroundLearned):
     """A learned `Policy` of stride choices (a model trained with ``env.stride_choices``) as a
     policy of the plain ditch env: each choice becomes the env's action through `choices` (a
     `hexapod_envs.wrappers.StrideChoices`). Attributes it lacks are the learned policy's."""
 
+    _OWN = ("learned", "choices")
+
     def __init__(self, learned: Policy, choices: Any):
         self.learned, self.choices = learned, choices
-
-    def __getattr__(self, name: str) -> Any:
-        if name in ("learned", "choices"):
-            raise AttributeError(name)
-        return getattr(self.learned, name)
-
-    def reset(self) -> None:
-        self.learned.reset()
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:
         return self.choices.action(self.learned(observation))
 
 
-class HeldPerEpisode:
+class HeldPerEpisode(AroundLearned):
     """A learned `Policy` asked once per episode, at its first observation, whose action is then
     held: a model trained with ``env.decision: episode`` (`hexapod_envs.wrappers.GainsPerEpisode`)
     run at every step of the plain env. Attributes it lacks are the learned policy's."""
 
+    _OWN = ("learned", "_action")
+
     def __init__(self, learned: Policy):
         self.learned = learned
         self._action: np.ndarray | None = None
-
-    def __getattr__(self, name: str) -> Any:
-        if name == "learned":
-            raise AttributeError(name)
-        return getattr(self.learned, name)
 
     def reset(self) -> None:
         self.learned.reset()

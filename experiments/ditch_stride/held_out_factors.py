@@ -25,6 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 import hexapod_envs  # noqa: E402,F401
 from agents.ppo import PPOPolicy  # noqa: E402
 from agents.run_files.artifacts import find_model  # noqa: E402
+from experiments.ditch_stride.rules import play_episode  # noqa: E402
 from hexapod_envs.checks import count_argument  # noqa: E402
 from hexapod_envs.envs.ditch_crossing import DITCH_TEST, DITCH_TRAIN  # noqa: E402
 
@@ -43,17 +44,8 @@ def ranges_with(factor: str) -> dict[str, tuple[float, float]]:
 
 def play(env: gym.Env, policy, seeds) -> tuple[int, int]:
     """(successes, tip-overs) of `policy` on the tasks of `seeds`."""
-    wins = tips = 0
-    for seed in seeds:
-        obs, _ = env.reset(seed=seed)
-        policy.reset()
-        done = False
-        while not done:
-            obs, _, terminated, truncated, info = env.step(policy(obs))
-            done = terminated or truncated
-        wins += bool(info["is_success"])
-        tips += bool(info["is_tipped_over"])
-    return wins, tips
+    infos = [play_episode(env, policy, seed) for seed in seeds]
+    return sum(i["is_success"] for i in infos), sum(i["is_tipped_over"] for i in infos)
 
 
 class FullStrides:

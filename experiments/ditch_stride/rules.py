@@ -71,17 +71,22 @@ class StrideRule(ClearStridePolicy):
         return super().stride(ahead, upper_next)
 
 
+def play_episode(env: gym.Env, policy, seed: int) -> dict:
+    """The last info of one episode of `policy` from ``env.reset(seed=seed)``."""
+    obs, _ = env.reset(seed=seed)
+    policy.reset()
+    while True:
+        obs, _, terminated, truncated, info = env.step(policy(obs))
+        if terminated or truncated:
+            return info
+
+
 def run(rule: str, distribution: str, tasks: int, values=None) -> list[dict]:
     env = gym.make(ENV_ID, stride_action=True, task_distribution=distribution)
     policy = StrideRule(env, rule, values=values)
     rows = []
     for seed in range(tasks):
-        obs, info = env.reset(seed=seed)
-        policy.reset()
-        done = False
-        while not done:
-            obs, _, terminated, truncated, info = env.step(policy(obs))
-            done = terminated or truncated
+        info = play_episode(env, policy, seed)
         rows.append(
             {
                 "seed": seed,
