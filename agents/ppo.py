@@ -83,12 +83,14 @@ class PPOPolicy:
         observation_space = env.observation_space
         if knobs is not None:
             observation_space = knobs_observation_space(env, knobs)
-        if privileged:
-            observation_space = privileged_space(observation_space)
         action_space = env.action_space if knobs is None else knobs.action_space
-        choices = _stride_choices(env, config, files)
+        choices, clearances = _stride_choices(env, config, files)
         if choices is not None:
             action_space = choices.action_space
+        if clearances is not None:
+            observation_space = clearances.observation_space
+        if privileged:
+            observation_space = privileged_space(observation_space)
         for what, key, env_space in (
             ("observation", "observation_shape", observation_space),
             ("action", "action_shape", action_space),
@@ -110,7 +112,7 @@ class PPOPolicy:
         train_kwargs = (config.get("env") or {}).get("kwargs") or {}
         policy = cls(model, stats, files, deterministic, train_kwargs, privileged)
         if choices is not None:
-            return ChosenStride(policy, choices)
+            return ChosenStride(policy, choices, clearances)
         return _as_trained(policy, env, config, knobs)
 
     def reset(self) -> None:
@@ -162,31 +164,39 @@ def _as_trained(
         raise UserError(f"cannot use the model at {policy.files.model}: {exc}") from None
 
 
-def _stride_choices(env: gym.Env, config: dict[str, Any], files: ModelFiles) -> Any:
-    """A model trained with ``env.stride_choices``: `hexapod_envs.wrappers.StrideChoices` on
-    `env`, which turns its choices into `env`'s actions; None for any other model."""
-    values = (config.get("env") or {}).get("stride_choices")
+def _stride_choices(env: gym.Env, config: dict[str, Any], files: ModelFiles) -> tuple[Any, Any]:
+    """A model trained with ``env.stride_choices``: (`hexapod_envs.wrappers.StrideChoices` on
+    `env`, which turns its choices into `env`'s actions; `StrideClearances` on `env` if it
+    trained with ``env.stride_clearances``, else None); (None, None) for any other model."""
+    section = config.get("env") or {}
+    values = section.get("stride_choices")
     if values is None:
-        return None
-    from hexapod_envs.wrappers import StrideChoices
+        return None, None
+    from hexapod_envs.wrappers import StrideChoices, StrideClearances
 
     try:
-        return StrideChoices(env, values)
+        choices = StrideChoices(env, values)
+        clearances = StrideClearances(env, values) if section.get("stride_clearances") else None
     except ValueError as exc:
         raise UserError(f"cannot use the model at {files.model}: {exc}") from None
+    return choices, clearances
 
 
 class ChosenStride(AroundLearned):
     """A learned `Policy` of stride choices (a model trained with ``env.stride_choices``) as a
     policy of the plain ditch env: each choice becomes the env's action through `choices` (a
-    `hexapod_envs.wrappers.StrideChoices`). Attributes it lacks are the learned policy's."""
+    `hexapod_envs.wrappers.StrideChoices`); with `clearances` (a `StrideClearances`), the
+    learned policy sees the observation as it trained on it. Attributes it lacks are the learned
+    policy's."""
 
-    _OWN = ("learned", "choices")
+    _OWN = ("learned", "choices", "clearances")
 
-    def __init__(self, learned: Policy, choices: Any):
-        self.learned, self.choices = learned, choices
+    def __init__(self, learned: Policy, choices: Any, clearances: Any = None):
+        self.learned, self.choices, self.clearances = learned, choices, clearances
 
     def __call__(self, observation: np.ndarray) -> np.ndarray:
+        if self.clearances is not None:
+            observation = self.clearances.observation(np.asarray(observation))
         return self.choices.action(self.learned(observation))
 
 

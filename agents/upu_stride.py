@@ -25,9 +25,7 @@ import gymnasium as gym
 import numpy as np
 
 from hexapod_envs.envs.ditch_crossing import STRIDE_ACTION
-from hexapod_envs.robots.upu.gait_plan import edge_clearance
-from hexapod_envs.robots.upu.online_gait import stride_of
-from hexapod_envs.robots.upu.params import PLATFORM_LEGS
+from hexapod_envs.robots.upu.stride_clearance import StrideClearance
 
 from .policy import ObservationReader
 
@@ -50,16 +48,8 @@ class ClearStridePolicy:
             )
         self.env = base
         self.read = ObservationReader(base.observation_structure)
-        params = base.params
-        self.band = base.edge_band
-        """How far from an edge a foot must land [m]."""
-        self.reach = params.leg_extend
-        """The deepest ditch a foot can stand in [m]."""
-        self.offsets = {
-            m: np.array([params.foot_offset(leg)[0] for leg in PLATFORM_LEGS[m]])
-            for m in PLATFORM_LEGS
-        }
-        """Each platform's feet, x relative to its centre [m]."""
+        self.geometry = StrideClearance.of(base.params, base.gait_settings)
+        """Where each candidate stride lands the moving feet."""
         self.n_actions = base.action_space.shape[0]
         self.values = None if values is None else np.asarray(values, dtype=np.float64)
         if self.values is not None and not (
@@ -81,20 +71,8 @@ class ClearStridePolicy:
 
     def stride(self, ahead: np.ndarray, upper_next: bool) -> float:
         """The stride value for the platform about to move, from ``ditch_ahead``."""
-        gait = self.env.online_gait  # the robot's stride limits: constants of the env
-        near_u, far_u, near_l, far_l, depth = ahead
-        lead = near_l - near_u  # x_upper - x_lower
-        room = gait.max_stride - lead if upper_next else lead
-        near, far = (near_u, far_u) if upper_next else (near_l, far_l)
-        feet0 = self.offsets["upper" if upper_next else "lower"]
-        grid = gait.min_stride
-        if self.values is None:
-            strides = np.arange(max(room, grid), grid - 1e-9, -grid)
-        else:
-            strides = np.array([stride_of(v, gait.max_stride, grid, room) for v in self.values])
-        feet = strides[:, None] + feet0[None, :]  # foot x in the frame of the edges
-        # Too deep to stand in (depth > reach): a foot may not land in the ditch at all.
-        clear = edge_clearance(feet, near, far, self.band, depth <= self.reach).min(axis=1)
-        ok = np.flatnonzero(clear >= self.band)
+        strides, clear = self.geometry.candidates(ahead, upper_next, self.values)
+        band = self.geometry.band
+        ok = np.flatnonzero(clear >= band)
         best = ok[np.argmax(strides[ok])] if ok.size else int(np.argmax(clear))
-        return stride_value(float(strides[best]), gait.max_stride)
+        return stride_value(float(strides[best]), self.geometry.max_stride)

@@ -36,6 +36,7 @@ cycles, so per-cycle rewards credit little of it). The step's reward is the epis
 `gymnasium.spaces.Discrete` action), the residuals off. A Gaussian policy that starts at the full
 stride moves its mean by small steps, and on the way to a stride that clears an edge it meets
 strides that land a foot on it; a categorical policy weighs each value apart.
+`StrideClearances` appends where each choice would land the moving feet.
 
 `StabilityRulePenalty`: per-step penalties that mirror a ``-v1`` success rule's bounds on the
 time spent tipping and the largest tilt (and, on the cliff walk, its pace), for learners that
@@ -312,30 +313,16 @@ class StrideChoices(gym.ActionWrapper):
 
     def __init__(self, env: gym.Env, values: Any):
         super().__init__(env)
-        base = env.unwrapped
-        if not getattr(base, "stride_action", False):
-            raise ValueError(
-                f"StrideChoices needs HexapodDitchCrossing-* with stride_action=True, got "
-                f"{_env_name(env)}"
-            )
+        base = _stride_env(env, "StrideChoices")
         if len(base.inert_actions) != env.action_space.shape[0] - 1:
             raise ValueError(
                 "StrideChoices sets only the stride value; it needs residual_limb_m=0 and "
                 f"residual_leg_m=0 (got {base.settings.residual_limb_m} and "
                 f"{base.settings.residual_leg_m})"
             )
-        values = np.asarray(values, dtype=np.float64)
-        if values.ndim != 1 or values.size < 2:
-            raise ValueError(f"StrideChoices needs a list of at least 2 values, got {values!r}")
-        if not (np.all(np.isfinite(values)) and np.all((values >= -1.0) & (values <= 0.0))):
-            raise ValueError(
-                f"stride values must lie in [-1, 0] (0: the full stride), got {values.tolist()}"
-            )
-        if np.unique(values).size != values.size:
-            raise ValueError(f"stride values must differ, got {values.tolist()}")
-        self.values = values
+        self.values = _stride_values(values, "StrideChoices")
         (self.stride_index,) = base.action_read_flags
-        self.action_space = gym.spaces.Discrete(values.size)
+        self.action_space = gym.spaces.Discrete(self.values.size)
 
     def action(self, action: Any) -> np.ndarray:
         choice = int(np.asarray(action).reshape(()))
@@ -344,6 +331,69 @@ class StrideChoices(gym.ActionWrapper):
         full = np.zeros(self.env.action_space.shape, dtype=self.env.action_space.dtype)
         full[self.stride_index] = self.values[choice]
         return full
+
+
+class StrideClearances(gym.ObservationWrapper):
+    """The ditch crossing's observation (``stride_action=True``) with one value appended per
+    stride value in `values`: where the next platform step, taking that stride, lands the moving
+    platform's worst-placed foot, as its clearance from the nearer ditch edge less the clear
+    band [m] (>= 0: every foot clear; `hexapod_envs.robots.upu.stride_clearance`), clipped to
+    +-`bound`.
+
+    The values are a function of the observation (``ditch_ahead``, ``stride_decision``) and the
+    robot's constants, the geometry the clear-stride rule computes; they let a learner of
+    `StrideChoices` weigh each choice by where it lands instead of from the edges' positions,
+    which do not extrapolate to ditches wider or farther than those it trained on. A ValueError
+    names the problem for another env or bad values."""
+
+    def __init__(self, env: gym.Env, values: Any, bound: float = 0.3):
+        super().__init__(env)
+        base = _stride_env(env, "StrideClearances")
+        from .robots.upu.stride_clearance import StrideClearance
+
+        self.values = _stride_values(values, "StrideClearances")
+        self.bound = float(bound)
+        self.geometry = StrideClearance.of(base.params, base.gait_settings)
+        slices = base.observation_layout.slices
+        self._ahead, self._decision = slices["ditch_ahead"], slices["stride_decision"]
+        space = env.observation_space
+        low = np.concatenate([space.low, np.full(self.values.size, -self.bound)])
+        high = np.concatenate([space.high, np.full(self.values.size, self.bound)])
+        self.observation_space = gym.spaces.Box(low, high, dtype=space.dtype)
+
+    def clearances(self, observation: np.ndarray) -> np.ndarray:
+        """Each stride value's clearance less the band [m], clipped to +-`bound`."""
+        upper_next = observation[self._decision][0] > 0.5
+        _, clear = self.geometry.candidates(observation[self._ahead], upper_next, self.values)
+        return np.clip(clear - self.geometry.band, -self.bound, self.bound)
+
+    def observation(self, observation: np.ndarray) -> np.ndarray:
+        extra = self.clearances(observation).astype(observation.dtype)
+        return np.concatenate([observation, extra])
+
+
+def _stride_env(env: gym.Env, wrapper: str) -> Any:
+    """The ditch crossing under `env`, which must have the stride action."""
+    base = env.unwrapped
+    if not getattr(base, "stride_action", False):
+        raise ValueError(
+            f"{wrapper} needs HexapodDitchCrossing-* with stride_action=True, got {_env_name(env)}"
+        )
+    return base
+
+
+def _stride_values(values: Any, wrapper: str) -> np.ndarray:
+    """`values` as stride values: at least 2, distinct, in [-1, 0]."""
+    values = np.asarray(values, dtype=np.float64)
+    if values.ndim != 1 or values.size < 2:
+        raise ValueError(f"{wrapper} needs a list of at least 2 values, got {values!r}")
+    if not (np.all(np.isfinite(values)) and np.all((values >= -1.0) & (values <= 0.0))):
+        raise ValueError(
+            f"stride values must lie in [-1, 0] (0: the full stride), got {values.tolist()}"
+        )
+    if np.unique(values).size != values.size:
+        raise ValueError(f"stride values must differ, got {values.tolist()}")
+    return values
 
 
 class StabilityRulePenalty(gym.Wrapper):

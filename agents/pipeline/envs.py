@@ -104,6 +104,10 @@ class EnvSpec:
     stride_choices: list[float] | None = None
     """The ditch crossing's stride action as a choice among these stride values
     (`hexapod_envs.wrappers.StrideChoices`, inside the decision wrappers); None: the env's."""
+    stride_clearances: bool = False
+    """Append each stride choice's landing clearance to the observation
+    (`hexapod_envs.wrappers.StrideClearances`, inside `PrivilegedObservation`: the actor sees
+    it); needs `stride_choices`."""
 
     def make(self, **extra: Any) -> gym.Env:
         """gym.make (then the hybrid wrapper, if any) with the env's own errors (bad kwargs)
@@ -130,6 +134,11 @@ class EnvSpec:
             weight, progress = self.stability_penalty, self.progress_penalty
             where = f"env.stability_penalty / env.progress_penalty on {self.id}"
             env = _wrapped(env, lambda e: StabilityRulePenalty(e, weight, progress), where)
+        if self.stride_clearances:
+            from hexapod_envs.wrappers import StrideClearances
+
+            choices, where = self.stride_choices, f"env.stride_clearances on {self.id}"
+            env = _wrapped(env, lambda e: StrideClearances(e, choices), where)
         if self.privileged_critic:
             from ..privileged_critic import PrivilegedObservation
 

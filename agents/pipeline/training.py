@@ -105,6 +105,7 @@ def env_spec(config: TrainConfig) -> EnvSpec:
         env.stability_penalty,
         env.progress_penalty,
         None if env.stride_choices is None else list(env.stride_choices),
+        env.stride_clearances,
     )
 
 

@@ -112,6 +112,10 @@ class EnvConfig:
     half of it), learnt by a categorical policy once per platform step (``decision:
     gait_cycle``); the first must be the full stride (0.0): an untrained model takes it
     deterministically, its step 0. None: the env's own action."""
+    stride_clearances: bool = False
+    """With ``stride_choices``: append to the observation, for each stride value, where it would
+    land the moving platform's worst-placed foot relative to the ditch's edges
+    (`hexapod_envs.wrappers.StrideClearances`); the actor sees it."""
     vectorization: Literal["vec_env", "batched"] = "vec_env"
     """How the ``vec_env.n_envs`` training envs run: "vec_env", the SB3 vec env that
     ``vec_env.type`` picks (SubprocVecEnv or DummyVecEnv); "batched", one process whose envs'
@@ -489,6 +493,11 @@ class TrainConfig:
             )
         if self.env.stride_choices is not None:
             self._check_stride_choices()
+        elif self.env.stride_clearances:
+            raise ValueError(
+                "env.stride_clearances appends one value per stride choice; it needs "
+                "env.stride_choices"
+            )
         if self.policy.score_read_actions_only and (
             self.hybrid is not None
             or self.knobs is not None

@@ -67,3 +67,26 @@ def test_a_run_trains_and_loads_as_a_policy_of_the_plain_env_only(tmp_path):
     residuals = gym.make("HexapodDitchCrossing-v1", task_distribution="train", stride_action=True)
     with pytest.raises(UserError, match="residual_limb_m=0 and residual_leg_m=0"):
         PPOPolicy.load(tmp_path / "run", residuals)
+
+
+def test_clearances_need_stride_choices():
+    with pytest.raises(ValueError, match="env.stride_clearances .* needs env.stride_choices"):
+        load_train_config(CHOICES_CONFIG, ["env.stride_choices=null", "env.stride_clearances=true"])
+
+
+def test_a_run_with_clearances_loads_seeing_them(tmp_path):
+    """The run's config says the model saw each choice's clearance: the loaded policy appends
+    them to the plain env's observation; without that key the shapes disagree, by name."""
+    assert train_tiny(CHOICES_CONFIG, tmp_path, "env.stride_clearances=true") == 0
+    env = gym.make("HexapodDitchCrossing-v1", **load_train_config(CHOICES_CONFIG).env.kwargs)
+    policy = PPOPolicy.load(tmp_path / "run", env)
+    assert isinstance(policy, ChosenStride) and policy.clearances is not None
+    obs, _ = env.reset(seed=0)
+    assert policy.clearances.observation(obs).shape == (obs.size + 5,)
+    assert policy(obs)[STRIDE_ACTION] in np.float32(
+        load_train_config(CHOICES_CONFIG).env.stride_choices
+    )
+    for config in (tmp_path / "run").rglob("config.yaml"):  # the run's and each model's
+        config.write_text(config.read_text().replace("clearances: true", "clearances: false"))
+    with pytest.raises(UserError, match=r"expects observation shape \(\d+,\)"):
+        PPOPolicy.load(tmp_path / "run", env)

@@ -1,4 +1,5 @@
-"""The ditch crossing's stride action as a choice among stride values (`StrideChoices`)."""
+"""The ditch crossing's stride action as a choice among stride values (`StrideChoices`) and
+each choice's landing clearance in the observation (`StrideClearances`)."""
 
 import gymnasium as gym
 import numpy as np
@@ -6,8 +7,9 @@ import pytest
 from helpers.ditch_stride_runs import STRIDES_OFF
 
 import hexapod_envs  # noqa: F401  (registers the env ids)
+from agents.upu_stride import ClearStridePolicy
 from hexapod_envs.envs.ditch_crossing import STRIDE_ACTION
-from hexapod_envs.wrappers import GainsPerCycle, StrideChoices
+from hexapod_envs.wrappers import GainsPerCycle, StrideChoices, StrideClearances
 
 ENV_ID = "HexapodDitchCrossing-v1"
 STRIDES = STRIDES_OFF
@@ -69,3 +71,46 @@ def test_other_envs_residuals_and_bad_values_are_refused_by_name(kwargs, values,
     env = gym.make(ENV_ID, **kwargs)
     with pytest.raises(ValueError, match=match):
         StrideChoices(env, values)
+
+
+def test_the_clearances_follow_the_observation_and_rank_choices_as_the_rule_does():
+    """On a test ditch the clear-stride rule drives: the wrapped observation is the plain one
+    and one value per choice in [-0.3, 0.3] m; at each decision the rule takes the longest
+    choice whose value is >= 0 (every foot clear), or the largest value where none is."""
+    kwargs = {**STRIDES, "task_distribution": "test", "max_episode_steps": None}
+    env = StrideClearances(gym.make(ENV_ID, **kwargs), VALUES)
+    plain = env.env
+    rule = ClearStridePolicy(plain, values=VALUES)
+    n = plain.observation_space.shape[0]
+    assert env.observation_space.shape == (n + 5,)
+    obs, _ = env.reset(seed=1)
+    flag = plain.unwrapped.observation_layout.slices["stride_decision"].start + 1
+    done, decisions, shortened = False, 0, 0
+    while not done:
+        assert env.observation_space.contains(obs)
+        clearances, action = obs[n:], rule(obs[:n])
+        np.testing.assert_array_equal(clearances, env.clearances(obs[:n]))
+        if obs[flag] == 1.0:
+            upper_next = obs[env._decision][0] > 0.5
+            strides, _ = env.geometry.candidates(obs[env._ahead], upper_next, VALUES)
+            clear = np.flatnonzero(clearances >= 0)
+            expected = strides[clear].max() if clear.size else strides[np.argmax(clearances)]
+            stride = env.geometry.max_stride * (1.0 + action[STRIDE_ACTION])
+            assert stride == pytest.approx(expected, abs=1e-6)
+            decisions += 1
+            shortened += expected < strides[0]
+        obs, _, term, trunc, _ = env.step(action)
+        done = term or trunc
+    assert decisions >= 15 and shortened >= 2
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "values", "match"),
+    [
+        ({}, VALUES, "StrideClearances needs HexapodDitchCrossing-\\* with stride_action=True"),
+        (STRIDES, [0.0, 0.5], r"lie in \[-1, 0\]"),
+    ],
+)
+def test_clearances_refuse_other_envs_and_bad_values_by_name(kwargs, values, match):
+    with pytest.raises(ValueError, match=match):
+        StrideClearances(gym.make(ENV_ID, **kwargs), values)
