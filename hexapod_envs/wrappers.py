@@ -352,6 +352,8 @@ class StrideClearances(gym.ObservationWrapper):
         from .robots.upu.stride_clearance import StrideClearance
 
         self.values = _stride_values(values, "StrideClearances")
+        if not bound > 0:
+            raise ValueError(f"StrideClearances needs a bound > 0 [m], got {bound!r}")
         self.bound = float(bound)
         self.geometry = StrideClearance.of(base.params, base.gait_settings)
         slices = base.observation_layout.slices

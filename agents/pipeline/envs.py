@@ -85,7 +85,7 @@ class EnvSpec:
     privileged_critic: bool = False
     """Append the task and the episode's elapsed share to the observation for an asymmetric
     critic (`agents.privileged_critic.PrivilegedObservation`, inside every wrapper but
-    `MinimumDifficulty` and `StabilityRulePenalty`)."""
+    `MinimumDifficulty`, `StabilityRulePenalty` and `StrideClearances`)."""
     knobs: Any = None
     """`agents.knobs.KnobSettings` (or the training config's ``knobs`` section): one learner
     step per tipping event, which sets the recovery's knobs (`agents.knobs.KnobsPerEvent`), or
@@ -177,6 +177,11 @@ class EnvSpec:
     def _check_decision(self) -> None:
         """`decision` and `cycle_baseline` name valid choices that fit together (before any env
         is built)."""
+        if self.stride_clearances and self.stride_choices is None:
+            raise UserError(
+                "env.stride_clearances appends one value per stride choice; it needs "
+                "env.stride_choices"
+            )
         if self.decision not in ("step", "gait_cycle", "episode"):
             raise UserError(
                 f"env.decision must be 'step', 'gait_cycle' or 'episode', got {self.decision!r}"

@@ -1,14 +1,18 @@
 """A categorical stride learner (``env.stride_choices``) trains, loads as a policy of the plain
 ditch env and starts at the full stride."""
 
+from dataclasses import replace
+
 import gymnasium as gym
 import numpy as np
 import pytest
+import torch
 from helpers.ditch_stride_runs import CHOICES_CONFIG, train_tiny
+from stable_baselines3.common.utils import obs_as_tensor
 
 import hexapod_envs  # noqa: F401  (registers the ids)
 from agents.export import actor_module, export_model
-from agents.pipeline.training import untrained_model
+from agents.pipeline.training import env_spec, untrained_model
 from agents.ppo import ChosenStride, PPOPolicy
 from agents.run_files.errors import UserError
 from agents.run_files.train_config import load_train_config
@@ -75,18 +79,44 @@ def test_clearances_need_stride_choices():
 
 
 def test_a_run_with_clearances_loads_seeing_them(tmp_path):
-    """The run's config says the model saw each choice's clearance: the loaded policy appends
-    them to the plain env's observation; without that key the shapes disagree, by name."""
+    """The run's config says the model saw each choice's clearance: on the plain env the loaded
+    policy's actor gets exactly the training env's observation (clearances inside the
+    privileged critic's values, which the actor ignores); without that key the shapes
+    disagree, by name."""
     assert train_tiny(CHOICES_CONFIG, tmp_path, "env.stride_clearances=true") == 0
-    env = gym.make("HexapodDitchCrossing-v1", **load_train_config(CHOICES_CONFIG).env.kwargs)
+    config = load_train_config(CHOICES_CONFIG, ["env.stride_clearances=true"])
+    env = gym.make("HexapodDitchCrossing-v1", **config.env.kwargs)
+    training = replace(env_spec(config), decision="step").make()  # as the evaluations run
     policy = PPOPolicy.load(tmp_path / "run", env)
     assert isinstance(policy, ChosenStride) and policy.clearances is not None
-    obs, _ = env.reset(seed=0)
+    learned = policy.learned
+    with torch.no_grad():  # a tiny run's logits barely move: make every actor input count
+        torch.manual_seed(0)
+        learned.model.policy.action_net.weight.normal_()
+    seen, chosen = [], []  # what the actor got and chose through the load path
+    predict = learned.model.predict
+
+    def recorded(obs, **kwargs):
+        seen.append(obs)
+        chosen.append(predict(obs, **kwargs)[0])
+        return chosen[-1], None
+
+    learned.model.predict = recorded
+    obs, _ = env.reset(seed=3)
+    obs_training, _ = training.reset(seed=3)
     assert policy.clearances.observation(obs).shape == (obs.size + 5,)
-    assert policy(obs)[STRIDE_ACTION] in np.float32(
-        load_train_config(CHOICES_CONFIG).env.stride_choices
-    )
-    for config in (tmp_path / "run").rglob("config.yaml"):  # the run's and each model's
-        config.write_text(config.read_text().replace("clearances: true", "clearances: false"))
+    for _ in range(60):
+        action = policy(obs)
+        assert action[STRIDE_ACTION] in np.float32(config.env.stride_choices)
+        logits = [
+            learned.model.policy.get_distribution(obs_as_tensor(o[None], "cpu")).distribution.logits
+            for o in (seen[-1], learned.stats.normalize_obs(obs_training))
+        ]
+        np.testing.assert_array_equal(*(x.detach().numpy() for x in logits))
+        obs = env.step(action)[0]
+        obs_training = training.step(int(chosen[-1]))[0]
+    for config_file in (tmp_path / "run").rglob("config.yaml"):  # the run's and each model's
+        text = config_file.read_text().replace("clearances: true", "clearances: false")
+        config_file.write_text(text)
     with pytest.raises(UserError, match=r"expects observation shape \(\d+,\)"):
         PPOPolicy.load(tmp_path / "run", env)

@@ -9,6 +9,7 @@ from helpers.ditch_stride_runs import STRIDES_OFF
 import hexapod_envs  # noqa: F401  (registers the env ids)
 from agents.upu_stride import ClearStridePolicy
 from hexapod_envs.envs.ditch_crossing import STRIDE_ACTION
+from hexapod_envs.robots.upu.gait_plan import edge_clearance
 from hexapod_envs.wrappers import GainsPerCycle, StrideChoices, StrideClearances
 
 ENV_ID = "HexapodDitchCrossing-v1"
@@ -75,8 +76,9 @@ def test_other_envs_residuals_and_bad_values_are_refused_by_name(kwargs, values,
 
 def test_the_clearances_follow_the_observation_and_rank_choices_as_the_rule_does():
     """On a test ditch the clear-stride rule drives: the wrapped observation is the plain one
-    and one value per choice in [-0.3, 0.3] m; at each decision the rule takes the longest
-    choice whose value is >= 0 (every foot clear), or the largest value where none is."""
+    and one value per choice in [-0.3, 0.3] m; the chosen value's is where the env then plans
+    the moving feet (world frame, its own ditch), and the rule takes the longest choice whose
+    value is >= 0 (every foot clear), or the largest value where none is."""
     kwargs = {**STRIDES, "task_distribution": "test", "max_episode_steps": None}
     env = StrideClearances(gym.make(ENV_ID, **kwargs), VALUES)
     plain = env.env
@@ -85,12 +87,14 @@ def test_the_clearances_follow_the_observation_and_rank_choices_as_the_rule_does
     assert env.observation_space.shape == (n + 5,)
     obs, _ = env.reset(seed=1)
     flag = plain.unwrapped.observation_layout.slices["stride_decision"].start + 1
+    base = plain.unwrapped
     done, decisions, shortened = False, 0, 0
     while not done:
         assert env.observation_space.contains(obs)
         clearances, action = obs[n:], rule(obs[:n])
         np.testing.assert_array_equal(clearances, env.clearances(obs[:n]))
-        if obs[flag] == 1.0:
+        decided = obs[flag] == 1.0
+        if decided:
             upper_next = obs[env._decision][0] > 0.5
             strides, _ = env.geometry.candidates(obs[env._ahead], upper_next, VALUES)
             clear = np.flatnonzero(clearances >= 0)
@@ -101,6 +105,16 @@ def test_the_clearances_follow_the_observation_and_rank_choices_as_the_rule_does
             shortened += expected < strides[0]
         obs, _, term, trunc, _ = env.step(action)
         done = term or trunc
+        if decided:  # the env has just planned the step
+            step, d = base.online_gait.steps[-1], base.ditch
+            feet = step.end_x + env.geometry.feet_x[step.moving]
+            planned = edge_clearance(
+                feet, d.start_x, d.end_x, base.edge_band, d.depth <= base.params.leg_extend
+            )
+            k = int(np.argmin(np.abs(strides - step.stride)))
+            assert clearances[k] == pytest.approx(
+                np.clip(planned.min() - base.edge_band, -0.3, 0.3), abs=1e-6
+            )
     assert decisions >= 15 and shortened >= 2
 
 

@@ -3,7 +3,8 @@ numpy.
 
 The ditch crossing's stride action (``stride_action=True``) sets each platform step's stride as
 it begins. Where a stride lands a foot depends only on where the ditch's edges lie relative to
-the moving platform's centre and on the robot's constants, both known at the decision: this is
+both platform centres (the other platform caps the stride) and on the robot's constants, all
+known at the decision: this is
 the geometry of the clear-stride rule (`agents.upu_stride.ClearStridePolicy`) and of the
 stride-choices observation (`hexapod_envs.wrappers.StrideClearances`).
 """
@@ -31,7 +32,7 @@ class StrideClearance:
     reach: float
     """The deepest ditch a foot can stand in [m]; a deeper one may not take a foot at all."""
     max_stride: float
-    """The longest stride [m] (eq. 17)."""
+    """The longest stride [m] (`gait_plan.stride_limit`: eq. 17 or the settings' cap)."""
     grid: float
     """The shortest stride and the planner's stride grid [m]."""
 
