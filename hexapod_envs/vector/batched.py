@@ -40,9 +40,10 @@ single env's warm start from one control period to the next. `mujoco.batch` keep
 `MjData` per simulation, which would have to be copied into each env's data in and out of
 every step, and ATHENA's contact checks within a period would be reimplemented.
 
-What the threads buy, and what caps it (the calling thread's share of a step, two cores that
-together run physics only 1.3-1.9 x as fast as one): benchmarks/README.md,
-``bench_vector_env.py``.
+What the threads buy, and what caps it: every world's step outside the physics runs on the
+calling thread, so the batched env pays on few cores and SubprocVecEnv, which runs a Python per
+process, overtakes it on many; and cores run the worlds' physics side by side less than
+linearly (benchmarks/README.md, ``bench_vector_env.py``).
 """
 
 from __future__ import annotations
