@@ -11,13 +11,15 @@ with the physics on the calling thread (Gymnasium's SyncVectorEnv loop: what the
 machinery costs). Configurations are measured in turn, `--rounds` times, best of the rounds
 (the machine is shared: interference only slows a run down). Beside the rates, this process's
 CPU per env step (all threads, and the calling thread's: not for subprocess envs) and the rate
-those allow on 2 free cores (1 / CPU for the single env; 1 / max(main, CPU / 2) with the
+those allow on free cores (1 / CPU for the single env; 1 / max(main, CPU / threads) with the
 physics threads): the figure a loaded machine cannot show. Each env also gets its step profile
 (`common.step_profile`: physics against the env's Python, µs per step) and the ceiling of any
-batching on this machine: 16 worlds' physics alone (their `_simulate`, no other Python) on one
-thread and on the 2 threads, the rate against one env that a batched env with no Python cost
-would reach at that scaling (from the step profile: its physics and Python), and the CPU per
-world step that the 1.8 x target allows with both cores fully used.
+batching on this machine: 16 worlds' physics alone (no other Python) on one thread and on the
+2 threads as the batched env runs it (compiled shares, or a thread pool for ATHENA); the same
+worlds' trajectories stepped alone and interleaved (what interleaving costs the physics); the
+rate against one env that a batched env with no Python cost would reach (one env's step over
+the interleaved physics split at that scaling), and the CPU per world step that the 1.8 x
+target allows with both cores fully used.
 
 PPO rows: configs/cliff_walk_ppo.yaml on HexapodCliffWalk-v1 with the same rollout size
 (`--rollout` steps over all envs) and `--ppo-steps` steps: SubprocVecEnv(2), the batched
@@ -58,6 +60,9 @@ from agents.pipeline.batched_vec_env import make_batched_vec_env  # noqa: E402
 from agents.pipeline.envs import EnvSpec, make_vec_env  # noqa: E402
 from agents.run_files.train_config import load_train_config  # noqa: E402
 from benchmarks.common import step_profile, verdict  # noqa: E402
+from hexapod_envs.vector import BatchedPhysics  # noqa: E402
+from hexapod_envs.vector.batched import load_period  # noqa: E402
+from hexapod_envs.vector.compiled_steps import run_control_periods  # noqa: E402
 
 ENV_IDS = ("HexapodCliffWalk-v1", "HexapodStewartTilt-v1", "HexapodIrregularTerrain-v1")
 KWARGS = {"task_distribution": "train"}
@@ -157,9 +162,12 @@ def physics_ceiling(
     env_id: str, seconds: float, n_worlds: int, threads: int
 ) -> tuple[float, float]:
     """The batching's ceiling on this machine: µs of wall time per world and control period of
-    the physics alone (each world's `_simulate`, no other Python), `n_worlds` worlds in turn on
-    the calling thread, and split between `threads` threads. Each round restores every world to
-    the state it had after 50 random-action steps, so both figures step the same states."""
+    the physics alone (no other Python), `n_worlds` worlds in turn on the calling thread (each
+    world's `_simulate`), and split between `threads` threads as the batched env runs them: in
+    contiguous compiled shares that hold no GIL where the worlds' periods are plain MuJoCo steps
+    (`BatchedPhysics.compiled`), else each world's `_simulate` on a thread pool. Each round
+    restores every world to the state it had after 50 random-action steps (each thread its own
+    worlds), so both figures step the same states."""
     worlds = []
     for seed in range(n_worlds):
         env = gym.make(env_id, **KWARGS)
@@ -172,9 +180,13 @@ def physics_ceiling(
         mujoco.mj_getState(world.model, world.data, state, spec)
         worlds.append((world, state, spec, env))
 
-    def periods(share: list) -> None:
+    def restore(share: list) -> None:
         for world, state, spec, _ in share:
             mujoco.mj_setState(world.model, world.data, state, spec)
+
+    def periods(share: list) -> None:
+        restore(share)
+        for world, *_ in share:
             world._simulate()
 
     def per_world(run: Callable[[], None]) -> float:
@@ -184,13 +196,36 @@ def physics_ceiling(
             rounds += 1
         return elapsed / (rounds * n_worlds) * 1e6
 
+    engine = BatchedPhysics([world for world, *_ in worlds], threads)
+    compiled = engine.compiled
+    engine.close()
     with ThreadPoolExecutor(threads) as pool:
-        shares = [worlds[k::threads] for k in range(threads)]
-        threaded = per_world(lambda: list(pool.map(periods, shares)))
+        if compiled:
+            arrays = _period_arrays([world for world, *_ in worlds])
+            bounds = [n_worlds * k // threads for k in range(threads + 1)]
+
+            def share(k: int) -> None:
+                restore(worlds[bounds[k] : bounds[k + 1]])
+                run_control_periods(*arrays, bounds[k], bounds[k + 1])
+
+            threaded = per_world(lambda: list(pool.map(share, range(threads))))
+        else:
+            shares = [worlds[k::threads] for k in range(threads)]
+            threaded = per_world(lambda: list(pool.map(periods, shares)))
     one = per_world(lambda: periods(worlds))
     for *_, env in worlds:
         env.close()
     return one, threaded
+
+
+def _period_arrays(worlds: list) -> tuple[np.ndarray, ...]:
+    """`run_control_periods`' arrays for one control period of each of `worlds`."""
+    n = len(worlds)
+    arrays = (np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros((n, 2), np.int32))
+    arrays += (np.zeros(n, np.int64), np.zeros(n, np.int8))
+    for k, world in enumerate(worlds):
+        load_period(arrays, k, world)
+    return arrays
 
 
 def interleaving_cost(env_id: str, n_worlds: int, steps: int) -> tuple[float, float]:

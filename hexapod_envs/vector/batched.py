@@ -192,16 +192,9 @@ class BatchedPhysics:
         own = n if helpers == 0 else min(n - 1, max(0, round(self._own_share * n)))
         bounds = [own + (n - own) * h // helpers for h in range(helpers + 1)] if helpers else []
         args = (self._models, self._datas, self._flags, self._nsteps, self._done)
-        models, datas, flags, nsteps, done = args
         expected = {}
         for k, i in enumerate(order):
-            world = self.worlds[i]
-            models[k], datas[k] = world.model._address, world.data._address
-            own_flags = world.model.opt.disableflags
-            flags[k] = own_flags if world._sensors_every_step else own_flags | SENSORS_OFF
-            flags[k, 1] = own_flags
-            nsteps[k] = world.n_substeps
-            done[k] = 0
+            load_period(args, k, self.worlds[i])
         shares = {}
         for start, stop in zip(bounds[:-1], bounds[1:], strict=False):
             for k in range(start, stop):
@@ -346,6 +339,19 @@ _POLL_S = 5e-5
 
 _STORES_IN_ORDER = platform.machine().lower() in ("x86_64", "amd64")
 """Other cores see a thread's stores in the order it made them (x86-64's memory model)."""
+
+
+def load_period(arrays: Sequence[np.ndarray], k: int, world: HexapodEnv) -> None:
+    """Row `k` of `run_control_periods`' arrays (models, datas, flags, nsteps, done) for one
+    control period of `world`: its model's and data's addresses, the flags of the period's steps
+    (the sensors off before the last, unless they keep a history), its steps, not done."""
+    models, datas, flags, nsteps, done = arrays
+    models[k], datas[k] = world.model._address, world.data._address
+    own_flags = world.model.opt.disableflags
+    flags[k] = own_flags if world._sensors_every_step else own_flags | SENSORS_OFF
+    flags[k, 1] = own_flags
+    nsteps[k] = world.n_substeps
+    done[k] = 0
 
 
 def _run_share(started: threading.Event, *args) -> None:
