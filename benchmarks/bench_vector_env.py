@@ -14,12 +14,12 @@ CPU per env step (all threads, and the calling thread's: not for subprocess envs
 those allow on free cores (1 / CPU for the single env; 1 / max(main, CPU / threads) with the
 physics threads): the figure a loaded machine cannot show. Each env also gets its step profile
 (`common.step_profile`: physics against the env's Python, µs per step) and the ceiling of any
-batching on this machine: 16 worlds' physics alone (no other Python) on one thread and on the
-2 threads as the batched env runs it (compiled shares, or a thread pool for ATHENA); the same
-worlds' trajectories stepped alone and interleaved (what interleaving costs the physics); the
-rate against one env that a batched env with no Python cost would reach (one env's step over
-the interleaved physics split at that scaling), and the CPU per world step that the 1.8 x
-target allows with both cores fully used.
+batching on this machine: the largest batch's worlds' physics alone (no other Python) on one
+thread and on the physics threads as the batched env runs it (compiled shares, or a thread
+pool for ATHENA); the same worlds' trajectories stepped alone and interleaved (what
+interleaving costs the physics); the rate against one env that a batched env with no Python
+cost would reach (one env's step over the interleaved physics split at that scaling), and the
+CPU per world step that the 1.8 x target allows with those cores fully used.
 
 PPO rows: configs/cliff_walk_ppo.yaml on HexapodCliffWalk-v1 with the same rollout size
 (`--rollout` steps over all envs) and `--ppo-steps` steps: SubprocVecEnv(2), the batched
@@ -61,7 +61,7 @@ from agents.pipeline.envs import EnvSpec, make_vec_env  # noqa: E402
 from agents.run_files.train_config import load_train_config  # noqa: E402
 from benchmarks.common import step_profile, verdict  # noqa: E402
 from hexapod_envs.vector import BatchedPhysics  # noqa: E402
-from hexapod_envs.vector.batched import load_period  # noqa: E402
+from hexapod_envs.vector.batched import load_period, period_arrays  # noqa: E402
 from hexapod_envs.vector.compiled_steps import run_control_periods  # noqa: E402
 
 ENV_IDS = ("HexapodCliffWalk-v1", "HexapodStewartTilt-v1", "HexapodIrregularTerrain-v1")
@@ -162,12 +162,12 @@ def physics_ceiling(
     env_id: str, seconds: float, n_worlds: int, threads: int
 ) -> tuple[float, float]:
     """The batching's ceiling on this machine: µs of wall time per world and control period of
-    the physics alone (no other Python), `n_worlds` worlds in turn on the calling thread (each
-    world's `_simulate`), and split between `threads` threads as the batched env runs them: in
-    contiguous compiled shares that hold no GIL where the worlds' periods are plain MuJoCo steps
-    (`BatchedPhysics.compiled`), else each world's `_simulate` on a thread pool. Each round
-    restores every world to the state it had after 50 random-action steps (each thread its own
-    worlds), so both figures step the same states."""
+    the physics alone (no other Python), `n_worlds` worlds in turn on the calling thread and
+    split between `threads` threads, both as the batched env runs them: in compiled shares that
+    hold no GIL where the worlds' periods are plain MuJoCo steps (`BatchedPhysics.compiled`),
+    else each world's `_simulate` (on a thread pool for the threads). Each round restores every
+    world to the state it had after 50 random-action steps (each thread its own worlds), so both
+    figures step the same states."""
     worlds = []
     for seed in range(n_worlds):
         env = gym.make(env_id, **KWARGS)
@@ -201,31 +201,25 @@ def physics_ceiling(
     engine.close()
     with ThreadPoolExecutor(threads) as pool:
         if compiled:
-            arrays = _period_arrays([world for world, *_ in worlds])
+            arrays = period_arrays(n_worlds)
+            for k, (world, *_) in enumerate(worlds):
+                load_period(arrays, k, world)
             bounds = [n_worlds * k // threads for k in range(threads + 1)]
 
-            def share(k: int) -> None:
-                restore(worlds[bounds[k] : bounds[k + 1]])
-                run_control_periods(*arrays, bounds[k], bounds[k + 1])
+            def compiled_share(start: int, stop: int) -> None:
+                restore(worlds[start:stop])
+                run_control_periods(*arrays, start, stop)
 
-            threaded = per_world(lambda: list(pool.map(share, range(threads))))
+            compiled_share(0, 1)  # loads the compiled kernel (start-up, not stepping)
+            threaded = per_world(lambda: list(pool.map(compiled_share, bounds[:-1], bounds[1:])))
+            one = per_world(lambda: compiled_share(0, n_worlds))
         else:
             shares = [worlds[k::threads] for k in range(threads)]
             threaded = per_world(lambda: list(pool.map(periods, shares)))
-    one = per_world(lambda: periods(worlds))
+            one = per_world(lambda: periods(worlds))
     for *_, env in worlds:
         env.close()
     return one, threaded
-
-
-def _period_arrays(worlds: list) -> tuple[np.ndarray, ...]:
-    """`run_control_periods`' arrays for one control period of each of `worlds`."""
-    n = len(worlds)
-    arrays = (np.zeros(n, np.int64), np.zeros(n, np.int64), np.zeros((n, 2), np.int32))
-    arrays += (np.zeros(n, np.int64), np.zeros(n, np.int8))
-    for k, world in enumerate(worlds):
-        load_period(arrays, k, world)
-    return arrays
 
 
 def interleaving_cost(env_id: str, n_worlds: int, steps: int) -> tuple[float, float]:
@@ -237,16 +231,18 @@ def interleaving_cost(env_id: str, n_worlds: int, steps: int) -> tuple[float, fl
     difference is the caches: a world stepped alone finds its model, data and the env's Python
     objects where its last step left them. The first step of each world and the resets' settling
     periods are not counted."""
-    actions = _actions(gym.make(env_id, **KWARGS).action_space, steps * n_worlds, 2)
-    actions = actions.reshape(steps, n_worlds, -1)
-    alone: list[float] = []
+    alone, periods = [], []
     for i in range(n_worlds):
         with gym.make(env_id, **KWARGS) as env, _timing_simulate(env.unwrapped) as times:
+            if i == 0:
+                actions = _actions(env.action_space, steps * n_worlds, 2)
+                actions = actions.reshape(steps, n_worlds, -1)
             env.reset(seed=i)
             for k in range(steps):
                 _, _, terminated, truncated, _ = env.step(actions[k, i])
                 if terminated or truncated:
                     break
+        periods.append(len(times[id(env.unwrapped)]))
         alone += times[id(env.unwrapped)][1:]
     envs = gym.make_vec(
         env_id, n_worlds, vectorization_mode="vector_entry_point", nthread=0, **KWARGS
@@ -255,8 +251,11 @@ def interleaving_cost(env_id: str, n_worlds: int, steps: int) -> tuple[float, fl
     with _timing_simulate(envs.envs[0].unwrapped) as times:
         for k in range(steps):
             envs.step(actions[k])
+    # each world's periods up to where it ended alone (the vector env goes on after an autoreset)
+    interleaved = [
+        t for i, e in enumerate(envs.envs) for t in times[id(e.unwrapped)][1 : periods[i]]
+    ]
     envs.close()
-    interleaved = [t for world in times.values() for t in world[1:]]
     return float(np.mean(alone)) * 1e6, float(np.mean(interleaved)) * 1e6
 
 
@@ -441,7 +440,7 @@ def print_env_rows(
                 f"{r.rate / subproc.rate:10.2f} {r.cpu_us:7.0f} {r.main_us:8.0f} "
                 f"{bound:11.0f} {bound / single_bound:9.2f}"
             )
-            if name.startswith("batched") and not name.endswith("0 threads"):
+            if name.startswith("batched") and threads > 0:
                 judged.append((r.rate / single.rate, r.rate / subproc.rate))
         with gym.make(env_id, **KWARGS) as env:
             profile = step_profile(env, profile_steps)
@@ -471,6 +470,12 @@ def print_env_rows(
     return judged
 
 
+def _positive(text: str) -> int:
+    if not text.isdigit() or int(text) < 1:
+        raise argparse.ArgumentTypeError(f"takes an integer >= 1, got {text!r}")
+    return int(text)
+
+
 def _worlds(text: str) -> tuple[int, ...]:
     sizes = tuple(int(n) for n in text.split(","))
     if not sizes or min(sizes) < 1:
@@ -486,9 +491,11 @@ def main() -> None:
     parser.add_argument("--interleave-steps", type=int, default=100, help="steps a world")
     parser.add_argument("--ppo-steps", type=int, default=8192, help="0: no PPO rows")
     parser.add_argument("--rollout", type=int, default=1024, help="PPO rollout, all envs")
-    parser.add_argument("--threads", type=int, default=2, help="the batched env's physics threads")
+    parser.add_argument(
+        "--threads", type=_positive, default=2, help="the batched env's physics threads"
+    )
     parser.add_argument("--worlds", type=_worlds, default=(8, 16), help="batched sizes, as 8,16")
-    parser.add_argument("--subproc", type=int, default=2, help="SubprocVecEnv workers")
+    parser.add_argument("--subproc", type=_positive, default=2, help="SubprocVecEnv workers")
     args = parser.parse_args()
     setup = Setup(args.threads, args.worlds, args.subproc)
 

@@ -41,8 +41,8 @@ single env's warm start from one control period to the next. `mujoco.batch` keep
 every step, and ATHENA's contact checks within a period would be reimplemented.
 
 What the threads buy, and what caps it: every world's step outside the physics runs on the
-calling thread, so the batched env pays on few cores and SubprocVecEnv, which runs a Python per
-process, overtakes it on many; and cores run the worlds' physics side by side less than
+calling thread, so the batched env pays off on few cores and SubprocVecEnv, which runs a Python
+per process, overtakes it on many; and cores run the worlds' physics side by side less than
 linearly (benchmarks/README.md, ``bench_vector_env.py``).
 """
 
@@ -119,11 +119,7 @@ class BatchedPhysics:
         """The calling thread's share of the worlds in the compiled mode, tuned every step so
         that the helpers finish their worlds when the calling thread reaches them."""
         n = len(self.worlds)
-        self._models = np.zeros(n, np.int64)
-        self._datas = np.zeros(n, np.int64)
-        self._flags = np.zeros((n, 2), np.int32)
-        self._nsteps = np.zeros(n, np.int64)
-        self._done = np.zeros(n, np.int8)
+        self._models, self._datas, self._flags, self._nsteps, self._done = period_arrays(n)
         self._compiled_worlds = 0
         """Worlds of the step in progress run compiled (their flags are ``_done[:n]``)."""
 
@@ -339,6 +335,18 @@ _POLL_S = 5e-5
 
 _STORES_IN_ORDER = platform.machine().lower() in ("x86_64", "amd64")
 """Other cores see a thread's stores in the order it made them (x86-64's memory model)."""
+
+
+def period_arrays(n: int) -> tuple[np.ndarray, ...]:
+    """Empty arrays of `run_control_periods` for `n` worlds: models, datas, flags, nsteps,
+    done (see `load_period`)."""
+    return (
+        np.zeros(n, np.int64),
+        np.zeros(n, np.int64),
+        np.zeros((n, 2), np.int32),
+        np.zeros(n, np.int64),
+        np.zeros(n, np.int8),
+    )
 
 
 def load_period(arrays: Sequence[np.ndarray], k: int, world: HexapodEnv) -> None:
