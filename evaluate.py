@@ -5,12 +5,10 @@ Thin front end of the installed ``hexapod-evaluate`` command for a source checko
 lives in `agents.pipeline`.
 """
 
-import os
 import sys
 
-os.environ.setdefault("MUJOCO_GL", "egl")  # headless rendering for --frames
-
-from agents.pipeline.cli import evaluate_main  # noqa: E402
+from agents.pipeline.cli import default_headless_gl, evaluate_main
 
 if __name__ == "__main__":
+    default_headless_gl()  # before MuJoCo loads
     sys.exit(evaluate_main())

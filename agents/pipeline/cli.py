@@ -274,10 +274,21 @@ def evaluate_main(argv: Sequence[str] | None = None, prog: str = "evaluate.py") 
 
 def hexapod_evaluate() -> int:
     """The ``hexapod-evaluate`` console script."""
+    default_headless_gl()
+    return evaluate_main(prog="hexapod-evaluate")
+
+
+def default_headless_gl() -> None:
+    """Render without a display (``--frames``, ``--video``): ``MUJOCO_GL=egl`` unless the
+    variable is set already or the machine has no libEGL. Call it before MuJoCo is imported.
+    Without libEGL MuJoCo cannot even be imported with ``MUJOCO_GL=egl`` (its renderer loads
+    at import), so the evaluation runs there without rendering, and a frame strip or video
+    says what to set (`hexapod_envs` render errors)."""
+    import ctypes.util
     import os
 
-    os.environ.setdefault("MUJOCO_GL", "egl")  # headless rendering for --frames and --video
-    return evaluate_main(prog="hexapod-evaluate")
+    if "MUJOCO_GL" not in os.environ and ctypes.util.find_library("EGL"):
+        os.environ["MUJOCO_GL"] = "egl"
 
 
 def _suite_envs(config: Path | None, ids: list[str]) -> tuple[list[dict], list[str]]:

@@ -2,6 +2,7 @@
 bad-input paths: clear one-line errors on stderr and a non-zero exit code."""
 
 import json
+import os
 import shutil
 import subprocess
 import sys
@@ -15,7 +16,7 @@ from helpers.cliff_ppo_runs import CONFIG, TINY, evaluate, meta, train
 from helpers.paths import REPO
 
 from agents.pipeline import callbacks
-from agents.pipeline.cli import evaluate_main, train_main
+from agents.pipeline.cli import default_headless_gl, evaluate_main, train_main
 from agents.ppo import PPOPolicy
 from agents.run_files.env_settings import read_settings, resolved_settings
 
@@ -744,3 +745,20 @@ def test_every_switch_that_shapes_the_spaces_is_a_policy_setting(env_id):
             if (made.action_space.shape, made.observation_space.shape) != spaces:
                 shaping.append(name)
     assert shaping and not set(shaping) - set(POLICY_SETTINGS), shaping
+
+
+@pytest.mark.parametrize(
+    ("already", "egl", "expected"),
+    [(None, "libEGL.so.1", "egl"), (None, None, None), ("osmesa", "libEGL.so.1", "osmesa")],
+)
+def test_headless_gl_defaults_to_egl_only_where_libegl_exists(monkeypatch, already, egl, expected):
+    """hexapod-evaluate sets MUJOCO_GL=egl for its frames, but not where libEGL is missing (MuJoCo
+    could not even be imported then) nor over the user's own choice."""
+    import ctypes.util
+
+    monkeypatch.delenv("MUJOCO_GL", raising=False)
+    if already is not None:
+        monkeypatch.setenv("MUJOCO_GL", already)
+    monkeypatch.setattr(ctypes.util, "find_library", lambda name: egl if name == "EGL" else None)
+    default_headless_gl()
+    assert os.environ.get("MUJOCO_GL") == expected
