@@ -1,3 +1,3 @@
-import os
+from agents.pipeline.cli import default_headless_gl
 
-os.environ.setdefault("MUJOCO_GL", "egl")
+default_headless_gl()  # MUJOCO_GL=egl where libEGL exists, before MuJoCo loads
