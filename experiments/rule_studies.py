@@ -16,21 +16,23 @@ Rows = list[dict]
 
 
 def play(env: gym.Env, act: Callable, seeds: range, row: Callable[[int, dict], dict]) -> Rows:
-    """One episode per seed with policy `act` (its ``reset()`` called first); `row(seed, info)`
-    of each episode's last info."""
-    rows = []
+    """One episode per seed with policy `act` (`play_episode`); `row(seed, info)` of each
+    episode's last info. Closes `env`."""
     try:
-        for seed in seeds:
-            obs, info = env.reset(seed=seed)
-            act.reset()
-            done = False
-            while not done:
-                obs, _, terminated, truncated, info = env.step(act(np.asarray(obs)))
-                done = terminated or truncated
-            rows.append(row(seed, info))
+        return [row(seed, play_episode(env, act, seed)) for seed in seeds]
     finally:
         env.close()
-    return rows
+
+
+def play_episode(env: gym.Env, act: Callable, seed: int) -> dict:
+    """The last info of one episode of policy `act` (its ``reset()`` called first) from
+    ``env.reset(seed=seed)``."""
+    obs, _ = env.reset(seed=seed)
+    act.reset()
+    while True:
+        obs, _, terminated, truncated, info = env.step(act(np.asarray(obs)))
+        if terminated or truncated:
+            return info
 
 
 def outcome(seed: int, info: dict) -> dict:

@@ -25,7 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 import hexapod_envs  # noqa: E402,F401
 from agents.ppo import PPOPolicy  # noqa: E402
 from agents.run_files.artifacts import find_model  # noqa: E402
-from experiments.ditch_stride.rules import play_episode  # noqa: E402
+from experiments.rule_studies import play_episode  # noqa: E402
 from hexapod_envs.checks import count_argument  # noqa: E402
 from hexapod_envs.envs.ditch_crossing import DITCH_TEST, DITCH_TRAIN  # noqa: E402
 

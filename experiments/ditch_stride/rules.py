@@ -33,6 +33,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 import hexapod_envs  # noqa: E402,F401
 from agents.upu_stride import ClearStridePolicy, stride_value  # noqa: E402
+from experiments import rule_studies  # noqa: E402
 from hexapod_envs.checks import count_argument  # noqa: E402
 from hexapod_envs.robots.upu.gait_plan import plan_ditch_crossing  # noqa: E402
 
@@ -71,34 +72,21 @@ class StrideRule(ClearStridePolicy):
         return super().stride(ahead, upper_next)
 
 
-def play_episode(env: gym.Env, policy, seed: int) -> dict:
-    """The last info of one episode of `policy` from ``env.reset(seed=seed)``."""
-    obs, _ = env.reset(seed=seed)
-    policy.reset()
-    while True:
-        obs, _, terminated, truncated, info = env.step(policy(obs))
-        if terminated or truncated:
-            return info
-
-
 def run(rule: str, distribution: str, tasks: int, values=None) -> list[dict]:
     env = gym.make(ENV_ID, stride_action=True, task_distribution=distribution)
     policy = StrideRule(env, rule, values=values)
-    rows = []
-    for seed in range(tasks):
-        info = play_episode(env, policy, seed)
-        rows.append(
-            {
-                "seed": seed,
-                "success": bool(info["is_success"]),
-                "tipped": bool(info["is_tipped_over"]),
-                "distance": float(info["distance"]),
-                "max_tilt": float(info["max_tilt_deg"]),
-                "ditch": info["ditch"],
-            }
-        )
-    env.close()
-    return rows
+
+    def row(seed: int, info: dict) -> dict:
+        return {
+            "seed": seed,
+            "success": bool(info["is_success"]),
+            "tipped": bool(info["is_tipped_over"]),
+            "distance": float(info["distance"]),
+            "max_tilt": float(info["max_tilt_deg"]),
+            "ditch": info["ditch"],
+        }
+
+    return rule_studies.play(env, policy, range(tasks), row)
 
 
 def main() -> None:
